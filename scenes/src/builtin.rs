@@ -1,0 +1,221 @@
+//! Built-in scenes: the measured Cornell box, the textbook penumbra scene, and a furnace.
+
+use glam::DVec3;
+
+use crate::color::Rgb;
+use crate::model::{Camera, Scene, Surface};
+use crate::polygon;
+
+/// Names and one-line descriptions of the built-in scenes.
+pub const NAMES: [(&str, &str); 3] = [
+    (
+        "cornell",
+        "the measured Cornell box (mm): red and green walls, two white blocks, ceiling light",
+    ),
+    (
+        "textbook",
+        "unit square light at height 3, unit square blocker at height 1, a floor: closed-form penumbra",
+    ),
+    (
+        "furnace",
+        "closed unit cube, every face emitting (E = 1) and reflecting (rho = 0.5): B = E / (1 - rho)",
+    ),
+];
+
+/// The built-in scene called `name`.
+pub fn builtin(name: &str) -> Option<Scene> {
+    match name {
+        "cornell" => Some(cornell()),
+        "textbook" => Some(textbook()),
+        "furnace" => Some(furnace(1.0, 0.5)),
+        _ => None,
+    }
+}
+
+fn v(x: f64, y: f64, z: f64) -> DVec3 {
+    DVec3::new(x, y, z)
+}
+
+/// Reverses `polygon` if needed so that its front faces `toward` (or away, if `outward`).
+fn facing(mut polygon: Vec<DVec3>, point: DVec3, outward: bool) -> Vec<DVec3> {
+    let n = polygon::newell_normal(&polygon);
+    let to_point = point - polygon::centroid(&polygon);
+    if (n.dot(to_point) < 0.0) != outward {
+        polygon.reverse();
+    }
+    polygon
+}
+
+/// The Cornell box as measured (<https://www.graphics.cornell.edu/online/box/data.html>), in mm.
+///
+/// The red wall's measured corners are 3 mm off a plane, so it is split into two triangles. The
+/// light is lowered 0.1 mm below the ceiling so that the two do not share a plane. The blocks are
+/// their five visible faces.
+pub fn cornell() -> Scene {
+    let white = Rgb::splat(0.73);
+    let red = Rgb::new(0.63, 0.065, 0.05);
+    let green = Rgb::new(0.14, 0.45, 0.091);
+    let inside = v(278.0, 274.4, 279.6);
+    let wall = |name: &str, p: Vec<DVec3>, rho: Rgb| Surface::new(name, facing(p, inside, false), rho);
+
+    let mut surfaces = vec![
+        wall(
+            "floor",
+            vec![v(552.8, 0.0, 0.0), v(0.0, 0.0, 0.0), v(0.0, 0.0, 559.2), v(549.6, 0.0, 559.2)],
+            white,
+        ),
+        wall(
+            "ceiling",
+            vec![v(556.0, 548.8, 0.0), v(556.0, 548.8, 559.2), v(0.0, 548.8, 559.2), v(0.0, 548.8, 0.0)],
+            white,
+        ),
+        wall(
+            "back_wall",
+            vec![v(549.6, 0.0, 559.2), v(0.0, 0.0, 559.2), v(0.0, 548.8, 559.2), v(556.0, 548.8, 559.2)],
+            white,
+        ),
+        wall(
+            "green_wall",
+            vec![v(0.0, 0.0, 559.2), v(0.0, 0.0, 0.0), v(0.0, 548.8, 0.0), v(0.0, 548.8, 559.2)],
+            green,
+        ),
+        // The measured red wall is not planar: split along the diagonal 0-2.
+        wall(
+            "red_wall_low",
+            vec![v(552.8, 0.0, 0.0), v(549.6, 0.0, 559.2), v(556.0, 548.8, 559.2)],
+            red,
+        ),
+        wall(
+            "red_wall_high",
+            vec![v(552.8, 0.0, 0.0), v(556.0, 548.8, 559.2), v(556.0, 548.8, 0.0)],
+            red,
+        ),
+        wall(
+            "light",
+            vec![v(343.0, 548.7, 227.0), v(343.0, 548.7, 332.0), v(213.0, 548.7, 332.0), v(213.0, 548.7, 227.0)],
+            Rgb::splat(0.78),
+        )
+        .with_emission(Rgb::new(57.8, 49.0, 25.1)),
+    ];
+
+    let short_top = [v(130.0, 165.0, 65.0), v(82.0, 165.0, 225.0), v(240.0, 165.0, 272.0), v(290.0, 165.0, 114.0)];
+    let tall_top = [v(423.0, 330.0, 247.0), v(265.0, 330.0, 296.0), v(314.0, 330.0, 456.0), v(472.0, 330.0, 406.0)];
+    for (block, top) in [("short_block", short_top), ("tall_block", tall_top)] {
+        let center = polygon::centroid(&top) * DVec3::new(1.0, 0.5, 1.0);
+        surfaces.push(Surface::new(format!("{block}_top"), facing(top.to_vec(), center, true), white));
+        for i in 0..4 {
+            let (a, b) = (top[i], top[(i + 1) % 4]);
+            let side = vec![v(a.x, 0.0, a.z), v(b.x, 0.0, b.z), b, a];
+            surfaces.push(Surface::new(format!("{block}_side{i}"), facing(side, center, true), white));
+        }
+    }
+
+    Scene {
+        name: "cornell".into(),
+        camera: Some(Camera {
+            eye: v(278.0, 273.0, -800.0),
+            target: v(278.0, 273.0, 0.0),
+            up: v(0.0, 1.0, 0.0),
+            // 35 mm focal length on a 25 mm film.
+            fov_deg: 2.0 * (12.5f64 / 35.0).atan().to_degrees(),
+        }),
+        surfaces,
+    }
+}
+
+/// Section 3 of the analytic notes: a unit square light (exitance 1) at height 3 facing down, a unit
+/// square blocker at height 1, and a 6 x 6 floor. On the floor the umbra is |x|, |y| <= 0.5 and
+/// the penumbra reaches |x|, |y| = 1.
+pub fn textbook() -> Scene {
+    let square = |h: f64, s: f64| vec![v(-s, -s, h), v(s, -s, h), v(s, s, h), v(-s, s, h)];
+    let mut light = square(3.0, 0.5);
+    light.reverse(); // facing down
+    Scene {
+        name: "textbook".into(),
+        camera: Some(Camera {
+            eye: v(0.0, -6.5, 4.5),
+            target: v(0.0, 0.0, 0.4),
+            up: v(0.0, 0.0, 1.0),
+            fov_deg: 45.0,
+        }),
+        surfaces: vec![
+            Surface::new("light", light, Rgb::ZERO).with_emission(Rgb::splat(1.0)),
+            Surface::new("blocker", square(1.0, 0.5), Rgb::splat(0.5)),
+            Surface::new("floor", square(0.0, 3.0), Rgb::splat(0.7)),
+        ],
+    }
+}
+
+/// A closed unit cube whose six inward faces all emit `emission` and reflect `reflectance`: the
+/// exact radiosity is `emission / (1 - reflectance)` everywhere.
+pub fn furnace(emission: f64, reflectance: f64) -> Scene {
+    let inside = DVec3::splat(0.5);
+    let faces = [
+        ("floor", [v(0., 0., 0.), v(1., 0., 0.), v(1., 1., 0.), v(0., 1., 0.)]),
+        ("ceiling", [v(0., 0., 1.), v(1., 0., 1.), v(1., 1., 1.), v(0., 1., 1.)]),
+        ("south", [v(0., 0., 0.), v(1., 0., 0.), v(1., 0., 1.), v(0., 0., 1.)]),
+        ("north", [v(0., 1., 0.), v(1., 1., 0.), v(1., 1., 1.), v(0., 1., 1.)]),
+        ("west", [v(0., 0., 0.), v(0., 1., 0.), v(0., 1., 1.), v(0., 0., 1.)]),
+        ("east", [v(1., 0., 0.), v(1., 1., 0.), v(1., 1., 1.), v(1., 0., 1.)]),
+    ];
+    Scene {
+        name: "furnace".into(),
+        camera: Some(Camera {
+            eye: v(0.5, 0.02, 0.5),
+            target: v(0.5, 1.0, 0.5),
+            up: v(0.0, 0.0, 1.0),
+            fov_deg: 100.0,
+        }),
+        surfaces: faces
+            .into_iter()
+            .map(|(name, p)| {
+                Surface::new(name, facing(p.to_vec(), inside, false), Rgb::splat(reflectance))
+                    .with_emission(Rgb::splat(emission))
+            })
+            .collect(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::validate::validate;
+
+    #[test]
+    fn builtins_are_valid() {
+        for (name, _) in NAMES {
+            let scene = builtin(name).expect("every listed name is built in");
+            assert_eq!(validate(&scene), vec![], "{name}");
+        }
+    }
+
+    #[test]
+    fn cornell_faces_point_into_the_room_and_out_of_the_blocks() {
+        let scene = cornell();
+        let room_center = v(278.0, 274.4, 279.6);
+        for s in &scene.surfaces {
+            let c = polygon::centroid(&s.polygon);
+            let n = s.normal();
+            if s.name.contains("block") {
+                // Block faces see the room centre's side less than the walls do; check against the block axis.
+                let axis = if s.name.starts_with("short") { v(186.0, c.y, 169.0) } else { v(368.5, c.y, 351.25) };
+                let outward = if s.name.ends_with("top") { v(0.0, 1.0, 0.0) } else { (c - axis).normalize() };
+                assert!(n.dot(outward) > 0.5, "{} faces inward", s.name);
+            } else {
+                assert!(n.dot(room_center - c) > 0.0, "{} faces out of the room", s.name);
+            }
+        }
+        let light = &scene.surfaces[scene.surface_id("light").expect("cornell has a light")];
+        assert!(light.normal().y < -0.999);
+    }
+
+    #[test]
+    fn furnace_faces_point_inward() {
+        let scene = furnace(1.0, 0.5);
+        for s in &scene.surfaces {
+            let c = polygon::centroid(&s.polygon);
+            assert!(s.normal().dot(DVec3::splat(0.5) - c) > 0.0, "{}", s.name);
+            assert!((s.area() - 1.0).abs() < 1e-15);
+        }
+    }
+}

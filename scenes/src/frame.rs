@@ -1,0 +1,84 @@
+//! Plane frames: each surface's own 2D coordinate system.
+//!
+//! A frame is built from the polygon alone (origin at its first vertex, `u` along its first edge,
+//! `v = n × u`), so a surface's 2D coordinates do not depend on where the scene sits in space:
+//! moving or rotating the scene leaves them unchanged up to rounding.
+
+use glam::{DVec2, DVec3};
+
+use crate::polygon;
+
+/// An orthonormal frame of a plane: `to_3d(to_2d(p)) == p` for points on the plane.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlaneFrame {
+    pub origin: DVec3,
+    pub u: DVec3,
+    pub v: DVec3,
+    pub normal: DVec3,
+}
+
+impl PlaneFrame {
+    /// The frame of a polygon; `None` when the polygon has no area or no usable edge.
+    pub fn of_polygon(points: &[DVec3]) -> Option<PlaneFrame> {
+        let normal = polygon::newell_normal(points).try_normalize()?;
+        let origin = *points.first()?;
+        // The first edge that is not negligible against the polygon's size sets `u`.
+        let size = polygon::diameter(points);
+        let u = points
+            .iter()
+            .skip(1)
+            .map(|&p| p - origin)
+            .map(|d| d - normal * normal.dot(d))
+            .find(|d| d.length() > 1e-9 * size)?
+            .try_normalize()?;
+        let v = normal.cross(u);
+        Some(PlaneFrame {
+            origin,
+            u,
+            v,
+            normal,
+        })
+    }
+
+    pub fn to_2d(&self, p: DVec3) -> DVec2 {
+        let d = p - self.origin;
+        DVec2::new(d.dot(self.u), d.dot(self.v))
+    }
+
+    pub fn to_3d(&self, q: DVec2) -> DVec3 {
+        self.origin + self.u * q.x + self.v * q.y
+    }
+
+    /// Signed distance of `p` from the plane, positive on the front.
+    pub fn height(&self, p: DVec3) -> f64 {
+        (p - self.origin).dot(self.normal)
+    }
+
+    pub fn vector_to_3d(&self, d: DVec2) -> DVec3 {
+        self.u * d.x + self.v * d.y
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn round_trip_and_orientation() {
+        let poly = [
+            DVec3::new(1.0, 2.0, 3.0),
+            DVec3::new(4.0, 2.0, 3.0),
+            DVec3::new(4.0, 5.0, 7.0),
+            DVec3::new(1.0, 5.0, 7.0),
+        ];
+        let f = PlaneFrame::of_polygon(&poly).expect("a valid quad has a frame");
+        for &p in &poly {
+            assert!((f.to_3d(f.to_2d(p)) - p).length() < 1e-14);
+            assert!(f.height(p).abs() < 1e-14);
+        }
+        // Counter-clockwise in 3D about the normal stays counter-clockwise in 2D.
+        let q: Vec<DVec2> = poly.iter().map(|&p| f.to_2d(p)).collect();
+        assert!(polygon::signed_area_2d(&q) > 0.0);
+        assert!((polygon::signed_area_2d(&q) - 15.0).abs() < 1e-12);
+    }
+}

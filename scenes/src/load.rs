@@ -1,0 +1,128 @@
+//! Loading scenes: built-in names, our JSON format, and OBJ+MTL.
+
+use std::path::{Path, PathBuf};
+
+use glam::DVec3;
+
+use crate::builtin;
+use crate::error::SceneError;
+use crate::model::{Scene, Surface};
+use crate::obj;
+use crate::validate::validate;
+
+/// A validated scene and what loading it had to repair.
+#[derive(Clone, Debug)]
+pub struct LoadedScene {
+    pub scene: Scene,
+    /// Where it came from: a path, or `builtin:NAME`.
+    pub source: String,
+    /// Repairs made while loading (OBJ only), one line each.
+    pub warnings: Vec<String>,
+}
+
+/// Loads `spec` — a path to a `.json` or `.obj` file, or the name of a built-in scene — and
+/// validates it. Every problem is reported at once.
+pub fn load_scene(spec: &str) -> Result<LoadedScene, SceneError> {
+    let path = Path::new(spec);
+    let looks_like_path = path.exists()
+        || spec.contains(std::path::MAIN_SEPARATOR)
+        || spec.contains('/')
+        || path.extension().is_some();
+    let (scene, source, warnings) = if looks_like_path {
+        let (scene, warnings) = read_scene_file(path)?;
+        (scene, path.display().to_string(), warnings)
+    } else if let Some(scene) = builtin::builtin(spec) {
+        (scene, format!("builtin:{spec}"), Vec::new())
+    } else {
+        return Err(SceneError::UnknownScene {
+            name: spec.to_string(),
+            available: builtin::NAMES.iter().map(|(n, _)| *n).collect(),
+        });
+    };
+    let problems = validate(&scene);
+    if !problems.is_empty() {
+        return Err(SceneError::Invalid {
+            source_name: source,
+            problems,
+        });
+    }
+    Ok(LoadedScene {
+        scene,
+        source,
+        warnings,
+    })
+}
+
+/// Reads a scene file without validating it.
+pub fn read_scene_file(path: &Path) -> Result<(Scene, Vec<String>), SceneError> {
+    let extension = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match extension.as_deref() {
+        Some("json") => {
+            let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+                path: path.to_path_buf(),
+                source,
+            })?;
+            let scene = parse_json(&text, path)?;
+            Ok((scene, Vec::new()))
+        }
+        Some("obj") => obj::read_obj(path),
+        _ => Err(SceneError::UnsupportedFormat {
+            path: path.to_path_buf(),
+        }),
+    }
+}
+
+/// Parses the JSON scene format; `path` only names the source in errors.
+pub fn parse_json(text: &str, path: &Path) -> Result<Scene, SceneError> {
+    let mut scene: Scene = serde_json::from_str(text).map_err(|e| SceneError::Json {
+        path: PathBuf::from(path),
+        line: e.line(),
+        column: e.column(),
+        message: strip_position(&e.to_string()),
+    })?;
+    if scene.name.is_empty() {
+        scene.name = path
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .unwrap_or("scene")
+            .to_string();
+    }
+    for s in &mut scene.surfaces {
+        drop_repeated_vertices(&mut s.polygon);
+    }
+    Ok(scene)
+}
+
+/// serde_json appends " at line L column C"; the error already says where.
+fn strip_position(message: &str) -> String {
+    match message.rfind(" at line ") {
+        Some(i) => message[..i].to_string(),
+        None => message.to_string(),
+    }
+}
+
+/// Removes vertices exactly equal to their predecessor, and a closing vertex equal to the first:
+/// both are common ways of writing a polygon and neither changes its shape.
+pub fn drop_repeated_vertices(polygon: &mut Vec<DVec3>) {
+    polygon.dedup();
+    while polygon.len() > 1 && polygon.first() == polygon.last() {
+        polygon.pop();
+    }
+}
+
+/// Writes a scene in the JSON format (pretty-printed).
+pub fn to_json(scene: &Scene) -> String {
+    serde_json::to_string_pretty(scene).unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"))
+}
+
+impl Surface {
+    /// True when every number of the surface is finite.
+    pub fn is_finite(&self) -> bool {
+        self.polygon.iter().all(|p| p.is_finite())
+            && self.emission.is_finite()
+            && self.reflectance.is_finite()
+    }
+}

@@ -1,0 +1,288 @@
+//! Scene validation: every problem at once, each naming the surface and what to change.
+//!
+//! The thresholds guard numerical degeneracy, not physical size: a light a millionth of the scene
+//! or a scene measured in micrometres is legitimate. Every threshold is relative — to the scene's
+//! bounding-box diagonal or to the polygon's own size.
+
+use std::collections::HashMap;
+use std::fmt;
+
+use glam::DVec3;
+
+use crate::frame::PlaneFrame;
+use crate::model::{Scene, Surface};
+use crate::polygon;
+
+/// Vertices closer than this fraction of the scene diagonal are the same vertex.
+pub const SAME_POINT_TOLERANCE: f64 = 1e-12;
+/// Polygons smaller than this fraction of the scene diagonal are rounding noise, not geometry.
+pub const MIN_RELATIVE_SIZE: f64 = 1e-10;
+/// Polygons whose area is below this fraction of their diameter squared are slivers.
+pub const MIN_THINNESS: f64 = 1e-9;
+/// Largest distance of a vertex from the polygon's plane, relative to the polygon's diameter.
+pub const PLANARITY_TOLERANCE: f64 = 1e-6;
+
+/// One thing wrong with a scene.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Problem {
+    /// The surface concerned, or `None` for scene-wide problems.
+    pub surface: Option<String>,
+    pub kind: ProblemKind,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum ProblemKind {
+    NoSurfaces,
+    EmptyName,
+    NonFinite { field: &'static str },
+    TooFewVertices { distinct: usize },
+    RepeatedVertex { first: usize, second: usize },
+    TinyArea { area: f64, diameter: f64, scene_diagonal: f64 },
+    NonPlanar { deviation: f64, vertex: usize, tolerance: f64 },
+    SelfIntersecting { edge_a: usize, edge_b: usize },
+    ReflectanceOutOfRange { channel: &'static str, value: f64 },
+    NegativeEmission { channel: &'static str, value: f64 },
+    DuplicateName { first: usize, second: usize },
+    NoEmitter,
+    BadCamera { reason: &'static str },
+}
+
+impl fmt::Display for Problem {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if let Some(name) = &self.surface {
+            write!(f, "surface \"{name}\": ")?;
+        }
+        use ProblemKind::*;
+        match &self.kind {
+            NoSurfaces => write!(f, "the scene has no surfaces; add at least an emitter and a receiver"),
+            EmptyName => write!(f, "a surface has an empty name; give every surface a unique name"),
+            NonFinite { field } => write!(
+                f,
+                "{field} contains a non-finite number (NaN or infinity); replace it with a finite value"
+            ),
+            TooFewVertices { distinct } => write!(
+                f,
+                "the polygon has {distinct} distinct vertices; a surface needs at least 3"
+            ),
+            RepeatedVertex { first, second } => write!(
+                f,
+                "vertices {first} and {second} coincide; remove the repeated vertex (a polygon may not touch itself)"
+            ),
+            TinyArea {
+                area,
+                diameter,
+                scene_diagonal,
+            } => write!(
+                f,
+                "the polygon has zero or negligible area ({area:.3e}, diameter {diameter:.3e}, scene diagonal \
+                 {scene_diagonal:.3e}); remove it or give it a real extent (its vertices may be collinear)"
+            ),
+            NonPlanar {
+                deviation,
+                vertex,
+                tolerance,
+            } => write!(
+                f,
+                "the polygon is not planar: vertex {vertex} lies {deviation:.3e} from its plane (tolerance \
+                 {tolerance:.3e}); split it into planar pieces, e.g. triangles"
+            ),
+            SelfIntersecting { edge_a, edge_b } => write!(
+                f,
+                "the polygon intersects itself (edges {edge_a} and {edge_b} touch); reorder its vertices or split it \
+                 into simple polygons"
+            ),
+            ReflectanceOutOfRange { channel, value } => write!(
+                f,
+                "reflectance {value} in channel {channel} is outside [0, 1); a surface cannot reflect all the light it \
+                 receives — use a value below 1"
+            ),
+            NegativeEmission { channel, value } => write!(
+                f,
+                "emission {value} in channel {channel} is negative; emission must be zero or positive"
+            ),
+            DuplicateName { first, second } => write!(
+                f,
+                "surfaces {first} and {second} share this name; give each surface a unique name"
+            ),
+            NoEmitter => write!(
+                f,
+                "no surface emits light; give at least one surface a positive \"emission\""
+            ),
+            BadCamera { reason } => write!(f, "camera: {reason}"),
+        }
+    }
+}
+
+/// All the problems of a scene; empty when the scene is valid.
+pub fn validate(scene: &Scene) -> Vec<Problem> {
+    let mut problems = Vec::new();
+    if scene.surfaces.is_empty() {
+        problems.push(Problem {
+            surface: None,
+            kind: ProblemKind::NoSurfaces,
+        });
+        return problems;
+    }
+    let finite_points = scene
+        .surfaces
+        .iter()
+        .filter(|s| s.polygon.iter().all(|p| p.is_finite()))
+        .flat_map(|s| s.polygon.iter());
+    let scene_diagonal = crate::model::Bounds::from_points(finite_points).diagonal();
+
+    let mut seen: HashMap<&str, usize> = HashMap::new();
+    for (index, surface) in scene.surfaces.iter().enumerate() {
+        let mut report = |kind| {
+            problems.push(Problem {
+                surface: Some(surface.name.clone()),
+                kind,
+            });
+        };
+        if surface.name.is_empty() {
+            report(ProblemKind::EmptyName);
+        } else if let Some(&first) = seen.get(surface.name.as_str()) {
+            report(ProblemKind::DuplicateName {
+                first,
+                second: index,
+            });
+        } else {
+            seen.insert(&surface.name, index);
+        }
+        check_material(surface, &mut report);
+        check_geometry(surface, scene_diagonal, &mut report);
+    }
+
+    let emits = scene
+        .surfaces
+        .iter()
+        .any(|s| s.is_emitter() && s.emission.is_finite());
+    if !emits {
+        problems.push(Problem {
+            surface: None,
+            kind: ProblemKind::NoEmitter,
+        });
+    }
+    if let Some(c) = &scene.camera {
+        if let Some(reason) = camera_problem(c) {
+            problems.push(Problem {
+                surface: None,
+                kind: ProblemKind::BadCamera { reason },
+            });
+        }
+    }
+    problems
+}
+
+const CHANNELS: [&str; 3] = ["r", "g", "b"];
+
+fn check_material(surface: &Surface, report: &mut impl FnMut(ProblemKind)) {
+    if !surface.reflectance.is_finite() {
+        report(ProblemKind::NonFinite {
+            field: "reflectance",
+        });
+    } else {
+        for (channel, value) in CHANNELS.into_iter().zip(surface.reflectance.to_array()) {
+            if !(0.0..1.0).contains(&value) {
+                report(ProblemKind::ReflectanceOutOfRange { channel, value });
+            }
+        }
+    }
+    if !surface.emission.is_finite() {
+        report(ProblemKind::NonFinite { field: "emission" });
+    } else {
+        for (channel, value) in CHANNELS.into_iter().zip(surface.emission.to_array()) {
+            if value < 0.0 {
+                report(ProblemKind::NegativeEmission { channel, value });
+            }
+        }
+    }
+}
+
+fn check_geometry(surface: &Surface, scene_diagonal: f64, report: &mut impl FnMut(ProblemKind)) {
+    let points = &surface.polygon;
+    if points.iter().any(|p| !p.is_finite()) {
+        report(ProblemKind::NonFinite { field: "polygon" });
+        return;
+    }
+    let same = SAME_POINT_TOLERANCE * scene_diagonal;
+    let mut distinct: Vec<DVec3> = Vec::new();
+    for &p in points {
+        if distinct.iter().all(|&q| q.distance(p) > same) {
+            distinct.push(p);
+        }
+    }
+    if distinct.len() < 3 {
+        report(ProblemKind::TooFewVertices {
+            distinct: distinct.len(),
+        });
+        return;
+    }
+    for i in 0..points.len() {
+        for j in i + 1..points.len() {
+            if points[i].distance(points[j]) <= same {
+                report(ProblemKind::RepeatedVertex {
+                    first: i,
+                    second: j,
+                });
+                return;
+            }
+        }
+    }
+    let diameter = polygon::diameter(points);
+    let area = surface.area();
+    if diameter < MIN_RELATIVE_SIZE * scene_diagonal || area < MIN_THINNESS * diameter * diameter {
+        report(ProblemKind::TinyArea {
+            area,
+            diameter,
+            scene_diagonal,
+        });
+        return;
+    }
+    let Some(frame) = PlaneFrame::of_polygon(points) else {
+        report(ProblemKind::TinyArea {
+            area,
+            diameter,
+            scene_diagonal,
+        });
+        return;
+    };
+    // Distances are measured from the best-fit plane through the centroid, not the first vertex.
+    let centroid = polygon::centroid(points);
+    let tolerance = PLANARITY_TOLERANCE * diameter;
+    if let Some((vertex, deviation)) = points
+        .iter()
+        .map(|&p| (p - centroid).dot(frame.normal).abs())
+        .enumerate()
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .filter(|&(_, d)| d > tolerance)
+    {
+        report(ProblemKind::NonPlanar {
+            deviation,
+            vertex,
+            tolerance,
+        });
+        return;
+    }
+    let flat: Vec<_> = points.iter().map(|&p| frame.to_2d(p)).collect();
+    if let Some((edge_a, edge_b)) = polygon::first_self_intersection(&flat) {
+        report(ProblemKind::SelfIntersecting { edge_a, edge_b });
+    }
+}
+
+fn camera_problem(c: &crate::model::Camera) -> Option<&'static str> {
+    if !(c.eye.is_finite() && c.target.is_finite() && c.up.is_finite() && c.fov_deg.is_finite()) {
+        return Some("contains a non-finite number; replace it with a finite value");
+    }
+    let view = c.target - c.eye;
+    if view.length() == 0.0 {
+        return Some("eye and target coincide; move the target in front of the eye");
+    }
+    if view.cross(c.up).length() <= 1e-9 * view.length() * c.up.length() {
+        return Some("up is zero or parallel to the view direction; choose an up vector across the view");
+    }
+    if !(c.fov_deg > 0.0 && c.fov_deg < 180.0) {
+        return Some("fov_deg must be between 0 and 180 degrees");
+    }
+    None
+}
