@@ -1,1 +1,23 @@
-//! placeholder
+//! # penumbra-meshing
+//!
+//! Per-surface meshes for radiosity: each surface's polygon is triangulated in its own 2D
+//! coordinates with a constrained Delaunay triangulation (`spade`) and refined to a target size.
+//! Values live at mesh vertices and are interpolated linearly over the triangles.
+//!
+//! ```
+//! use penumbra_meshing::mesh_scene_uniform;
+//! let scene = penumbra_scenes::builtin::textbook();
+//! let mesh = mesh_scene_uniform(&scene, 500).unwrap();
+//! assert!(mesh.triangle_count() <= 500);
+//! mesh.sanity_check().unwrap();
+//! ```
+
+pub mod error;
+pub mod mesh;
+pub mod scene_mesh;
+pub mod uniform;
+
+pub use error::MeshError;
+pub use mesh::{MeshQuality, SurfaceMesh, quality_of};
+pub use scene_mesh::{SceneMesh, mesh_scene_uniform, spread_by_area};
+pub use uniform::{MeshCoordinates, mesh_surface_uniform};

@@ -56,57 +56,109 @@ pub fn cornell() -> Scene {
     let red = Rgb::new(0.63, 0.065, 0.05);
     let green = Rgb::new(0.14, 0.45, 0.091);
     let inside = v(278.0, 274.4, 279.6);
-    let wall = |name: &str, p: Vec<DVec3>, rho: Rgb| Surface::new(name, facing(p, inside, false), rho);
+    let wall =
+        |name: &str, p: Vec<DVec3>, rho: Rgb| Surface::new(name, facing(p, inside, false), rho);
 
     let mut surfaces = vec![
         wall(
             "floor",
-            vec![v(552.8, 0.0, 0.0), v(0.0, 0.0, 0.0), v(0.0, 0.0, 559.2), v(549.6, 0.0, 559.2)],
+            vec![
+                v(552.8, 0.0, 0.0),
+                v(0.0, 0.0, 0.0),
+                v(0.0, 0.0, 559.2),
+                v(549.6, 0.0, 559.2),
+            ],
             white,
         ),
         wall(
             "ceiling",
-            vec![v(556.0, 548.8, 0.0), v(556.0, 548.8, 559.2), v(0.0, 548.8, 559.2), v(0.0, 548.8, 0.0)],
+            vec![
+                v(556.0, 548.8, 0.0),
+                v(556.0, 548.8, 559.2),
+                v(0.0, 548.8, 559.2),
+                v(0.0, 548.8, 0.0),
+            ],
             white,
         ),
         wall(
             "back_wall",
-            vec![v(549.6, 0.0, 559.2), v(0.0, 0.0, 559.2), v(0.0, 548.8, 559.2), v(556.0, 548.8, 559.2)],
+            vec![
+                v(549.6, 0.0, 559.2),
+                v(0.0, 0.0, 559.2),
+                v(0.0, 548.8, 559.2),
+                v(556.0, 548.8, 559.2),
+            ],
             white,
         ),
         wall(
             "green_wall",
-            vec![v(0.0, 0.0, 559.2), v(0.0, 0.0, 0.0), v(0.0, 548.8, 0.0), v(0.0, 548.8, 559.2)],
+            vec![
+                v(0.0, 0.0, 559.2),
+                v(0.0, 0.0, 0.0),
+                v(0.0, 548.8, 0.0),
+                v(0.0, 548.8, 559.2),
+            ],
             green,
         ),
         // The measured red wall is not planar: split along the diagonal 0-2.
         wall(
             "red_wall_low",
-            vec![v(552.8, 0.0, 0.0), v(549.6, 0.0, 559.2), v(556.0, 548.8, 559.2)],
+            vec![
+                v(552.8, 0.0, 0.0),
+                v(549.6, 0.0, 559.2),
+                v(556.0, 548.8, 559.2),
+            ],
             red,
         ),
         wall(
             "red_wall_high",
-            vec![v(552.8, 0.0, 0.0), v(556.0, 548.8, 559.2), v(556.0, 548.8, 0.0)],
+            vec![
+                v(552.8, 0.0, 0.0),
+                v(556.0, 548.8, 559.2),
+                v(556.0, 548.8, 0.0),
+            ],
             red,
         ),
         wall(
             "light",
-            vec![v(343.0, 548.7, 227.0), v(343.0, 548.7, 332.0), v(213.0, 548.7, 332.0), v(213.0, 548.7, 227.0)],
+            vec![
+                v(343.0, 548.7, 227.0),
+                v(343.0, 548.7, 332.0),
+                v(213.0, 548.7, 332.0),
+                v(213.0, 548.7, 227.0),
+            ],
             Rgb::splat(0.78),
         )
         .with_emission(Rgb::new(57.8, 49.0, 25.1)),
     ];
 
-    let short_top = [v(130.0, 165.0, 65.0), v(82.0, 165.0, 225.0), v(240.0, 165.0, 272.0), v(290.0, 165.0, 114.0)];
-    let tall_top = [v(423.0, 330.0, 247.0), v(265.0, 330.0, 296.0), v(314.0, 330.0, 456.0), v(472.0, 330.0, 406.0)];
+    let short_top = [
+        v(130.0, 165.0, 65.0),
+        v(82.0, 165.0, 225.0),
+        v(240.0, 165.0, 272.0),
+        v(290.0, 165.0, 114.0),
+    ];
+    let tall_top = [
+        v(423.0, 330.0, 247.0),
+        v(265.0, 330.0, 296.0),
+        v(314.0, 330.0, 456.0),
+        v(472.0, 330.0, 406.0),
+    ];
     for (block, top) in [("short_block", short_top), ("tall_block", tall_top)] {
         let center = polygon::centroid(&top) * DVec3::new(1.0, 0.5, 1.0);
-        surfaces.push(Surface::new(format!("{block}_top"), facing(top.to_vec(), center, true), white));
+        surfaces.push(Surface::new(
+            format!("{block}_top"),
+            facing(top.to_vec(), center, true),
+            white,
+        ));
         for i in 0..4 {
             let (a, b) = (top[i], top[(i + 1) % 4]);
             let side = vec![v(a.x, 0.0, a.z), v(b.x, 0.0, b.z), b, a];
-            surfaces.push(Surface::new(format!("{block}_side{i}"), facing(side, center, true), white));
+            surfaces.push(Surface::new(
+                format!("{block}_side{i}"),
+                facing(side, center, true),
+                white,
+            ));
         }
     }
 
@@ -151,12 +203,30 @@ pub fn textbook() -> Scene {
 pub fn furnace(emission: f64, reflectance: f64) -> Scene {
     let inside = DVec3::splat(0.5);
     let faces = [
-        ("floor", [v(0., 0., 0.), v(1., 0., 0.), v(1., 1., 0.), v(0., 1., 0.)]),
-        ("ceiling", [v(0., 0., 1.), v(1., 0., 1.), v(1., 1., 1.), v(0., 1., 1.)]),
-        ("south", [v(0., 0., 0.), v(1., 0., 0.), v(1., 0., 1.), v(0., 0., 1.)]),
-        ("north", [v(0., 1., 0.), v(1., 1., 0.), v(1., 1., 1.), v(0., 1., 1.)]),
-        ("west", [v(0., 0., 0.), v(0., 1., 0.), v(0., 1., 1.), v(0., 0., 1.)]),
-        ("east", [v(1., 0., 0.), v(1., 1., 0.), v(1., 1., 1.), v(1., 0., 1.)]),
+        (
+            "floor",
+            [v(0., 0., 0.), v(1., 0., 0.), v(1., 1., 0.), v(0., 1., 0.)],
+        ),
+        (
+            "ceiling",
+            [v(0., 0., 1.), v(1., 0., 1.), v(1., 1., 1.), v(0., 1., 1.)],
+        ),
+        (
+            "south",
+            [v(0., 0., 0.), v(1., 0., 0.), v(1., 0., 1.), v(0., 0., 1.)],
+        ),
+        (
+            "north",
+            [v(0., 1., 0.), v(1., 1., 0.), v(1., 1., 1.), v(0., 1., 1.)],
+        ),
+        (
+            "west",
+            [v(0., 0., 0.), v(0., 1., 0.), v(0., 1., 1.), v(0., 0., 1.)],
+        ),
+        (
+            "east",
+            [v(1., 0., 0.), v(1., 1., 0.), v(1., 1., 1.), v(1., 0., 1.)],
+        ),
     ];
     Scene {
         name: "furnace".into(),
@@ -169,8 +239,12 @@ pub fn furnace(emission: f64, reflectance: f64) -> Scene {
         surfaces: faces
             .into_iter()
             .map(|(name, p)| {
-                Surface::new(name, facing(p.to_vec(), inside, false), Rgb::splat(reflectance))
-                    .with_emission(Rgb::splat(emission))
+                Surface::new(
+                    name,
+                    facing(p.to_vec(), inside, false),
+                    Rgb::splat(reflectance),
+                )
+                .with_emission(Rgb::splat(emission))
             })
             .collect(),
     }
@@ -198,11 +272,23 @@ mod tests {
             let n = s.normal();
             if s.name.contains("block") {
                 // Block faces see the room centre's side less than the walls do; check against the block axis.
-                let axis = if s.name.starts_with("short") { v(186.0, c.y, 169.0) } else { v(368.5, c.y, 351.25) };
-                let outward = if s.name.ends_with("top") { v(0.0, 1.0, 0.0) } else { (c - axis).normalize() };
+                let axis = if s.name.starts_with("short") {
+                    v(186.0, c.y, 169.0)
+                } else {
+                    v(368.5, c.y, 351.25)
+                };
+                let outward = if s.name.ends_with("top") {
+                    v(0.0, 1.0, 0.0)
+                } else {
+                    (c - axis).normalize()
+                };
                 assert!(n.dot(outward) > 0.5, "{} faces inward", s.name);
             } else {
-                assert!(n.dot(room_center - c) > 0.0, "{} faces out of the room", s.name);
+                assert!(
+                    n.dot(room_center - c) > 0.0,
+                    "{} faces out of the room",
+                    s.name
+                );
             }
         }
         let light = &scene.surfaces[scene.surface_id("light").expect("cornell has a light")];

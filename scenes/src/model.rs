@@ -60,7 +60,9 @@ impl Bounds {
     };
 
     pub fn from_points<'a>(points: impl IntoIterator<Item = &'a DVec3>) -> Bounds {
-        points.into_iter().fold(Bounds::EMPTY, |b, &p| b.including(p))
+        points
+            .into_iter()
+            .fold(Bounds::EMPTY, |b, &p| b.including(p))
     }
 
     pub fn including(self, p: DVec3) -> Bounds {
@@ -150,7 +152,10 @@ impl Scene {
     }
 
     pub fn emitters(&self) -> impl Iterator<Item = (SurfaceId, &Surface)> {
-        self.surfaces.iter().enumerate().filter(|(_, s)| s.is_emitter())
+        self.surfaces
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| s.is_emitter())
     }
 
     pub fn emitted_power(&self) -> Rgb {

@@ -56,7 +56,9 @@ pub fn read_obj(path: &Path) -> Result<(Scene, Vec<String>), SceneError> {
         };
         let (reflectance, emission) = match mesh.material_id.and_then(|m| materials.get(m)) {
             Some(m) => (
-                m.diffuse.map(Rgb::from).unwrap_or(Rgb::splat(DEFAULT_REFLECTANCE)),
+                m.diffuse
+                    .map(Rgb::from)
+                    .unwrap_or(Rgb::splat(DEFAULT_REFLECTANCE)),
                 m.emissive.map(Rgb::from).unwrap_or(Rgb::ZERO),
             ),
             None => {
@@ -80,7 +82,12 @@ pub fn read_obj(path: &Path) -> Result<(Scene, Vec<String>), SceneError> {
             } else {
                 format!("{}/{face_index}", model.name)
             };
-            faces.push((name, indices.iter().map(|&i| position(i)).collect::<Vec<_>>(), reflectance, emission));
+            faces.push((
+                name,
+                indices.iter().map(|&i| position(i)).collect::<Vec<_>>(),
+                reflectance,
+                emission,
+            ));
         }
     }
     if missing_material > 0 {

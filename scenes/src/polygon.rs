@@ -166,7 +166,13 @@ pub fn triangulate_ccw(points: &[DVec2]) -> Vec<[usize; 3]> {
             }
         }
     }
-    if remaining.len() == 3 && orient(points[remaining[0]], points[remaining[1]], points[remaining[2]]) > 0.0 {
+    if remaining.len() == 3
+        && orient(
+            points[remaining[0]],
+            points[remaining[1]],
+            points[remaining[2]],
+        ) > 0.0
+    {
         triangles.push([remaining[0], remaining[1], remaining[2]]);
     }
     triangles
@@ -203,14 +209,23 @@ mod tests {
 
     #[test]
     fn straight_angles_do_not_make_slivers() {
-        let sq = [v(0.0, 0.0), v(1.0, 0.0), v(2.0, 0.0), v(2.0, 2.0), v(0.0, 2.0)];
+        let sq = [
+            v(0.0, 0.0),
+            v(1.0, 0.0),
+            v(2.0, 0.0),
+            v(2.0, 2.0),
+            v(0.0, 2.0),
+        ];
         let tris = triangulate_ccw(&sq);
         let area: f64 = tris
             .iter()
             .map(|t| signed_area_2d(&[sq[t[0]], sq[t[1]], sq[t[2]]]))
             .sum();
         assert!((area - 4.0).abs() < 1e-15);
-        assert!(tris.iter().all(|t| orient(sq[t[0]], sq[t[1]], sq[t[2]]) > 0.0));
+        assert!(
+            tris.iter()
+                .all(|t| orient(sq[t[0]], sq[t[1]], sq[t[2]]) > 0.0)
+        );
         assert!(is_convex_ccw(&sq));
     }
 
@@ -221,7 +236,13 @@ mod tests {
         let square = [v(0.0, 0.0), v(1.0, 0.0), v(1.0, 1.0), v(0.0, 1.0)];
         assert_eq!(first_self_intersection(&square), None);
         // A vertex touching a non-adjacent edge.
-        let touching = [v(0.0, 0.0), v(2.0, 0.0), v(2.0, 2.0), v(1.0, 0.0), v(0.0, 2.0)];
+        let touching = [
+            v(0.0, 0.0),
+            v(2.0, 0.0),
+            v(2.0, 2.0),
+            v(1.0, 0.0),
+            v(0.0, 2.0),
+        ];
         assert!(first_self_intersection(&touching).is_some());
         // A spike folding back along its own edge.
         let spike = [v(0.0, 0.0), v(2.0, 0.0), v(1.0, 0.0), v(1.0, 1.0)];

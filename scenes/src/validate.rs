@@ -35,17 +35,46 @@ pub struct Problem {
 pub enum ProblemKind {
     NoSurfaces,
     EmptyName,
-    NonFinite { field: &'static str },
-    TooFewVertices { distinct: usize },
-    RepeatedVertex { first: usize, second: usize },
-    TinyArea { area: f64, diameter: f64, scene_diagonal: f64 },
-    NonPlanar { deviation: f64, vertex: usize, tolerance: f64 },
-    SelfIntersecting { edge_a: usize, edge_b: usize },
-    ReflectanceOutOfRange { channel: &'static str, value: f64 },
-    NegativeEmission { channel: &'static str, value: f64 },
-    DuplicateName { first: usize, second: usize },
+    NonFinite {
+        field: &'static str,
+    },
+    TooFewVertices {
+        distinct: usize,
+    },
+    RepeatedVertex {
+        first: usize,
+        second: usize,
+    },
+    TinyArea {
+        area: f64,
+        diameter: f64,
+        scene_diagonal: f64,
+    },
+    NonPlanar {
+        deviation: f64,
+        vertex: usize,
+        tolerance: f64,
+    },
+    SelfIntersecting {
+        edge_a: usize,
+        edge_b: usize,
+    },
+    ReflectanceOutOfRange {
+        channel: &'static str,
+        value: f64,
+    },
+    NegativeEmission {
+        channel: &'static str,
+        value: f64,
+    },
+    DuplicateName {
+        first: usize,
+        second: usize,
+    },
     NoEmitter,
-    BadCamera { reason: &'static str },
+    BadCamera {
+        reason: &'static str,
+    },
 }
 
 impl fmt::Display for Problem {
@@ -55,8 +84,14 @@ impl fmt::Display for Problem {
         }
         use ProblemKind::*;
         match &self.kind {
-            NoSurfaces => write!(f, "the scene has no surfaces; add at least an emitter and a receiver"),
-            EmptyName => write!(f, "a surface has an empty name; give every surface a unique name"),
+            NoSurfaces => write!(
+                f,
+                "the scene has no surfaces; add at least an emitter and a receiver"
+            ),
+            EmptyName => write!(
+                f,
+                "a surface has an empty name; give every surface a unique name"
+            ),
             NonFinite { field } => write!(
                 f,
                 "{field} contains a non-finite number (NaN or infinity); replace it with a finite value"
@@ -279,7 +314,9 @@ fn camera_problem(c: &crate::model::Camera) -> Option<&'static str> {
         return Some("eye and target coincide; move the target in front of the eye");
     }
     if view.cross(c.up).length() <= 1e-9 * view.length() * c.up.length() {
-        return Some("up is zero or parallel to the view direction; choose an up vector across the view");
+        return Some(
+            "up is zero or parallel to the view direction; choose an up vector across the view",
+        );
     }
     if !(c.fov_deg > 0.0 && c.fov_deg < 180.0) {
         return Some("fov_deg must be between 0 and 180 degrees");

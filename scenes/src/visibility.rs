@@ -117,8 +117,16 @@ impl Visibility {
         } else {
             let mut time = Duration::default();
             (
-                Some(build_cwbvh(&boxes, BvhBuildParams::medium_build(), &mut time)),
-                Some(build_bvh2(&boxes, BvhBuildParams::medium_build(), &mut time)),
+                Some(build_cwbvh(
+                    &boxes,
+                    BvhBuildParams::medium_build(),
+                    &mut time,
+                )),
+                Some(build_bvh2(
+                    &boxes,
+                    BvhBuildParams::medium_build(),
+                    &mut time,
+                )),
             )
         };
         Visibility {
@@ -251,7 +259,10 @@ fn to_f32_box(b: Bounds, center: DVec3, padding: f64) -> Aabb {
     let lo = b.min - center;
     let hi = b.max - center;
     let slack = padding + 2f64.powi(-22) * lo.abs().max(hi.abs()).max_element();
-    Aabb::new(to_vec3a(lo - DVec3::splat(slack)), to_vec3a(hi + DVec3::splat(slack)))
+    Aabb::new(
+        to_vec3a(lo - DVec3::splat(slack)),
+        to_vec3a(hi + DVec3::splat(slack)),
+    )
 }
 
 /// Watertight ray–triangle intersection (Woop, Benthin & Wald 2013) in f64; no back-face culling.
@@ -306,7 +317,10 @@ mod tests {
     struct Lcg(u64);
     impl Lcg {
         fn next(&mut self) -> f64 {
-            self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            self.0 = self
+                .0
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             (self.0 >> 11) as f64 / (1u64 << 53) as f64
         }
     }
@@ -320,10 +334,17 @@ mod tests {
         let mut rng = Lcg(7);
         let mut misses = 0;
         for _ in 0..20_000 {
-            let o = DVec3::new(0.05 + 0.9 * rng.next(), 0.05 + 0.9 * rng.next(), 0.05 + 0.9 * rng.next());
+            let o = DVec3::new(
+                0.05 + 0.9 * rng.next(),
+                0.05 + 0.9 * rng.next(),
+                0.05 + 0.9 * rng.next(),
+            );
             // A target on an edge of the cube (two coordinates in {0, 1}) or a face diagonal.
             let s = rng.next();
-            let (a, b) = (if rng.next() < 0.5 { 0.0 } else { 1.0 }, if rng.next() < 0.5 { 0.0 } else { 1.0 });
+            let (a, b) = (
+                if rng.next() < 0.5 { 0.0 } else { 1.0 },
+                if rng.next() < 0.5 { 0.0 } else { 1.0 },
+            );
             let target = match (rng.next() * 5.0) as usize {
                 0 => DVec3::new(s, a, b),
                 1 => DVec3::new(a, s, b),
@@ -331,7 +352,10 @@ mod tests {
                 3 => DVec3::new(s, s, a),
                 _ => DVec3::new(s, 1.0 - s, a),
             };
-            if vis.closest_hit(o, target - o, 0.0, f64::INFINITY, None).is_none() {
+            if vis
+                .closest_hit(o, target - o, 0.0, f64::INFINITY, None)
+                .is_none()
+            {
                 misses += 1;
             }
         }
@@ -350,7 +374,11 @@ mod tests {
         let on_edge = DVec3::new(0.3, 0.0, 0.0);
         assert!(!vis.occluded(on_edge, DVec3::new(0.7, 0.0, 0.6), [floor, south]));
         assert!(!vis.occluded(on_edge, DVec3::new(0.6, 0.2, 1.0), [floor, ceiling]));
-        assert!(!vis.occluded(DVec3::new(0.0, 0.0, 0.0), DVec3::new(1.0, 1.0, 1.0), [floor, ceiling]));
+        assert!(!vis.occluded(
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(1.0, 1.0, 1.0),
+            [floor, ceiling]
+        ));
     }
 
     #[test]
@@ -359,11 +387,18 @@ mod tests {
         let vis = Visibility::build(&scene);
         let mut rng = Lcg(11);
         for _ in 0..20_000 {
-            let o = DVec3::new(0.1 + 0.8 * rng.next(), 0.1 + 0.8 * rng.next(), 0.1 + 0.8 * rng.next());
+            let o = DVec3::new(
+                0.1 + 0.8 * rng.next(),
+                0.1 + 0.8 * rng.next(),
+                0.1 + 0.8 * rng.next(),
+            );
             // Through an edge or corner of the cube to a far point outside.
             let through = DVec3::new(rng.next().round(), rng.next().round(), rng.next());
             let far = o + (through - o) * 3.0;
-            assert!(vis.occluded(o, far, [usize::MAX, usize::MAX]), "leak from {o} through {through}");
+            assert!(
+                vis.occluded(o, far, [usize::MAX, usize::MAX]),
+                "leak from {o} through {through}"
+            );
         }
     }
 
@@ -373,7 +408,11 @@ mod tests {
         let vis = Visibility::build(&scene);
         let mut rng = Lcg(3);
         for _ in 0..2000 {
-            let o = DVec3::new(20.0 + 500.0 * rng.next(), 20.0 + 500.0 * rng.next(), 20.0 + 500.0 * rng.next());
+            let o = DVec3::new(
+                20.0 + 500.0 * rng.next(),
+                20.0 + 500.0 * rng.next(),
+                20.0 + 500.0 * rng.next(),
+            );
             let d = DVec3::new(rng.next() - 0.5, rng.next() - 0.5, rng.next() - 0.5);
             let hit = vis.closest_hit(o, d, 0.0, f64::INFINITY, None);
             let brute = vis
@@ -401,7 +440,11 @@ mod tests {
         vis.triangles_overlapping(query, |i| found.push(i));
         for (i, t) in vis.triangles().iter().enumerate() {
             if Bounds::from_points(&t.vertices).overlaps(&query) {
-                assert!(found.contains(&i), "triangle {i} of surface {} missed", t.surface);
+                assert!(
+                    found.contains(&i),
+                    "triangle {i} of surface {} missed",
+                    t.surface
+                );
             }
         }
     }

@@ -1,0 +1,224 @@
+//! `SurfaceMesh`: the triangles of one surface, in its own 2D coordinates and in 3D.
+
+use glam::{DVec2, DVec3};
+use penumbra_scenes::polygon::{orient, signed_area_2d};
+use penumbra_scenes::{PlaneFrame, SurfaceId};
+use serde::Serialize;
+
+use crate::error::MeshError;
+
+/// Relative agreement required between the triangles' total area and the meshed polygon's.
+pub const AREA_CHECK_TOLERANCE: f64 = 1e-12;
+/// How far (in mesh units, where the polygon's extent is 1) a vertex that splits a boundary or
+/// constraint edge may sit off the exact segment: the rounding of the split point.
+pub const ON_SEGMENT_TOLERANCE: f64 = 1e-12;
+
+/// The mesh of one surface. Values live at vertices and are interpolated linearly over triangles.
+///
+/// Positions are kept in *mesh coordinates* (`local`): the surface's plane-frame coordinates
+/// divided by `scale` and snapped to a grid, the exact coordinates the triangulation was built in.
+/// `frame.to_3d(local[i] * scale) == points3[i]` up to rounding.
+#[derive(Clone, Debug)]
+pub struct SurfaceMesh {
+    pub surface: SurfaceId,
+    pub frame: PlaneFrame,
+    /// Surface units per mesh unit.
+    pub scale: f64,
+    pub local: Vec<DVec2>,
+    pub points3: Vec<DVec3>,
+    /// Counter-clockwise (seen from the surface's front) vertex index triples.
+    pub triangles: Vec<[u32; 3]>,
+    /// The meshed polygon in mesh coordinates (the surface polygon snapped to the grid).
+    pub boundary: Vec<DVec2>,
+    /// Area of the surface's own polygon in 3D.
+    pub polygon_area: f64,
+}
+
+/// Mesh quality figures: the smallest angle and the distribution of aspect ratios
+/// (circumradius over twice the inradius: 1 for an equilateral triangle).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct MeshQuality {
+    pub triangles: usize,
+    pub min_angle_deg: f64,
+    pub aspect_ratio_median: f64,
+    pub aspect_ratio_p95: f64,
+    pub aspect_ratio_max: f64,
+}
+
+impl SurfaceMesh {
+    pub fn vertex_count(&self) -> usize {
+        self.local.len()
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// Plane-frame (surface) coordinates of vertex `i`.
+    pub fn point2(&self, i: usize) -> DVec2 {
+        self.local[i] * self.scale
+    }
+
+    pub fn triangle_points3(&self, t: usize) -> [DVec3; 3] {
+        self.triangles[t].map(|i| self.points3[i as usize])
+    }
+
+    /// Area of triangle `t` in surface units squared.
+    pub fn triangle_area(&self, t: usize) -> f64 {
+        let [a, b, c] = self.triangles[t].map(|i| self.local[i as usize]);
+        0.5 * (b - a).perp_dot(c - a) * self.scale * self.scale
+    }
+
+    pub fn area(&self) -> f64 {
+        (0..self.triangles.len())
+            .map(|t| self.triangle_area(t))
+            .sum()
+    }
+
+    /// Area of the meshed polygon (the snapped surface polygon).
+    pub fn boundary_area(&self) -> f64 {
+        signed_area_2d(&self.boundary) * self.scale * self.scale
+    }
+
+    /// Checks the invariants every mesh must hold:
+    /// every triangle is strictly counter-clockwise (exact predicate), the triangles' areas sum to
+    /// the meshed polygon's area, and every boundary edge of the polygon is covered by mesh edges.
+    pub fn sanity_check(&self) -> Result<(), MeshError> {
+        let fail = |what: String| {
+            Err(MeshError::SanityCheck {
+                surface: self.surface,
+                what,
+            })
+        };
+        if self.local.len() != self.points3.len() {
+            return fail("2D and 3D vertex counts differ".into());
+        }
+        for (t, tri) in self.triangles.iter().enumerate() {
+            if tri.iter().any(|&i| i as usize >= self.local.len()) {
+                return fail(format!("triangle {t} has a vertex index out of range"));
+            }
+            let [a, b, c] = tri.map(|i| self.local[i as usize]);
+            if !(orient(a, b, c) > 0.0) {
+                return fail(format!("triangle {t} is not counter-clockwise"));
+            }
+        }
+        let total = self.area();
+        let expected = self.boundary_area();
+        if !((total - expected).abs() <= AREA_CHECK_TOLERANCE * expected) {
+            return fail(format!(
+                "triangle areas sum to {total:e}, the polygon's area is {expected:e}"
+            ));
+        }
+        // Each polygon edge must be a union of mesh edges: collect mesh edges lying on it, and
+        // check they chain from one end to the other.
+        let edges = self.edge_list();
+        let n = self.boundary.len();
+        for k in 0..n {
+            let (p, q) = (self.boundary[k], self.boundary[(k + 1) % n]);
+            if !self.edge_is_covered(p, q, &edges) {
+                return fail(format!("boundary edge {k} is not made of mesh edges"));
+            }
+        }
+        Ok(())
+    }
+
+    /// Undirected edges, each once, as sorted index pairs.
+    pub fn edge_list(&self) -> Vec<[u32; 2]> {
+        let mut edges: Vec<[u32; 2]> = self
+            .triangles
+            .iter()
+            .flat_map(|t| [[t[0], t[1]], [t[1], t[2]], [t[2], t[0]]])
+            .map(|[a, b]| [a.min(b), a.max(b)])
+            .collect();
+        edges.sort_unstable();
+        edges.dedup();
+        edges
+    }
+
+    /// Whether the segment `p -> q` is a chain of mesh edges from end to end. Split points may sit
+    /// off the segment by the rounding of their construction ([`ON_SEGMENT_TOLERANCE`]).
+    pub fn edge_is_covered(&self, p: DVec2, q: DVec2, edges: &[[u32; 2]]) -> bool {
+        let d = q - p;
+        let len2 = d.length_squared();
+        let off = |x: DVec2| d.perp_dot(x - p).abs() / len2.sqrt();
+        // Parameters along p -> q of the mesh edges that lie on the segment.
+        let mut pieces: Vec<(f64, f64)> = edges
+            .iter()
+            .filter_map(|&[a, b]| {
+                let (pa, pb) = (self.local[a as usize], self.local[b as usize]);
+                if off(pa) > ON_SEGMENT_TOLERANCE || off(pb) > ON_SEGMENT_TOLERANCE {
+                    return None;
+                }
+                let (ta, tb) = ((pa - p).dot(d) / len2, (pb - p).dot(d) / len2);
+                let (lo, hi) = (ta.min(tb), ta.max(tb));
+                (hi > 0.0 && lo < 1.0).then_some((lo, hi))
+            })
+            .collect();
+        pieces.sort_by(|a, b| a.0.total_cmp(&b.0));
+        // Chain the pieces; gaps of the rounding size are the split points' own error.
+        let slack = ON_SEGMENT_TOLERANCE / len2.sqrt();
+        let mut reached = 0.0;
+        for (lo, hi) in pieces {
+            if lo > reached + slack {
+                return false;
+            }
+            reached = f64::max(reached, hi);
+        }
+        reached >= 1.0 - slack
+    }
+
+    /// Per vertex, a unit direction into the surface: the mean direction to the centroids of the
+    /// triangles around it. Evaluations at boundary vertices take the one-sided limit from there.
+    pub fn interior_directions(&self) -> Vec<DVec3> {
+        let mut dirs = vec![DVec3::ZERO; self.local.len()];
+        for t in 0..self.triangles.len() {
+            let p = self.triangle_points3(t);
+            let c = (p[0] + p[1] + p[2]) / 3.0;
+            for (k, &i) in self.triangles[t].iter().enumerate() {
+                dirs[i as usize] += (c - p[k]).normalize_or_zero();
+            }
+        }
+        dirs.into_iter().map(DVec3::normalize_or_zero).collect()
+    }
+
+    pub fn quality(&self) -> MeshQuality {
+        quality_of(std::iter::once(self))
+    }
+}
+
+/// Quality figures over several meshes together.
+pub fn quality_of<'a>(meshes: impl IntoIterator<Item = &'a SurfaceMesh>) -> MeshQuality {
+    let mut min_angle = f64::INFINITY;
+    let mut ratios = Vec::new();
+    for m in meshes {
+        for tri in &m.triangles {
+            let [a, b, c] = tri.map(|i| m.local[i as usize]);
+            let (la, lb, lc) = ((b - c).length(), (c - a).length(), (a - b).length());
+            let angle = |opp: f64, s1: f64, s2: f64| {
+                ((s1 * s1 + s2 * s2 - opp * opp) / (2.0 * s1 * s2))
+                    .clamp(-1.0, 1.0)
+                    .acos()
+            };
+            let smallest = angle(la, lb, lc)
+                .min(angle(lb, lc, la))
+                .min(angle(lc, la, lb));
+            min_angle = min_angle.min(smallest.to_degrees());
+            let area = 0.5 * (b - a).perp_dot(c - a);
+            let s = 0.5 * (la + lb + lc);
+            let (inradius, circumradius) = (area / s, la * lb * lc / (4.0 * area));
+            ratios.push(circumradius / (2.0 * inradius));
+        }
+    }
+    if ratios.is_empty() {
+        return MeshQuality::default();
+    }
+    ratios.sort_by(f64::total_cmp);
+    let at = |q: f64| ratios[((ratios.len() - 1) as f64 * q).round() as usize];
+    MeshQuality {
+        triangles: ratios.len(),
+        min_angle_deg: min_angle,
+        aspect_ratio_median: at(0.5),
+        aspect_ratio_p95: at(0.95),
+        aspect_ratio_max: at(1.0),
+    }
+}

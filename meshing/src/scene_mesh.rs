@@ -1,0 +1,111 @@
+//! Meshes for a whole scene, with the element budget spread over the surfaces by area.
+
+use penumbra_scenes::Scene;
+
+use crate::error::MeshError;
+use crate::mesh::{MeshQuality, SurfaceMesh, quality_of};
+use crate::uniform::mesh_surface_uniform;
+
+/// One mesh per surface, in the scene's surface order.
+#[derive(Clone, Debug)]
+pub struct SceneMesh {
+    pub surfaces: Vec<SurfaceMesh>,
+}
+
+impl SceneMesh {
+    pub fn triangle_count(&self) -> usize {
+        self.surfaces.iter().map(SurfaceMesh::triangle_count).sum()
+    }
+
+    pub fn vertex_count(&self) -> usize {
+        self.surfaces.iter().map(SurfaceMesh::vertex_count).sum()
+    }
+
+    pub fn quality(&self) -> MeshQuality {
+        quality_of(&self.surfaces)
+    }
+
+    pub fn sanity_check(&self) -> Result<(), MeshError> {
+        self.surfaces.iter().try_for_each(SurfaceMesh::sanity_check)
+    }
+}
+
+/// Splits `max_elements` over the surfaces in proportion to their areas, giving each at least
+/// `minimum[s]` triangles. The targets never sum to more than `max_elements`.
+pub fn spread_by_area(
+    areas: &[f64],
+    minimum: &[usize],
+    max_elements: usize,
+) -> Result<Vec<usize>, MeshError> {
+    let needed: usize = minimum.iter().sum();
+    if needed > max_elements {
+        return Err(MeshError::BudgetTooSmall {
+            max_elements,
+            needed,
+        });
+    }
+    let total: f64 = areas.iter().sum();
+    let mut spread = max_elements;
+    loop {
+        let targets: Vec<usize> = areas
+            .iter()
+            .zip(minimum)
+            .map(|(&a, &m)| ((spread as f64 * a / total).floor() as usize).max(m))
+            .collect();
+        let sum: usize = targets.iter().sum();
+        if sum <= max_elements {
+            return Ok(targets);
+        }
+        spread -= (sum - max_elements).min(spread);
+    }
+}
+
+/// A uniform mesh of every surface, about `max_elements` triangles in all, spread by area.
+pub fn mesh_scene_uniform(scene: &Scene, max_elements: usize) -> Result<SceneMesh, MeshError> {
+    let areas: Vec<f64> = scene.surfaces.iter().map(|s| s.area()).collect();
+    // A polygon of n vertices needs n - 2 triangles.
+    let minimum: Vec<usize> = scene
+        .surfaces
+        .iter()
+        .map(|s| s.polygon.len().saturating_sub(2).max(1))
+        .collect();
+    let targets = spread_by_area(&areas, &minimum, max_elements)?;
+    let surfaces = scene
+        .surfaces
+        .iter()
+        .zip(targets)
+        .enumerate()
+        .map(|(id, (s, target))| mesh_surface_uniform(id, s, target))
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(SceneMesh { surfaces })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use penumbra_scenes::builtin;
+
+    #[test]
+    fn budget_is_a_cap_and_follows_area() {
+        let t = spread_by_area(&[1.0, 1.0, 2.0, 1e-6], &[2, 2, 2, 2], 1000).expect("fits");
+        assert!(t.iter().sum::<usize>() <= 1000);
+        assert!(t[2] > t[0] + t[0] / 2);
+        assert_eq!(t[3], 2);
+        assert!(matches!(
+            spread_by_area(&[1.0, 1.0], &[5, 5], 8),
+            Err(MeshError::BudgetTooSmall { needed: 10, .. })
+        ));
+    }
+
+    #[test]
+    fn cornell_meshes_within_budget() {
+        let scene = builtin::cornell();
+        for budget in [100, 2000, 10_000] {
+            let mesh = mesh_scene_uniform(&scene, budget).expect("cornell meshes");
+            mesh.sanity_check().expect("sane");
+            let n = mesh.triangle_count();
+            assert!(n <= budget, "{n} > {budget}");
+            assert!(n as f64 >= 0.7 * budget as f64, "{n} for {budget}");
+        }
+    }
+}
