@@ -250,6 +250,30 @@ impl Visibility {
     }
 }
 
+impl Visibility {
+    /// Whether some triangle whose box overlaps `bounds` satisfies `pred`; stops at the first.
+    pub fn any_triangle_overlapping(
+        &self,
+        bounds: Bounds,
+        mut pred: impl FnMut(&SceneTriangle) -> bool,
+    ) -> bool {
+        let Some(bvh) = &self.boxes else {
+            return false;
+        };
+        let query = to_f32_box(bounds, self.center, self.padding);
+        let mut found = false;
+        bvh.aabb_traverse(query, |bvh, node_index| {
+            let node = &bvh.nodes[node_index as usize];
+            let first = node.first_index as usize;
+            found = bvh.primitive_indices[first..first + node.prim_count as usize]
+                .iter()
+                .any(|&p| pred(&self.triangles[p as usize]));
+            !found
+        });
+        found
+    }
+}
+
 fn to_vec3a(v: DVec3) -> Vec3A {
     Vec3A::new(v.x as f32, v.y as f32, v.z as f32)
 }

@@ -1,0 +1,207 @@
+//! The discrete model the solvers work on: receivers (mesh vertices), elements (mesh triangles)
+//! and patches (groups of neighbouring elements that shoot together, after Cohen et al. 1988).
+
+use std::collections::{BTreeMap, HashSet};
+
+use glam::{DVec2, DVec3};
+use penumbra_meshing::SceneMesh;
+use penumbra_scenes::{Bounds, Rgb, Scene, SurfaceId};
+
+use crate::lambert::ReceivingPoint;
+
+/// One mesh triangle.
+#[derive(Clone, Debug)]
+pub struct Element {
+    pub surface: SurfaceId,
+    /// Global receiver (vertex) indices.
+    pub vertices: [usize; 3],
+    pub points: [DVec3; 3],
+    pub area: f64,
+    pub patch: usize,
+}
+
+/// Neighbouring elements of one surface that shoot their unshot power together.
+#[derive(Clone, Debug)]
+pub struct Patch {
+    pub surface: SurfaceId,
+    pub elements: Vec<usize>,
+    pub area: f64,
+    pub normal: DVec3,
+    /// A point of the patch's plane.
+    pub origin: DVec3,
+    /// The distinct vertex positions, for culling.
+    pub corners: Vec<DVec3>,
+    /// The patch outline as directed edges, counter-clockwise about the normal: the contour of
+    /// Lambert's formula (edges inside the patch cancel, so they are left out).
+    pub outline: Vec<[DVec3; 2]>,
+    pub bounds: Bounds,
+    /// Cumulative element areas, for sampling points by area.
+    pub cumulative_area: Vec<f64>,
+}
+
+/// Receivers, elements and patches of a meshed scene.
+#[derive(Clone, Debug)]
+pub struct Discretization {
+    /// First global receiver index of each surface's mesh.
+    pub offsets: Vec<usize>,
+    pub receivers: Vec<ReceivingPoint>,
+    pub receiver_surface: Vec<SurfaceId>,
+    pub elements: Vec<Element>,
+    pub patches: Vec<Patch>,
+    pub reflectance: Vec<Rgb>,
+    pub emission: Vec<Rgb>,
+}
+
+impl Discretization {
+    pub fn new(scene: &Scene, mesh: &SceneMesh, elements_per_patch: usize) -> Discretization {
+        let mut offsets = Vec::with_capacity(mesh.surfaces.len());
+        let mut receivers = Vec::new();
+        let mut receiver_surface = Vec::new();
+        let mut elements = Vec::new();
+        let mut patches = Vec::new();
+        for m in &mesh.surfaces {
+            let offset = receivers.len();
+            offsets.push(offset);
+            let normal = m.frame.normal;
+            for (p, inward) in m.points3.iter().zip(m.interior_directions()) {
+                receivers.push(ReceivingPoint {
+                    point: *p,
+                    normal,
+                    inward,
+                });
+                receiver_surface.push(m.surface);
+            }
+            // Patches: a grid over the surface in mesh coordinates, about `elements_per_patch`
+            // triangles per cell; each triangle belongs to the cell of its centroid.
+            let wanted = m
+                .triangle_count()
+                .div_ceil(elements_per_patch.max(1))
+                .max(1);
+            let local_area: f64 = m.area() / (m.scale * m.scale);
+            let cell = (local_area / wanted as f64).sqrt();
+            let mut cells: BTreeMap<(i64, i64), Vec<usize>> = BTreeMap::new();
+            for (t, tri) in m.triangles.iter().enumerate() {
+                let c: DVec2 = tri.iter().map(|&i| m.local[i as usize]).sum::<DVec2>() / 3.0;
+                let key = ((c.x / cell).floor() as i64, (c.y / cell).floor() as i64);
+                cells.entry(key).or_default().push(t);
+            }
+            for triangles in cells.into_values() {
+                let patch = patches.len();
+                let first = elements.len();
+                for &t in &triangles {
+                    let tri = m.triangles[t];
+                    elements.push(Element {
+                        surface: m.surface,
+                        vertices: tri.map(|i| offset + i as usize),
+                        points: tri.map(|i| m.points3[i as usize]),
+                        area: m.triangle_area(t),
+                        patch,
+                    });
+                }
+                patches.push(make_patch(
+                    m.surface,
+                    normal,
+                    &elements,
+                    first..elements.len(),
+                    &triangles,
+                    m,
+                ));
+            }
+        }
+        let reflectance = receiver_surface
+            .iter()
+            .map(|&s| scene.surfaces[s].reflectance)
+            .collect();
+        let emission = receiver_surface
+            .iter()
+            .map(|&s| scene.surfaces[s].emission)
+            .collect();
+        Discretization {
+            offsets,
+            receivers,
+            receiver_surface,
+            elements,
+            patches,
+            reflectance,
+            emission,
+        }
+    }
+
+    pub fn receiver_count(&self) -> usize {
+        self.receivers.len()
+    }
+
+    /// Splits a per-receiver vector into per-surface vectors.
+    pub fn per_surface<T: Clone>(&self, values: &[T]) -> Vec<Vec<T>> {
+        (0..self.offsets.len())
+            .map(|s| {
+                let end = self.offsets.get(s + 1).copied().unwrap_or(values.len());
+                values[self.offsets[s]..end].to_vec()
+            })
+            .collect()
+    }
+
+    /// ∫ over each element of a linearly interpolated per-receiver quantity, summed: the power
+    /// that quantity carries (for radiosity or irradiance values).
+    pub fn integrate(&self, values: &[Rgb], weight: impl Fn(&Element) -> Rgb) -> Rgb {
+        self.elements
+            .iter()
+            .map(|e| {
+                let mean =
+                    (values[e.vertices[0]] + values[e.vertices[1]] + values[e.vertices[2]]) / 3.0;
+                mean.mul_rgb(weight(e)) * e.area
+            })
+            .sum()
+    }
+}
+
+fn make_patch(
+    surface: SurfaceId,
+    normal: DVec3,
+    elements: &[Element],
+    range: std::ops::Range<usize>,
+    triangles: &[usize],
+    mesh: &penumbra_meshing::SurfaceMesh,
+) -> Patch {
+    let mine = &elements[range.clone()];
+    let directed: HashSet<(u32, u32)> = triangles
+        .iter()
+        .flat_map(|&t| {
+            let [a, b, c] = mesh.triangles[t];
+            [(a, b), (b, c), (c, a)]
+        })
+        .collect();
+    let mut outline: Vec<(u32, u32)> = directed
+        .iter()
+        .copied()
+        .filter(|&(a, b)| !directed.contains(&(b, a)))
+        .collect();
+    outline.sort_unstable();
+    let mut corner_ids: Vec<u32> = triangles.iter().flat_map(|&t| mesh.triangles[t]).collect();
+    corner_ids.sort_unstable();
+    corner_ids.dedup();
+    let corners: Vec<DVec3> = corner_ids
+        .iter()
+        .map(|&i| mesh.points3[i as usize])
+        .collect();
+    let mut cumulative_area = Vec::with_capacity(mine.len());
+    let mut area = 0.0;
+    for e in mine {
+        area += e.area;
+        cumulative_area.push(area);
+    }
+    Patch {
+        surface,
+        elements: range.collect(),
+        area,
+        normal,
+        origin: corners[0],
+        outline: outline
+            .into_iter()
+            .map(|(a, b)| [mesh.points3[a as usize], mesh.points3[b as usize]])
+            .collect(),
+        bounds: Bounds::from_points(&corners),
+        corners,
+        cumulative_area,
+    }
+}

@@ -1,0 +1,13 @@
+//! Errors of the solvers.
+
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SolveError {
+    #[error("invalid {option}: {reason}")]
+    InvalidOption {
+        option: &'static str,
+        reason: &'static str,
+    },
+    #[error("the mesh has {meshes} surfaces but the scene has {surfaces} (this is a bug)")]
+    MeshMismatch { surfaces: usize, meshes: usize },
+}

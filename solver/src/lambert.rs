@@ -1,0 +1,279 @@
+//! Point-to-polygon form factors by Lambert's contour formula.
+//!
+//! For a point x with unit normal n and a polygon with vertices v_i (R_i = v_i - x):
+//!
+//! F = 1/(2π) |Σ_i Θ_i (n · Γ_i)|, Θ_i = angle(R_i, R_{i+1}), Γ_i = unit(R_i × R_{i+1}).
+//!
+//! It is exact for an unoccluded polygon lying in front of x, so the polygon is first clipped to
+//! x's tangent half-space. Receiving points on a surface's boundary (where a wall meets a floor)
+//! lie on other polygons' planes or edges, where the formula is singular; there it returns the
+//! one-sided limit from inside the receiving surface, taken along its `inward` direction.
+
+use std::f64::consts::PI;
+
+use glam::DVec3;
+
+use crate::clip::clip_polygon_3d;
+
+/// A point receiving light: where it is, which way it faces, and which way its surface lies.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReceivingPoint {
+    pub point: DVec3,
+    /// Unit normal of the receiving surface.
+    pub normal: DVec3,
+    /// Unit direction into the receiving surface (tangent to it). Only used for the one-sided
+    /// limit at points on other polygons' planes, edges or vertices.
+    pub inward: DVec3,
+}
+
+impl ReceivingPoint {
+    /// A point in the interior of its surface, where no limit is needed.
+    pub fn interior(point: DVec3, normal: DVec3) -> ReceivingPoint {
+        ReceivingPoint {
+            point,
+            normal,
+            inward: normal.any_orthonormal_vector(),
+        }
+    }
+
+    /// Signed height of a point above the receiving tangent plane, snapped to zero within `tol`.
+    pub fn height(&self, p: DVec3, tol: f64) -> f64 {
+        let h = self.normal.dot(p - self.point);
+        if h.abs() <= tol { 0.0 } else { h }
+    }
+
+    /// Whether the (one-sided limit of the) point is strictly in front of a plane with unit normal
+    /// `plane_normal` through `plane_point`.
+    pub fn in_front_of(&self, plane_point: DVec3, plane_normal: DVec3, tol: f64) -> bool {
+        let h = plane_normal.dot(self.point - plane_point);
+        if h.abs() <= tol {
+            plane_normal.dot(self.inward) > 0.0
+        } else {
+            h > 0.0
+        }
+    }
+}
+
+/// Θ (n · Γ) for the directed edge `a -> b` seen from `x`: the edge's contribution to the contour
+/// sum. `tol` is the distance under which x counts as lying on a vertex or on the edge's line.
+pub fn edge_term(x: &ReceivingPoint, a: DVec3, b: DVec3, tol: f64) -> f64 {
+    let ra = a - x.point;
+    let rb = b - x.point;
+    let (la, lb) = (ra.length(), rb.length());
+    // A vertex at the point: the limit from inside the receiver sees it along -inward.
+    let da = if la <= tol { -x.inward } else { ra / la };
+    let db = if lb <= tol { -x.inward } else { rb / lb };
+    let e = b - a;
+    let le = e.length();
+    if le == 0.0 {
+        return 0.0;
+    }
+    // Distance of x from the edge's line, measured from the nearer end (fewer cancelled digits).
+    let line_distance = if la <= lb {
+        ra.cross(e).length() / le
+    } else {
+        rb.cross(e).length() / le
+    };
+    if line_distance <= tol {
+        // x on the edge's line: between the ends the limit plane through the edge and x is
+        // spanned by the edge and the inward direction; beyond the ends the edge subtends nothing.
+        let between = ra.dot(e) <= 0.0 && rb.dot(e) >= 0.0;
+        if !between && la > tol && lb > tol {
+            return 0.0;
+        }
+        let gamma = e.cross(x.inward).normalize_or_zero();
+        let theta = if la <= tol || lb <= tol {
+            da.angle_between(db)
+        } else {
+            PI
+        };
+        return theta * x.normal.dot(gamma);
+    }
+    let c = da.cross(db);
+    let s = c.length();
+    if s == 0.0 {
+        return 0.0;
+    }
+    let theta = s.atan2(da.dot(db));
+    theta * x.normal.dot(c / s)
+}
+
+/// Sum of the edge terms of a closed polygon (no clipping; the caller guarantees the polygon is
+/// in front of x). Its magnitude over 2π is the form factor.
+pub fn contour_sum(x: &ReceivingPoint, polygon: &[DVec3], tol: f64) -> f64 {
+    let n = polygon.len();
+    (0..n)
+        .map(|i| edge_term(x, polygon[i], polygon[(i + 1) % n], tol))
+        .sum()
+}
+
+/// The form factor from the point to a planar polygon, unoccluded: the polygon is clipped to the
+/// point's tangent half-space, then Lambert's formula applies.
+pub fn form_factor(x: &ReceivingPoint, polygon: &[DVec3], tol: f64) -> f64 {
+    let heights: Vec<f64> = polygon.iter().map(|&p| x.height(p, tol)).collect();
+    // Behind, or in the tangent plane itself (seen edge-on): nothing.
+    if heights.iter().all(|&h| h <= 0.0) {
+        return 0.0;
+    }
+    if heights.iter().all(|&h| h >= 0.0) {
+        return contour_sum(x, polygon, tol).abs() / (2.0 * PI);
+    }
+    let clipped = clip_polygon_3d(polygon, |p| x.height(p, tol));
+    if clipped.len() < 3 {
+        return 0.0;
+    }
+    contour_sum(x, &clipped, tol).abs() / (2.0 * PI)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn v(x: f64, y: f64, z: f64) -> DVec3 {
+        DVec3::new(x, y, z)
+    }
+
+    fn up_at(p: DVec3) -> ReceivingPoint {
+        ReceivingPoint::interior(p, DVec3::Z)
+    }
+
+    fn close(a: f64, b: f64, rel: f64) {
+        assert!(
+            (a - b).abs() <= rel * b.abs(),
+            "{a} vs {b} (relative {:e})",
+            (a - b).abs() / b.abs()
+        );
+    }
+
+    /// Section 1.1: differential area to a parallel rectangle, corner on the normal.
+    #[test]
+    fn parallel_rectangle_corner_on_normal() {
+        for (a, b, c, f) in [
+            (1.0, 1.0, 1.0, 0.138531605994893),
+            (2.0, 3.0, 1.0, 0.217575206107758),
+            (0.5, 0.25, 2.0, 0.00945845765854797),
+            (10.0, 10.0, 1.0, 0.24797140829531),
+        ] {
+            let rect = [v(0., 0., c), v(a, 0., c), v(a, b, c), v(0., b, c)];
+            close(form_factor(&up_at(DVec3::ZERO), &rect, 1e-12), f, 1e-9);
+        }
+    }
+
+    /// Section 1.2: differential area to a perpendicular rectangle whose bottom edge lies in the
+    /// point's tangent plane.
+    #[test]
+    fn perpendicular_rectangle() {
+        for (a, b, c, f) in [
+            (1.0, 1.0, 1.0, 0.0557341970025535),
+            (2.0, 1.0, 0.5, 0.158774804514299),
+            (1.0, 3.0, 2.0, 0.0239896394221535),
+            (0.1, 1.0, 1.0, 0.00101429585234492),
+        ] {
+            let rect = [v(c, 0., 0.), v(c, b, 0.), v(c, b, a), v(c, 0., a)];
+            close(form_factor(&up_at(DVec3::ZERO), &rect, 1e-12), f, 1e-9);
+        }
+    }
+
+    /// Section 1.6 cases A-D, including the square that straddles the tangent plane.
+    #[test]
+    fn arbitrary_polygons_and_clipping() {
+        let o = up_at(DVec3::ZERO);
+        close(
+            form_factor(&o, &[v(0., 0., 1.), v(1., 0., 1.), v(0., 1., 1.)], 1e-12),
+            0.0962250448649376,
+            1e-9,
+        );
+        let (c30, s30) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+        let center = v(0.3, -0.2, 1.5);
+        let (du, dv) = (v(0.5, 0., 0.), v(0., 0.5 * c30, 0.5 * s30));
+        let tilted = [
+            center - du - dv,
+            center + du - dv,
+            center + du + dv,
+            center - du + dv,
+        ];
+        close(form_factor(&o, &tilted, 1e-12), 0.107488688911369, 1e-9);
+        let l = [
+            (-1., -1.),
+            (1., -1.),
+            (1., 0.),
+            (0., 0.),
+            (0., 1.),
+            (-1., 1.),
+        ]
+        .map(|(x, y)| v(x, y, 1.0));
+        let tilt = ReceivingPoint::interior(
+            DVec3::ZERO,
+            v(20f64.to_radians().sin(), 0., 20f64.to_radians().cos()),
+        );
+        close(form_factor(&tilt, &l, 1e-12), 0.371469165650111, 1e-9);
+        let straddling = [
+            v(1., -1., -1.),
+            v(1., 1., -1.),
+            v(1., 1., 1.),
+            v(1., -1., 1.),
+        ];
+        close(form_factor(&o, &straddling, 1e-12), 0.111468394005107, 1e-9);
+    }
+
+    #[test]
+    fn orientation_and_vertex_order_do_not_matter() {
+        let o = up_at(DVec3::ZERO);
+        let mut rect = vec![v(0., 0., 1.), v(1., 0., 1.), v(1., 1., 1.), v(0., 1., 1.)];
+        let f = form_factor(&o, &rect, 1e-12);
+        rect.reverse();
+        close(form_factor(&o, &rect, 1e-12), f, 1e-14);
+        rect.rotate_left(1);
+        close(form_factor(&o, &rect, 1e-12), f, 1e-14);
+    }
+
+    /// At a point on the shared edge of a floor and a wall, the limit from inside the floor is the
+    /// limit of the values approaching the edge.
+    #[test]
+    fn one_sided_limit_at_an_edge_and_a_corner() {
+        let wall = [v(0., 0., 0.), v(0., 1., 0.), v(0., 1., 1.), v(0., 0., 1.)];
+        for (point, inward) in [
+            (v(0., 0.5, 0.), v(1., 0., 0.)), // on the wall's bottom edge
+            (v(0., 0., 0.), v(1., 1., 0.).normalize()), // at the wall's corner
+        ] {
+            let at = ReceivingPoint {
+                point,
+                normal: DVec3::Z,
+                inward,
+            };
+            let approach = inward;
+            let limit = form_factor(&at, &wall, 1e-12);
+            let near = form_factor(&up_at(point + approach * 1e-7), &wall, 1e-15);
+            assert!(limit > 0.05, "{limit}");
+            assert!(
+                (limit - near).abs() < 1e-5,
+                "limit {limit} vs nearby {near}"
+            );
+        }
+    }
+
+    /// Rows of a closed cube sum to one at every point, including edges and corners.
+    #[test]
+    fn closed_cube_row_sums_are_one() {
+        let scene = penumbra_scenes::builtin::furnace(1.0, 0.5);
+        let floor = &scene.surfaces[scene.surface_id("floor").expect("floor")];
+        for (point, inward) in [
+            (v(0.3, 0.7, 0.0), v(1., 0., 0.)),
+            (v(0.3, 0.0, 0.0), v(0., 1., 0.)),
+            (v(0.0, 0.0, 0.0), v(1., 1., 0.).normalize()),
+            (v(1.0, 0.25, 0.0), v(-1., 0., 0.)),
+        ] {
+            let x = ReceivingPoint {
+                point,
+                normal: floor.normal(),
+                inward,
+            };
+            let sum: f64 = scene
+                .surfaces
+                .iter()
+                .map(|s| form_factor(&x, &s.polygon, 1e-12))
+                .sum();
+            assert!((sum - 1.0).abs() < 1e-12, "row sum {sum} at {point}");
+        }
+    }
+}
