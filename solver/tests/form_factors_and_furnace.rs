@@ -1,0 +1,191 @@
+//! Discrete form factors (vertex-sampled, as the progressive solver uses them) against the
+//! enclosure identities and closed forms, and the furnace.
+
+use penumbra_meshing::mesh_scene_uniform;
+use penumbra_scenes::{Visibility, builtin};
+use penumbra_solver::coupling::PatchCoupling;
+use penumbra_solver::{Discretization, NoProgress, SolverOptions, StopReason, solve_progressive};
+
+/// Patch-to-patch form factors F_ij: the area average over patch i of the vertex form factors
+/// (linear interpolation over each element, the solver's own quadrature).
+fn patch_matrix(disc: &Discretization, coupling: &PatchCoupling) -> Vec<Vec<f64>> {
+    let n = disc.receiver_count();
+    let p = disc.patches.len();
+    let columns: Vec<Vec<f64>> = (0..p)
+        .map(|j| (0..n).map(|v| coupling.coupling(v, j).0).collect())
+        .collect();
+    (0..p)
+        .map(|i| {
+            let patch = &disc.patches[i];
+            (0..p)
+                .map(|j| {
+                    patch
+                        .elements
+                        .iter()
+                        .map(|&e| {
+                            let el = &disc.elements[e];
+                            el.area * el.vertices.iter().map(|&v| columns[j][v]).sum::<f64>() / 3.0
+                        })
+                        .sum::<f64>()
+                        / patch.area
+                })
+                .collect()
+        })
+        .collect()
+}
+
+#[test]
+fn closed_cube_patch_rows_sum_to_one() {
+    let scene = builtin::furnace(1.0, 0.5);
+    let vis = Visibility::build(&scene);
+    let mesh = mesh_scene_uniform(&scene, 3000).expect("cube meshes");
+    // Patches of about 30 elements: many patch pairs, adjacent and opposite, share edges.
+    let disc = Discretization::new(&scene, &mesh, 30);
+    let coupling = PatchCoupling { disc: &disc, visibility: &vis, rays: 4, seed: 1 };
+    let f = patch_matrix(&disc, &coupling);
+    let worst_row = f.iter().map(|row| (row.iter().sum::<f64>() - 1.0).abs()).fold(0.0, f64::max);
+    assert!(worst_row < 1e-3, "row sums off by {worst_row}");
+}
+
+/// A closed 1 x 2 x 3 box, faces inward, one patch per face.
+fn box_123() -> penumbra_scenes::Scene {
+    use glam::DVec3;
+    use penumbra_scenes::{Rgb, Scene, Surface};
+    let (a, b, c) = (1.0, 2.0, 3.0);
+    let v = |x: f64, y: f64, z: f64| DVec3::new(x * a, y * b, z * c);
+    let quads = [
+        ("z0", [v(0., 0., 0.), v(0., 1., 0.), v(1., 1., 0.), v(1., 0., 0.)]),
+        ("z1", [v(0., 0., 1.), v(1., 0., 1.), v(1., 1., 1.), v(0., 1., 1.)]),
+        ("y0", [v(0., 0., 0.), v(1., 0., 0.), v(1., 0., 1.), v(0., 0., 1.)]),
+        ("y1", [v(0., 1., 0.), v(0., 1., 1.), v(1., 1., 1.), v(1., 1., 0.)]),
+        ("x0", [v(0., 0., 0.), v(0., 0., 1.), v(0., 1., 1.), v(0., 1., 0.)]),
+        ("x1", [v(1., 0., 0.), v(1., 1., 0.), v(1., 1., 1.), v(1., 0., 1.)]),
+    ];
+    Scene {
+        name: "box123".into(),
+        camera: None,
+        surfaces: quads
+            .into_iter()
+            .map(|(n, q)| {
+                let mut q = q.to_vec();
+                let s = Surface::new(n, q.clone(), Rgb::splat(0.5));
+                let c = q.iter().copied().sum::<DVec3>() / 4.0;
+                if s.normal().dot(v(0.5, 0.5, 0.5) - c) < 0.0 {
+                    q.reverse();
+                }
+                Surface::new(n, q, Rgb::splat(0.5)).with_emission(Rgb::splat(1.0))
+            })
+            .collect(),
+    }
+}
+
+/// Section 2.1 of the analytic notes: the 1 x 2 x 3 box's face-to-face form factors, their row
+/// sums and their reciprocity, from the solver's vertex quadrature.
+#[test]
+fn box_face_factors_match_closed_forms_sum_to_one_and_are_reciprocal() {
+    let scene = box_123();
+    assert!(penumbra_scenes::validate(&scene).is_empty());
+    let inward = scene.surfaces.iter().all(|s| {
+        let c = s.polygon.iter().copied().sum::<glam::DVec3>() / 4.0;
+        s.normal().dot(glam::DVec3::new(0.5, 1.0, 1.5) - c) > 0.0
+    });
+    assert!(inward, "box faces must face inward");
+    let vis = Visibility::build(&scene);
+    let mesh = mesh_scene_uniform(&scene, 8000).expect("box meshes");
+    let disc = Discretization::new(&scene, &mesh, 1_000_000);
+    assert_eq!(disc.patches.len(), 6, "one patch per face");
+    let coupling = PatchCoupling { disc: &disc, visibility: &vis, rays: 4, seed: 1 };
+    let f = patch_matrix(&disc, &coupling);
+    // Closed forms by face size (dimensions of the emitting face, then of the receiving face).
+    let dims = |s: usize| {
+        let e = scene.surfaces[s].bounds();
+        let d = e.max - e.min;
+        let mut v = [d.x, d.y, d.z];
+        v.sort_by(f64::total_cmp);
+        (v[1], v[2]) // the face's two side lengths
+    };
+    let exact = |i: usize, j: usize| -> f64 {
+        let (ni, nj) = (scene.surfaces[i].normal(), scene.surfaces[j].normal());
+        let face = dims(i);
+        if ni.dot(nj) < -0.5 {
+            match face {
+                (2.0, 3.0) => 0.475576436532953,
+                (1.0, 3.0) => 0.146414577931196,
+                _ => 0.0603313853699537,
+            }
+        } else {
+            // The shared edge is the side the two faces have in common.
+            let other = dims(j);
+            let shared = if face.0 == other.0 || face.0 == other.1 { face.0 } else { face.1 };
+            match (face, shared) {
+                ((2.0, 3.0), 2.0) => 0.102713430993999,
+                ((2.0, 3.0), _) => 0.159498350739525,
+                ((1.0, 3.0), 1.0) => 0.107796009555352,
+                ((1.0, 3.0), _) => 0.31899670147905,
+                (_, 1.0) => 0.161694014333028,
+                _ => 0.308140292981996,
+            }
+        }
+    };
+    for i in 0..6 {
+        let (si, ai) = (disc.patches[i].surface, disc.patches[i].area);
+        let row: f64 = f[i].iter().sum();
+        assert!((row - 1.0).abs() < 1e-3, "row {i} sums to {row}");
+        for j in 0..6 {
+            let (sj, aj) = (disc.patches[j].surface, disc.patches[j].area);
+            if si == sj {
+                continue;
+            }
+            let e = exact(si, sj);
+            assert!((f[i][j] - e).abs() < 1e-3 * e.max(0.1), "F {} -> {} = {} vs {e}", scene.surfaces[si].name, scene.surfaces[sj].name, f[i][j]);
+            assert!((ai * f[i][j] - aj * f[j][i]).abs() < 1e-3 * ai * f[i][j], "reciprocity {i} {j}");
+        }
+    }
+}
+
+#[test]
+fn face_to_face_factors_match_the_closed_forms() {
+    let scene = builtin::furnace(1.0, 0.5);
+    let vis = Visibility::build(&scene);
+    let mesh = mesh_scene_uniform(&scene, 6000).expect("cube meshes");
+    // One patch per face.
+    let disc = Discretization::new(&scene, &mesh, 100_000);
+    assert_eq!(disc.patches.len(), 6);
+    let coupling = PatchCoupling { disc: &disc, visibility: &vis, rays: 4, seed: 1 };
+    let f = patch_matrix(&disc, &coupling);
+    const F_OPP: f64 = 0.199824895698387383;
+    const F_ADJ: f64 = 0.200043776075403154;
+    for i in 0..6 {
+        for j in 0..6 {
+            if i == j {
+                assert_eq!(f[i][j], 0.0);
+                continue;
+            }
+            let (si, sj) = (disc.patches[i].surface, disc.patches[j].surface);
+            let ni = scene.surfaces[si].normal();
+            let nj = scene.surfaces[sj].normal();
+            let exact = if ni.dot(nj) < -0.5 { F_OPP } else { F_ADJ };
+            assert!((f[i][j] - exact).abs() < 1e-3, "F[{i}][{j}] = {} vs {exact}", f[i][j]);
+        }
+    }
+}
+
+#[test]
+fn furnace_gives_e_over_one_minus_rho() {
+    for rho in [0.5, 0.9] {
+        let scene = builtin::furnace(1.0, rho);
+        let vis = Visibility::build(&scene);
+        let mesh = mesh_scene_uniform(&scene, 1200).expect("cube meshes");
+        let options = SolverOptions { epsilon: 1e-4, ..SolverOptions::default() };
+        let solution = solve_progressive(&scene, &mesh, &vis, &options, &NoProgress).expect("solves");
+        assert_eq!(solution.stats.stop, StopReason::Converged);
+        let expected = 1.0 / (1.0 - rho);
+        for b in solution.radiosity.iter().flatten() {
+            for c in b.to_array() {
+                assert!((c - expected).abs() < 5e-3 * expected, "rho {rho}: B = {c}, expected {expected}");
+            }
+        }
+        // A closed box lets nothing escape: what the vertex quadrature loses is its own error.
+        assert!(solution.stats.escaped.mean().abs() < 1e-3 * solution.stats.emitted.mean() / (1.0 - rho));
+    }
+}
