@@ -1,1 +1,224 @@
-fn main() {}
+//! `penumbra`: radiosity with exact direct light from area sources, from the command line.
+//!
+//! Exit codes: 0 success, 1 the run failed, 2 bad input or usage.
+#![allow(clippy::print_stdout, clippy::print_stderr)]
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::Context;
+use clap::{Parser, Subcommand, ValueEnum};
+use penumbra::outputs::write_outputs;
+use penumbra::progress_bar::Bars;
+use penumbra::{DEFAULT_MAX_ELEMENTS, MeshMethod, RunOptions};
+use penumbra_scenes::{builtin, load_scene};
+use penumbra_solver::SolverOptions;
+use penumbra_solver::progressive::DEFAULT_EPSILON;
+
+#[derive(Parser, Debug)]
+#[command(version, about = "Radiosity meshes that respect where shadows change")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Mesh, solve and render a scene; write solution.json, report.json, render.png and SVGs.
+    Run(RunArgs),
+    /// List the built-in scenes.
+    Scenes,
+    /// Load and validate a scene, reporting every problem at once.
+    Check {
+        /// A .json or .obj file, or the name of a built-in scene.
+        scene: String,
+    },
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum MeshArg {
+    /// Constrained Delaunay triangulation of each polygon, refined to a uniform size.
+    Uniform,
+}
+
+#[derive(clap::Args, Debug)]
+struct RunArgs {
+    /// A .json or .obj file, or the name of a built-in scene (see `penumbra scenes`).
+    scene: String,
+    /// Output directory.
+    #[arg(long, default_value = "out")]
+    out: PathBuf,
+    /// How surfaces are meshed.
+    #[arg(long, value_enum, default_value_t = MeshArg::Uniform)]
+    mesh: MeshArg,
+    /// Cap on triangles for the whole scene, spread over the surfaces by area.
+    #[arg(long, default_value_t = DEFAULT_MAX_ELEMENTS)]
+    max_elements: usize,
+    /// Stop shooting when the unshot power is below this fraction of the emitted power.
+    #[arg(long, default_value_t = DEFAULT_EPSILON)]
+    epsilon: f64,
+    /// Stop after this many patch shots, converged or not.
+    #[arg(long, default_value_t = SolverOptions::default().max_shots)]
+    max_shots: usize,
+    /// One exact bounce of direct light only: B = E + rho * H_direct.
+    #[arg(long)]
+    direct_only: bool,
+    /// Visibility rays per vertex-patch pair.
+    #[arg(long, default_value_t = SolverOptions::default().visibility_rays)]
+    rays: usize,
+    /// Mesh elements grouped into one shooting patch.
+    #[arg(long, default_value_t = SolverOptions::default().elements_per_patch)]
+    elements_per_patch: usize,
+    /// Seed of the visibility sampling.
+    #[arg(long, default_value_t = SolverOptions::default().seed)]
+    seed: u64,
+    /// Worker threads (default: one per core).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Render width in pixels.
+    #[arg(long, default_value_t = 640)]
+    width: u32,
+    /// Render height in pixels.
+    #[arg(long, default_value_t = 640)]
+    height: u32,
+    /// No progress bars and no summary.
+    #[arg(long)]
+    quiet: bool,
+}
+
+/// A failure, and whether it was the user's input (exit 2) or the run (exit 1).
+struct Failure {
+    error: anyhow::Error,
+    usage: bool,
+}
+
+impl<E: Into<anyhow::Error>> From<E> for Failure {
+    fn from(e: E) -> Self {
+        Failure {
+            error: e.into(),
+            usage: false,
+        }
+    }
+}
+
+fn usage(error: impl Into<anyhow::Error>) -> Failure {
+    Failure {
+        error: error.into(),
+        usage: true,
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match dispatch(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(f) => {
+            eprintln!("error: {:#}", f.error);
+            ExitCode::from(if f.usage { 2 } else { 1 })
+        }
+    }
+}
+
+fn dispatch(cli: Cli) -> Result<(), Failure> {
+    match cli.command {
+        Command::Scenes => {
+            for (name, description) in builtin::NAMES {
+                println!("{name:<10} {description}");
+            }
+            Ok(())
+        }
+        Command::Check { scene } => check(&scene),
+        Command::Run(args) => run(&args),
+    }
+}
+
+fn load(spec: &str) -> Result<penumbra_scenes::LoadedScene, Failure> {
+    // Every scene error (unreadable, malformed, invalid) is the input's: exit code 2.
+    load_scene(spec).map_err(usage)
+}
+
+fn check(spec: &str) -> Result<(), Failure> {
+    let loaded = load(spec)?;
+    for w in &loaded.warnings {
+        eprintln!("warning: {w}");
+    }
+    let s = &loaded.scene;
+    println!(
+        "{}: valid scene \"{}\": {} surfaces, {} emitting, total area {:.6e}, bounding-box diagonal {:.6e}",
+        loaded.source,
+        s.name,
+        s.surfaces.len(),
+        s.emitters().count(),
+        s.total_area(),
+        s.diagonal()
+    );
+    Ok(())
+}
+
+fn run(args: &RunArgs) -> Result<(), Failure> {
+    if let Some(n) = args.threads {
+        if n == 0 {
+            return Err(usage(anyhow::anyhow!("--threads must be at least 1")));
+        }
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global()
+            .context("cannot start the worker threads")?;
+    }
+    if args.width == 0 || args.height == 0 {
+        return Err(usage(anyhow::anyhow!(
+            "--width and --height must be at least 1"
+        )));
+    }
+    let loaded = load(&args.scene)?;
+    if !args.quiet {
+        for w in &loaded.warnings {
+            eprintln!("warning: {w}");
+        }
+    }
+    let options = RunOptions {
+        mesh: match args.mesh {
+            MeshArg::Uniform => MeshMethod::Uniform,
+        },
+        max_elements: args.max_elements,
+        solver: SolverOptions {
+            epsilon: args.epsilon,
+            max_shots: args.max_shots,
+            visibility_rays: args.rays,
+            elements_per_patch: args.elements_per_patch,
+            direct_only: args.direct_only,
+            seed: args.seed,
+            ..SolverOptions::default()
+        },
+        render: penumbra_viz::RenderOptions {
+            width: args.width,
+            height: args.height,
+            ..Default::default()
+        },
+    };
+    let bars = Bars::new(args.quiet);
+    let result = penumbra::run(loaded, &options, &bars).map_err(|e| {
+        if e.is_usage() {
+            usage(e)
+        } else {
+            Failure::from(e)
+        }
+    })?;
+    let written = write_outputs(&result, &args.out)?;
+    if !args.quiet {
+        let stats = &result.solution.stats;
+        println!(
+            "{}: {} triangles, {} vertices, {} patches; {} shots ({:?}), unshot {:.2e} of emitted; {:.2} s",
+            result.loaded.scene.name,
+            result.mesh.triangle_count(),
+            result.mesh.vertex_count(),
+            stats.patches,
+            stats.shots,
+            stats.stop,
+            stats.unshot_fraction,
+            result.times.total
+        );
+        println!("wrote {} files to {}", written.len(), args.out.display());
+    }
+    Ok(())
+}

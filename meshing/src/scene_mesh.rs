@@ -62,7 +62,11 @@ pub fn spread_by_area(
 
 /// A uniform mesh of every surface, about `max_elements` triangles in all, spread by area.
 pub fn mesh_scene_uniform(scene: &Scene, max_elements: usize) -> Result<SceneMesh, MeshError> {
-    let areas: Vec<f64> = scene.surfaces.iter().map(|s| s.area()).collect();
+    let areas: Vec<f64> = scene
+        .surfaces
+        .iter()
+        .map(penumbra_scenes::Surface::area)
+        .collect();
     // A polygon of n vertices needs n - 2 triangles.
     let minimum: Vec<usize> = scene
         .surfaces

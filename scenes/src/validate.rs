@@ -198,13 +198,13 @@ pub fn validate(scene: &Scene) -> Vec<Problem> {
             kind: ProblemKind::NoEmitter,
         });
     }
-    if let Some(c) = &scene.camera {
-        if let Some(reason) = camera_problem(c) {
-            problems.push(Problem {
-                surface: None,
-                kind: ProblemKind::BadCamera { reason },
-            });
-        }
+    if let Some(c) = &scene.camera
+        && let Some(reason) = camera_problem(c)
+    {
+        problems.push(Problem {
+            surface: None,
+            kind: ProblemKind::BadCamera { reason },
+        });
     }
     problems
 }

@@ -24,6 +24,10 @@ use crate::polygon;
 /// Points closer than this fraction of the scene diagonal to a surface count as lying on it: a
 /// segment that starts or ends within this distance of a surface is not blocked by it there.
 pub const CONTACT_TOLERANCE: f64 = 1e-9;
+/// How far ray origins at a surface's junctions are moved into the surface, relative to the
+/// scene diagonal: a ray that leaves a vertex on the edge where a wall meets a floor must pass
+/// above the floor, not through its plane, or its fate is decided by rounding.
+pub const JUNCTION_OFFSET: f64 = 1e-7;
 /// Outward padding of the f32 boxes, relative to the scene diagonal (f32 rounding is ~6e-8).
 const BOX_PADDING: f64 = 1e-6;
 
@@ -56,6 +60,8 @@ impl Boundable for PaddedBox {
 /// The visibility index of a scene.
 pub struct Visibility {
     triangles: Vec<SceneTriangle>,
+    /// Unit normal of each triangle's plane.
+    normals: Vec<DVec3>,
     /// Ray traversal (8-wide, fastest for rays); `None` for a scene without triangles.
     rays: Option<CwBvh>,
     /// Box queries (obvhs has them on the binary BVH only).
@@ -129,8 +135,16 @@ impl Visibility {
                 )),
             )
         };
+        let normals = triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.vertices;
+                (b - a).cross(c - a).normalize_or_zero()
+            })
+            .collect();
         Visibility {
             triangles,
+            normals,
             rays,
             boxes: box_bvh,
             center,
@@ -146,6 +160,11 @@ impl Visibility {
     /// Distance below which a point counts as lying on a surface.
     pub fn contact_distance(&self) -> f64 {
         self.contact
+    }
+
+    /// Distance by which ray origins at junctions move into their surface ([`JUNCTION_OFFSET`]).
+    pub fn junction_offset(&self) -> f64 {
+        self.contact * (JUNCTION_OFFSET / CONTACT_TOLERANCE)
     }
 
     fn f32_ray(&self, origin: DVec3, direction: DVec3, t_max: f64) -> Ray {
@@ -166,7 +185,8 @@ impl Visibility {
     ///
     /// The endpoints are usually on surfaces (a receiving vertex and a point of a shooter); planar
     /// surfaces cannot block segments from their own points, so pass them in `ignore`. Hits within
-    /// the contact distance of either endpoint do not count.
+    /// the contact distance of either endpoint do not count, and neither do surfaces whose plane
+    /// holds both endpoints (a segment along a surface grazes it, it does not cross it).
     pub fn occluded(&self, from: DVec3, to: DVec3, ignore: [SurfaceId; 2]) -> bool {
         let Some(bvh) = &self.rays else {
             return false;
@@ -180,8 +200,16 @@ impl Visibility {
         let (t_min, t_max) = (margin, 1.0 - margin);
         let ray = self.f32_ray(from, d, 1.0);
         !bvh.ray_traverse_miss(ray, |_, id| {
-            let tri = &self.triangles[bvh.primitive_indices[id] as usize];
+            let index = bvh.primitive_indices[id] as usize;
+            let tri = &self.triangles[index];
             if tri.surface == ignore[0] || tri.surface == ignore[1] {
+                return f32::INFINITY;
+            }
+            let n = self.normals[index];
+            let anchor = tri.vertices[0];
+            if n.dot(from - anchor).abs() <= self.contact
+                && n.dot(to - anchor).abs() <= self.contact
+            {
                 return f32::INFINITY;
             }
             match intersect_watertight(from, d, &tri.vertices) {

@@ -4,14 +4,20 @@ use std::path::Path;
 
 use glam::DVec3;
 use penumbra_scenes::load::parse_json;
-use penumbra_scenes::{ProblemKind, Rgb, Scene, SceneError, Surface, builtin, load_scene, validate};
+use penumbra_scenes::{
+    ProblemKind, Rgb, Scene, SceneError, Surface, builtin, load_scene, validate,
+};
 
 fn v(x: f64, y: f64, z: f64) -> DVec3 {
     DVec3::new(x, y, z)
 }
 
 fn square(name: &str, z: f64) -> Surface {
-    Surface::new(name, vec![v(0., 0., z), v(1., 0., z), v(1., 1., z), v(0., 1., z)], Rgb::splat(0.5))
+    Surface::new(
+        name,
+        vec![v(0., 0., z), v(1., 0., z), v(1., 1., z), v(0., 1., z)],
+        Rgb::splat(0.5),
+    )
 }
 
 /// A valid scene: an emitter above a floor.
@@ -43,11 +49,17 @@ fn non_finite_numbers() {
     s.surfaces[1].polygon[2].y = f64::NAN;
     let (kind, msg) = only_problem(&s);
     assert!(matches!(kind, ProblemKind::NonFinite { field: "polygon" }));
-    assert!(msg.contains("surface \"floor\"") && msg.contains("non-finite") && msg.contains("replace"), "{msg}");
+    assert!(
+        msg.contains("surface \"floor\"") && msg.contains("non-finite") && msg.contains("replace"),
+        "{msg}"
+    );
     let mut s = base();
     s.surfaces[1].reflectance.g = f64::INFINITY;
     let (_, msg) = only_problem(&s);
-    assert!(msg.contains("\"floor\"") && msg.contains("reflectance") && msg.contains("non-finite"), "{msg}");
+    assert!(
+        msg.contains("\"floor\"") && msg.contains("reflectance") && msg.contains("non-finite"),
+        "{msg}"
+    );
 }
 
 #[test]
@@ -55,8 +67,16 @@ fn fewer_than_three_distinct_vertices() {
     let mut s = base();
     s.surfaces[1].polygon = vec![v(0., 0., 0.), v(1., 0., 0.), v(1e-20, 0., 0.)];
     let (kind, msg) = only_problem(&s);
-    assert!(matches!(kind, ProblemKind::TooFewVertices { distinct: 2 }), "{kind:?}");
-    assert!(msg.contains("\"floor\"") && msg.contains("2 distinct vertices") && msg.contains("at least 3"), "{msg}");
+    assert!(
+        matches!(kind, ProblemKind::TooFewVertices { distinct: 2 }),
+        "{kind:?}"
+    );
+    assert!(
+        msg.contains("\"floor\"")
+            && msg.contains("2 distinct vertices")
+            && msg.contains("at least 3"),
+        "{msg}"
+    );
 }
 
 #[test]
@@ -65,16 +85,27 @@ fn zero_or_tiny_area() {
     s.surfaces[1].polygon = vec![v(0., 0., 0.), v(1., 0., 0.), v(2., 1e-12, 0.)];
     let (kind, msg) = only_problem(&s);
     assert!(matches!(kind, ProblemKind::TinyArea { .. }), "{kind:?}");
-    assert!(msg.contains("\"floor\"") && msg.contains("area") && msg.contains("collinear"), "{msg}");
+    assert!(
+        msg.contains("\"floor\"") && msg.contains("area") && msg.contains("collinear"),
+        "{msg}"
+    );
     // Tiny relative to the scene: a speck 1e-11 of the scene's size.
     let mut s = base();
-    s.surfaces.push(Surface::new("speck", vec![v(0., 0., 1.), v(1e-11, 0., 1.), v(0., 1e-11, 1.)], Rgb::splat(0.5)));
+    s.surfaces.push(Surface::new(
+        "speck",
+        vec![v(0., 0., 1.), v(1e-11, 0., 1.), v(0., 1e-11, 1.)],
+        Rgb::splat(0.5),
+    ));
     let (kind, msg) = only_problem(&s);
     assert!(matches!(kind, ProblemKind::TinyArea { .. }), "{kind:?}");
     assert!(msg.contains("\"speck\""), "{msg}");
     // But a light a millionth of the scene is legitimate.
     let mut s = base();
-    s.surfaces.push(Surface::new("small", vec![v(0., 0., 1.), v(1e-6, 0., 1.), v(0., 1e-6, 1.)], Rgb::splat(0.5)));
+    s.surfaces.push(Surface::new(
+        "small",
+        vec![v(0., 0., 1.), v(1e-6, 0., 1.), v(0., 1e-6, 1.)],
+        Rgb::splat(0.5),
+    ));
     assert!(validate(&s).is_empty());
 }
 
@@ -84,7 +115,10 @@ fn non_planar_polygon() {
     s.surfaces[1].polygon[2].z = 0.2;
     let (kind, msg) = only_problem(&s);
     assert!(matches!(kind, ProblemKind::NonPlanar { .. }), "{kind:?}");
-    assert!(msg.contains("\"floor\"") && msg.contains("not planar") && msg.contains("split"), "{msg}");
+    assert!(
+        msg.contains("\"floor\"") && msg.contains("not planar") && msg.contains("split"),
+        "{msg}"
+    );
     // Within the tolerance relative to the polygon's size: accepted, at any scale.
     for scale in [1e-6, 1.0, 1e6] {
         let mut s = base().transformed(&glam::DAffine3::from_scale(DVec3::splat(scale)));
@@ -97,10 +131,22 @@ fn non_planar_polygon() {
 fn self_intersecting_polygon() {
     let mut s = base();
     // A vertex touching a non-adjacent edge.
-    s.surfaces[1].polygon = vec![v(0., 0., 0.), v(2., 0., 0.), v(2., 2., 0.), v(1., 0., 0.), v(0., 2., 0.)];
+    s.surfaces[1].polygon = vec![
+        v(0., 0., 0.),
+        v(2., 0., 0.),
+        v(2., 2., 0.),
+        v(1., 0., 0.),
+        v(0., 2., 0.),
+    ];
     let (kind, msg) = only_problem(&s);
-    assert!(matches!(kind, ProblemKind::SelfIntersecting { .. }), "{kind:?}");
-    assert!(msg.contains("\"floor\"") && msg.contains("intersects itself") && msg.contains("reorder"), "{msg}");
+    assert!(
+        matches!(kind, ProblemKind::SelfIntersecting { .. }),
+        "{kind:?}"
+    );
+    assert!(
+        msg.contains("\"floor\"") && msg.contains("intersects itself") && msg.contains("reorder"),
+        "{msg}"
+    );
 }
 
 #[test]
@@ -109,8 +155,17 @@ fn reflectance_outside_zero_one() {
         let mut s = base();
         s.surfaces[1].reflectance = Rgb::new(0.5, bad, 0.5);
         let (kind, msg) = only_problem(&s);
-        assert!(matches!(kind, ProblemKind::ReflectanceOutOfRange { channel: "g", .. }), "{kind:?}");
-        assert!(msg.contains("\"floor\"") && msg.contains("outside [0, 1)") && msg.contains("below 1"), "{msg}");
+        assert!(
+            matches!(
+                kind,
+                ProblemKind::ReflectanceOutOfRange { channel: "g", .. }
+            ),
+            "{kind:?}"
+        );
+        assert!(
+            msg.contains("\"floor\"") && msg.contains("outside [0, 1)") && msg.contains("below 1"),
+            "{msg}"
+        );
     }
 }
 
@@ -119,8 +174,14 @@ fn negative_emission() {
     let mut s = base();
     s.surfaces[1].emission = Rgb::new(0.0, 0.0, -2.0);
     let (kind, msg) = only_problem(&s);
-    assert!(matches!(kind, ProblemKind::NegativeEmission { channel: "b", .. }), "{kind:?}");
-    assert!(msg.contains("\"floor\"") && msg.contains("negative") && msg.contains("zero or positive"), "{msg}");
+    assert!(
+        matches!(kind, ProblemKind::NegativeEmission { channel: "b", .. }),
+        "{kind:?}"
+    );
+    assert!(
+        msg.contains("\"floor\"") && msg.contains("negative") && msg.contains("zero or positive"),
+        "{msg}"
+    );
 }
 
 #[test]
@@ -128,8 +189,20 @@ fn duplicate_names() {
     let mut s = base();
     s.surfaces.push(square("floor", 0.5));
     let (kind, msg) = only_problem(&s);
-    assert!(matches!(kind, ProblemKind::DuplicateName { first: 1, second: 2 }), "{kind:?}");
-    assert!(msg.contains("\"floor\"") && msg.contains("unique name"), "{msg}");
+    assert!(
+        matches!(
+            kind,
+            ProblemKind::DuplicateName {
+                first: 1,
+                second: 2
+            }
+        ),
+        "{kind:?}"
+    );
+    assert!(
+        msg.contains("\"floor\"") && msg.contains("unique name"),
+        "{msg}"
+    );
 }
 
 #[test]
@@ -138,7 +211,10 @@ fn no_emitter_at_all() {
     s.surfaces[0].emission = Rgb::ZERO;
     let (kind, msg) = only_problem(&s);
     assert_eq!(kind, ProblemKind::NoEmitter);
-    assert!(msg.contains("no surface emits") && msg.contains("\"emission\""), "{msg}");
+    assert!(
+        msg.contains("no surface emits") && msg.contains("\"emission\""),
+        "{msg}"
+    );
 }
 
 #[test]
@@ -150,7 +226,10 @@ fn every_problem_is_reported_at_once() {
     let problems = validate(&s);
     // Three reflectance channels, one non-finite polygon, one duplicate name.
     assert_eq!(problems.len(), 5, "{problems:#?}");
-    let err = SceneError::Invalid { source_name: "x.json".into(), problems };
+    let err = SceneError::Invalid {
+        source_name: "x.json".into(),
+        problems,
+    };
     let text = err.to_string();
     assert!(text.starts_with("x.json: 5 problems:"), "{text}");
 }
@@ -160,7 +239,12 @@ fn json_errors_have_line_and_column_and_unknown_keys_are_rejected() {
     let path = Path::new("scene.json");
     let text = "{\n  \"surfaces\": [\n    {\"name\": \"a\", \"polygon\": [], \"reflectance\": [0.5, 0.5, 0.5], \"colour\": 1}\n  ]\n}";
     match parse_json(text, path) {
-        Err(SceneError::Json { line, column, message, .. }) => {
+        Err(SceneError::Json {
+            line,
+            column,
+            message,
+            ..
+        }) => {
             assert_eq!(line, 3);
             assert!(column > 60, "{column}");
             assert!(message.contains("unknown field `colour`"), "{message}");
@@ -189,7 +273,10 @@ fn json_round_trip_and_closing_vertex() {
 fn unknown_scene_names_list_the_builtins() {
     let err = load_scene("cornel").expect_err("no such scene");
     let text = err.to_string();
-    assert!(text.contains("\"cornel\"") && text.contains("cornell, textbook, furnace"), "{text}");
+    assert!(
+        text.contains("\"cornel\"") && text.contains("cornell, textbook, furnace"),
+        "{text}"
+    );
     let err = load_scene("missing/dir/scene.json").expect_err("no such file");
     assert!(matches!(err, SceneError::Io { .. }), "{err:?}");
 }
@@ -217,7 +304,21 @@ fn obj_import_maps_materials_and_repairs_faces() {
     assert_eq!(lamp.emission, Rgb::splat(5.0));
     assert!(lamp.normal().z < -0.99, "the lamp faces down");
     // The collinear face is dropped; the non-planar quad becomes two triangles.
-    assert!(loaded.warnings.iter().any(|w| w.contains("dropped 1 faces")), "{:?}", loaded.warnings);
-    assert!(loaded.warnings.iter().any(|w| w.contains("split 1 non-planar")), "{:?}", loaded.warnings);
+    assert!(
+        loaded
+            .warnings
+            .iter()
+            .any(|w| w.contains("dropped 1 faces")),
+        "{:?}",
+        loaded.warnings
+    );
+    assert!(
+        loaded
+            .warnings
+            .iter()
+            .any(|w| w.contains("split 1 non-planar")),
+        "{:?}",
+        loaded.warnings
+    );
     assert_eq!(s.surfaces.len(), 4);
 }

@@ -62,9 +62,41 @@ fn bounds_2d(polygon: &[DVec2]) -> (DVec2, DVec2) {
         })
 }
 
-/// `piece - hole` for convex counter-clockwise polygons, as convex pieces. Pieces with an area
-/// at most `min_area` are dropped.
-pub fn subtract_convex(piece: &[DVec2], hole: &[DVec2], min_area: f64, out: &mut Vec<Vec<DVec2>>) {
+/// Removes vertices within `tol` of the vertex before them (clipping makes such near-duplicates;
+/// the line through two of them has no reliable direction).
+pub fn merge_close_vertices(polygon: &mut Vec<DVec2>, tol: f64) {
+    let mut out: Vec<DVec2> = Vec::with_capacity(polygon.len());
+    for &p in polygon.iter() {
+        if out.last().is_none_or(|&q| q.distance(p) > tol) {
+            out.push(p);
+        }
+    }
+    while out.len() > 1 && out[0].distance(out[out.len() - 1]) <= tol {
+        out.pop();
+    }
+    *polygon = out;
+}
+
+/// Largest distance between two vertices.
+pub fn diameter_2d(polygon: &[DVec2]) -> f64 {
+    let mut d2: f64 = 0.0;
+    for (i, &a) in polygon.iter().enumerate() {
+        for &b in &polygon[i + 1..] {
+            d2 = d2.max(a.distance_squared(b));
+        }
+    }
+    d2.sqrt()
+}
+
+/// Whether a convex polygon is wider than `min_width` (area over diameter estimates the width).
+pub fn wider_than(polygon: &[DVec2], min_width: f64) -> bool {
+    polygon.len() >= 3 && area_2d(polygon) > min_width * diameter_2d(polygon)
+}
+
+/// `piece - hole` for convex counter-clockwise polygons, as convex pieces. Pieces no wider than
+/// `min_width` (slivers left by rounding) are dropped. The hole must not have repeated vertices
+/// ([`merge_close_vertices`]).
+pub fn subtract_convex(piece: &[DVec2], hole: &[DVec2], min_width: f64, out: &mut Vec<Vec<DVec2>>) {
     let (plo, phi) = bounds_2d(piece);
     let (hlo, hhi) = bounds_2d(hole);
     if plo.cmpgt(hhi).any() || hlo.cmpgt(phi).any() {
@@ -75,9 +107,12 @@ pub fn subtract_convex(piece: &[DVec2], hole: &[DVec2], min_area: f64, out: &mut
     let mut rest = piece.to_vec();
     for i in 0..m {
         let (a, b) = (hole[i], hole[(i + 1) % m]);
+        if a == b {
+            continue; // no line to cut along
+        }
         // Right of a -> b is outside the hole: that part stays visible.
         let outside = clip_left_of(&rest, b, a);
-        if outside.len() >= 3 && area_2d(&outside) > min_area {
+        if wider_than(&outside, min_width) {
             out.push(outside);
         }
         rest = clip_left_of(&rest, a, b);
@@ -116,6 +151,14 @@ mod tests {
         let mut out = Vec::new();
         subtract_convex(&sq(0.0, 0.0, 1.0), &sq(-1.0, -1.0, 5.0), 0.0, &mut out);
         assert!(out.is_empty());
+
+        // A repeated vertex in the hole must not duplicate the piece.
+        let mut hole = sq(2.0, 2.0, 1.0);
+        hole.insert(1, hole[1]);
+        let mut out = Vec::new();
+        subtract_convex(&sq(0.0, 0.0, 10.0), &hole, 0.0, &mut out);
+        let area: f64 = out.iter().map(|p| area_2d(p)).sum();
+        assert!((area - 99.0).abs() < 1e-12);
 
         // Touching along an edge: nothing removed, nothing of zero area added.
         let mut out = Vec::new();

@@ -51,12 +51,19 @@ impl PatchCoupling<'_> {
         {
             return (1.0, 0);
         }
+        // Rays leave from just inside the receiving surface, so that a vertex on a junction sees
+        // past (not along) the surfaces it touches: the one-sided limit again.
+        let origin = x.point + x.inward * self.visibility.junction_offset();
         let mut rng = SplitMix64::keyed(self.seed, &[v as u64, p as u64]);
         let total = patch.area;
-        let (mut seen, mut weight, mut hits, mut count) = (0.0, 0.0, 0u32, 0u32);
-        for k in 0..self.rays {
+        let (mut seen, mut weight, mut count) = (0.0, 0.0, 0u32);
+        // Samples that face away (behind x's tangent plane, or behind the patch) carry no weight
+        // and cast no ray; a patch straddling x's plane may need a few more draws.
+        let mut draws = 0;
+        while count < self.rays as u32 && draws < 4 * self.rays {
             // Stratified over the patch's area, then uniform inside the chosen element.
-            let u = (k as f64 + rng.next_f64()) / self.rays as f64 * total;
+            let u = ((draws % self.rays) as f64 + rng.next_f64()) / self.rays as f64 * total;
+            draws += 1;
             let idx = patch
                 .cumulative_area
                 .partition_point(|&c| c < u)
@@ -66,21 +73,19 @@ impl PatchCoupling<'_> {
             let y = e.points[0] * (1.0 - r1)
                 + e.points[1] * (r1 * (1.0 - r2))
                 + e.points[2] * (r1 * r2);
-            let d = y - x.point;
-            let w = (x.normal.dot(d) * -patch.normal.dot(d)).max(0.0) / d.length_squared().powi(2);
-            let open = !self.visibility.occluded(x.point, y, own);
+            let d = y - origin;
+            let w = x.normal.dot(d) * -patch.normal.dot(d) / d.length_squared().powi(2);
+            if !(w > 0.0) {
+                continue;
+            }
             count += 1;
-            if open {
-                hits += 1;
+            weight += w;
+            if !self.visibility.occluded(origin, y, own) {
                 seen += w;
             }
-            weight += w;
         }
-        let fraction = if weight > 0.0 {
-            seen / weight
-        } else {
-            hits as f64 / count.max(1) as f64
-        };
+        // No sample in front: the part of the patch x sees is too small to hit; take it as open.
+        let fraction = if weight > 0.0 { seen / weight } else { 1.0 };
         (fraction, count)
     }
 

@@ -16,12 +16,14 @@ use glam::{DVec2, DVec3};
 use penumbra_scenes::polygon::{is_convex_ccw, triangulate_ccw};
 use penumbra_scenes::{Bounds, PlaneFrame, Rgb, Scene, SurfaceId, Visibility};
 
-use crate::clip::{area_2d, clip_polygon_3d, subtract_convex};
+use crate::clip::{area_2d, clip_polygon_3d, merge_close_vertices, subtract_convex, wider_than};
 use crate::lambert::{ReceivingPoint, contour_sum};
 
-/// Visible pieces smaller than this fraction of the emitter's area are dropped: they change
-/// the form factor by less than rounding does.
-const MIN_PIECE_FRACTION: f64 = 1e-15;
+/// Visible pieces narrower than this many units in the last place of the coordinates involved
+/// are slivers left by rounding where two shadows share an edge; they are dropped.
+const SLIVER_ULPS: f64 = 64.0;
+/// Projected occluder vertices closer than this fraction of the emitter's diameter are merged.
+const MERGE_FRACTION: f64 = 1e-12;
 
 /// A planar convex polygon of a surface, with its plane.
 #[derive(Clone, Debug)]
@@ -38,7 +40,10 @@ struct Emitter {
     frame: PlaneFrame,
     /// The emitter as convex pieces (itself, if convex).
     pieces: Vec<Vec<DVec3>>,
-    min_area: f64,
+    /// Largest coordinate magnitude of the emitter, for the rounding scale.
+    magnitude: f64,
+    /// Shadow vertices closer than this (on the emitter's plane) are one vertex.
+    merge_distance: f64,
 }
 
 /// Splits a surface polygon into convex pieces: itself when convex, else its triangles.
@@ -85,7 +90,12 @@ impl<'a> DirectLight<'a> {
                     emission: s.emission,
                     frame: PlaneFrame::of_polygon(&s.polygon)?,
                     pieces: convex_pieces(&s.polygon),
-                    min_area: MIN_PIECE_FRACTION * s.area(),
+                    magnitude: s
+                        .polygon
+                        .iter()
+                        .map(|p| p.abs().max_element())
+                        .fold(0.0, f64::max),
+                    merge_distance: MERGE_FRACTION * penumbra_scenes::polygon::diameter(&s.polygon),
                 })
             })
             .collect();
@@ -203,6 +213,8 @@ impl<'a> DirectLight<'a> {
         h_x: f64,
     ) -> Vec<Vec<DVec2>> {
         let tol = self.tol;
+        // The rounding scale of this evaluation: coordinates as large as these carry this error.
+        let min_width = SLIVER_ULPS * f64::EPSILON * e.magnitude.max(x.point.abs().max_element());
         let mut visible = vec![front.iter().map(|&p| e.frame.to_2d(p)).collect::<Vec<_>>()];
         if area_2d(&visible[0]) < 0.0 {
             visible[0].reverse();
@@ -250,16 +262,19 @@ impl<'a> DirectLight<'a> {
                     e.frame.to_2d(x.point + (p - x.point) * s)
                 })
                 .collect();
-            let area = area_2d(&shadow);
-            if area.abs() <= e.min_area || !area.is_finite() {
+            merge_close_vertices(&mut shadow, e.merge_distance);
+            if shadow.len() < 3 {
                 continue;
             }
-            if area < 0.0 {
+            if area_2d(&shadow) < 0.0 {
                 shadow.reverse();
+            }
+            if !wider_than(&shadow, min_width) {
+                continue;
             }
             let mut next = Vec::with_capacity(visible.len() + 4);
             for v in &visible {
-                subtract_convex(v, &shadow, e.min_area, &mut next);
+                subtract_convex(v, &shadow, min_width, &mut next);
             }
             visible = next;
             if visible.is_empty() {

@@ -73,20 +73,31 @@ impl Discretization {
             }
             // Patches: a grid over the surface in mesh coordinates, about `elements_per_patch`
             // triangles per cell; each triangle belongs to the cell of its centroid.
-            let wanted = m.triangle_count().div_ceil(elements_per_patch.max(1)).max(1);
-            let (lo, hi) = m.local.iter().fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), &p| {
-                (lo.min(p), hi.max(p))
-            });
+            let wanted = m
+                .triangle_count()
+                .div_ceil(elements_per_patch.max(1))
+                .max(1);
+            let (lo, hi) = m
+                .local
+                .iter()
+                .fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), &p| {
+                    (lo.min(p), hi.max(p))
+                });
             let extent = (hi - lo).max(DVec2::splat(f64::MIN_POSITIVE));
             // About `wanted` cells, as square as the bounding box allows.
             let wanted_f = wanted as f64;
-            let cells_x = (wanted_f * extent.x / extent.y).sqrt().round().clamp(1.0, wanted_f);
+            let cells_x = (wanted_f * extent.x / extent.y)
+                .sqrt()
+                .round()
+                .clamp(1.0, wanted_f);
             let cells_y = (wanted_f / cells_x).round().max(1.0);
             let cell = DVec2::new(extent.x / cells_x, extent.y / cells_y);
             let mut cells: BTreeMap<(i64, i64), Vec<usize>> = BTreeMap::new();
             for (t, tri) in m.triangles.iter().enumerate() {
                 let c: DVec2 = tri.iter().map(|&i| m.local[i as usize]).sum::<DVec2>() / 3.0;
-                let k = ((c - lo) / cell).floor().min(DVec2::new(cells_x - 1.0, cells_y - 1.0));
+                let k = ((c - lo) / cell)
+                    .floor()
+                    .min(DVec2::new(cells_x - 1.0, cells_y - 1.0));
                 cells.entry((k.x as i64, k.y as i64)).or_default().push(t);
             }
             for triangles in cells.into_values() {

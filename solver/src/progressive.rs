@@ -140,7 +140,7 @@ pub fn direct_irradiance(
         .map(|v| {
             let h = direct.irradiance(&disc.receivers[v], disc.receiver_surface[v]);
             let d = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-            if d % 256 == 0 {
+            if d.is_multiple_of(256) {
                 progress.set(d);
             }
             h

@@ -1,3 +1,4 @@
+#![allow(clippy::needless_range_loop)] // matrix entries are clearest by index
 //! Discrete form factors (vertex-sampled, as the progressive solver uses them) against the
 //! enclosure identities and closed forms, and the furnace.
 
@@ -41,9 +42,17 @@ fn closed_cube_patch_rows_sum_to_one() {
     let mesh = mesh_scene_uniform(&scene, 3000).expect("cube meshes");
     // Patches of about 30 elements: many patch pairs, adjacent and opposite, share edges.
     let disc = Discretization::new(&scene, &mesh, 30);
-    let coupling = PatchCoupling { disc: &disc, visibility: &vis, rays: 4, seed: 1 };
+    let coupling = PatchCoupling {
+        disc: &disc,
+        visibility: &vis,
+        rays: 4,
+        seed: 1,
+    };
     let f = patch_matrix(&disc, &coupling);
-    let worst_row = f.iter().map(|row| (row.iter().sum::<f64>() - 1.0).abs()).fold(0.0, f64::max);
+    let worst_row = f
+        .iter()
+        .map(|row| (row.iter().sum::<f64>() - 1.0).abs())
+        .fold(0.0, f64::max);
     assert!(worst_row < 1e-3, "row sums off by {worst_row}");
 }
 
@@ -54,12 +63,30 @@ fn box_123() -> penumbra_scenes::Scene {
     let (a, b, c) = (1.0, 2.0, 3.0);
     let v = |x: f64, y: f64, z: f64| DVec3::new(x * a, y * b, z * c);
     let quads = [
-        ("z0", [v(0., 0., 0.), v(0., 1., 0.), v(1., 1., 0.), v(1., 0., 0.)]),
-        ("z1", [v(0., 0., 1.), v(1., 0., 1.), v(1., 1., 1.), v(0., 1., 1.)]),
-        ("y0", [v(0., 0., 0.), v(1., 0., 0.), v(1., 0., 1.), v(0., 0., 1.)]),
-        ("y1", [v(0., 1., 0.), v(0., 1., 1.), v(1., 1., 1.), v(1., 1., 0.)]),
-        ("x0", [v(0., 0., 0.), v(0., 0., 1.), v(0., 1., 1.), v(0., 1., 0.)]),
-        ("x1", [v(1., 0., 0.), v(1., 1., 0.), v(1., 1., 1.), v(1., 0., 1.)]),
+        (
+            "z0",
+            [v(0., 0., 0.), v(0., 1., 0.), v(1., 1., 0.), v(1., 0., 0.)],
+        ),
+        (
+            "z1",
+            [v(0., 0., 1.), v(1., 0., 1.), v(1., 1., 1.), v(0., 1., 1.)],
+        ),
+        (
+            "y0",
+            [v(0., 0., 0.), v(1., 0., 0.), v(1., 0., 1.), v(0., 0., 1.)],
+        ),
+        (
+            "y1",
+            [v(0., 1., 0.), v(0., 1., 1.), v(1., 1., 1.), v(1., 1., 0.)],
+        ),
+        (
+            "x0",
+            [v(0., 0., 0.), v(0., 0., 1.), v(0., 1., 1.), v(0., 1., 0.)],
+        ),
+        (
+            "x1",
+            [v(1., 0., 0.), v(1., 1., 0.), v(1., 1., 1.), v(1., 0., 1.)],
+        ),
     ];
     Scene {
         name: "box123".into(),
@@ -94,7 +121,12 @@ fn box_face_factors_match_closed_forms_sum_to_one_and_are_reciprocal() {
     let mesh = mesh_scene_uniform(&scene, 8000).expect("box meshes");
     let disc = Discretization::new(&scene, &mesh, 1_000_000);
     assert_eq!(disc.patches.len(), 6, "one patch per face");
-    let coupling = PatchCoupling { disc: &disc, visibility: &vis, rays: 4, seed: 1 };
+    let coupling = PatchCoupling {
+        disc: &disc,
+        visibility: &vis,
+        rays: 4,
+        seed: 1,
+    };
     let f = patch_matrix(&disc, &coupling);
     // Closed forms by face size (dimensions of the emitting face, then of the receiving face).
     let dims = |s: usize| {
@@ -116,7 +148,11 @@ fn box_face_factors_match_closed_forms_sum_to_one_and_are_reciprocal() {
         } else {
             // The shared edge is the side the two faces have in common.
             let other = dims(j);
-            let shared = if face.0 == other.0 || face.0 == other.1 { face.0 } else { face.1 };
+            let shared = if face.0 == other.0 || face.0 == other.1 {
+                face.0
+            } else {
+                face.1
+            };
             match (face, shared) {
                 ((2.0, 3.0), 2.0) => 0.102713430993999,
                 ((2.0, 3.0), _) => 0.159498350739525,
@@ -137,8 +173,17 @@ fn box_face_factors_match_closed_forms_sum_to_one_and_are_reciprocal() {
                 continue;
             }
             let e = exact(si, sj);
-            assert!((f[i][j] - e).abs() < 1e-3 * e.max(0.1), "F {} -> {} = {} vs {e}", scene.surfaces[si].name, scene.surfaces[sj].name, f[i][j]);
-            assert!((ai * f[i][j] - aj * f[j][i]).abs() < 1e-3 * ai * f[i][j], "reciprocity {i} {j}");
+            assert!(
+                (f[i][j] - e).abs() < 1e-3 * e.max(0.1),
+                "F {} -> {} = {} vs {e}",
+                scene.surfaces[si].name,
+                scene.surfaces[sj].name,
+                f[i][j]
+            );
+            assert!(
+                (ai * f[i][j] - aj * f[j][i]).abs() < 1e-3 * ai * f[i][j],
+                "reciprocity {i} {j}"
+            );
         }
     }
 }
@@ -151,10 +196,15 @@ fn face_to_face_factors_match_the_closed_forms() {
     // One patch per face.
     let disc = Discretization::new(&scene, &mesh, 100_000);
     assert_eq!(disc.patches.len(), 6);
-    let coupling = PatchCoupling { disc: &disc, visibility: &vis, rays: 4, seed: 1 };
+    let coupling = PatchCoupling {
+        disc: &disc,
+        visibility: &vis,
+        rays: 4,
+        seed: 1,
+    };
     let f = patch_matrix(&disc, &coupling);
-    const F_OPP: f64 = 0.199824895698387383;
-    const F_ADJ: f64 = 0.200043776075403154;
+    const F_OPP: f64 = 0.199_824_895_698_387_4;
+    const F_ADJ: f64 = 0.200_043_776_075_403_15;
     for i in 0..6 {
         for j in 0..6 {
             if i == j {
@@ -165,7 +215,11 @@ fn face_to_face_factors_match_the_closed_forms() {
             let ni = scene.surfaces[si].normal();
             let nj = scene.surfaces[sj].normal();
             let exact = if ni.dot(nj) < -0.5 { F_OPP } else { F_ADJ };
-            assert!((f[i][j] - exact).abs() < 1e-3, "F[{i}][{j}] = {} vs {exact}", f[i][j]);
+            assert!(
+                (f[i][j] - exact).abs() < 1e-3,
+                "F[{i}][{j}] = {} vs {exact}",
+                f[i][j]
+            );
         }
     }
 }
@@ -176,16 +230,26 @@ fn furnace_gives_e_over_one_minus_rho() {
         let scene = builtin::furnace(1.0, rho);
         let vis = Visibility::build(&scene);
         let mesh = mesh_scene_uniform(&scene, 1200).expect("cube meshes");
-        let options = SolverOptions { epsilon: 1e-4, ..SolverOptions::default() };
-        let solution = solve_progressive(&scene, &mesh, &vis, &options, &NoProgress).expect("solves");
+        let options = SolverOptions {
+            epsilon: 1e-4,
+            ..SolverOptions::default()
+        };
+        let solution =
+            solve_progressive(&scene, &mesh, &vis, &options, &NoProgress).expect("solves");
         assert_eq!(solution.stats.stop, StopReason::Converged);
         let expected = 1.0 / (1.0 - rho);
         for b in solution.radiosity.iter().flatten() {
             for c in b.to_array() {
-                assert!((c - expected).abs() < 5e-3 * expected, "rho {rho}: B = {c}, expected {expected}");
+                assert!(
+                    (c - expected).abs() < 5e-3 * expected,
+                    "rho {rho}: B = {c}, expected {expected}"
+                );
             }
         }
         // A closed box lets nothing escape: what the vertex quadrature loses is its own error.
-        assert!(solution.stats.escaped.mean().abs() < 1e-3 * solution.stats.emitted.mean() / (1.0 - rho));
+        assert!(
+            solution.stats.escaped.mean().abs()
+                < 1e-3 * solution.stats.emitted.mean() / (1.0 - rho)
+        );
     }
 }

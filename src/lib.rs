@@ -1,0 +1,11 @@
+//! # penumbra
+//!
+//! The pipeline that turns a scene into a radiosity solution — mesh, visibility, exact direct
+//! light, progressive refinement, render — and the files it writes. The `penumbra` binary is a
+//! thin command line around it.
+
+pub mod outputs;
+pub mod pipeline;
+pub mod progress_bar;
+
+pub use pipeline::{DEFAULT_MAX_ELEMENTS, MeshMethod, RunError, RunOptions, RunResult, run};

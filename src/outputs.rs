@@ -1,0 +1,258 @@
+//! The files a run writes: `solution.json`, `report.json`, `render.png` and one SVG per surface.
+//! Each file is written to a temporary name in the output directory and renamed into place, so
+//! a reader never sees half a file.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use penumbra_meshing::MeshQuality;
+use penumbra_scenes::Rgb;
+use penumbra_solver::SolveStats;
+use serde::Serialize;
+
+use crate::pipeline::{RunResult, StageTimes};
+
+pub const SOLUTION_FORMAT: &str = "penumbra-solution/1";
+pub const REPORT_FORMAT: &str = "penumbra-report/1";
+
+#[derive(Serialize)]
+struct SolutionFile<'a> {
+    format: &'static str,
+    scene: &'a str,
+    surfaces: Vec<SurfaceSolution<'a>>,
+}
+
+#[derive(Serialize)]
+struct SurfaceSolution<'a> {
+    name: &'a str,
+    vertices: Vec<[f64; 3]>,
+    triangles: &'a [[u32; 3]],
+    radiosity: Vec<[f64; 3]>,
+    discontinuities: Vec<Discontinuity>,
+}
+
+/// A discontinuity segment of the direct light on a surface (none for uniform meshes).
+#[derive(Debug, Serialize)]
+pub struct Discontinuity {
+    pub from: [f64; 3],
+    pub to: [f64; 3],
+    pub event: &'static str,
+    pub boundary: &'static str,
+    pub order: u8,
+}
+
+/// `solution.json`: per surface, vertices, triangles and radiosity (no display-only ambient term).
+pub fn solution_json(result: &RunResult) -> String {
+    let scene = &result.loaded.scene;
+    let file = SolutionFile {
+        format: SOLUTION_FORMAT,
+        scene: &scene.name,
+        surfaces: scene
+            .surfaces
+            .iter()
+            .zip(&result.mesh.surfaces)
+            .zip(&result.solution.radiosity)
+            .map(|((s, m), b)| SurfaceSolution {
+                name: &s.name,
+                vertices: m.points3.iter().map(|p| p.to_array()).collect(),
+                triangles: &m.triangles,
+                radiosity: b.iter().map(|c| c.to_array()).collect(),
+                discontinuities: Vec::new(),
+            })
+            .collect(),
+    };
+    to_json(&file)
+}
+
+#[derive(Serialize)]
+struct Report<'a> {
+    format: &'static str,
+    scene: SceneSummary<'a>,
+    warnings: &'a [String],
+    method: Method,
+    counts: Counts,
+    times_seconds: &'a StageTimes,
+    solver: &'a SolveStats,
+    energy: Energy,
+    mesh_quality: MeshQuality,
+    render: RenderSummary,
+}
+
+#[derive(Serialize)]
+struct SceneSummary<'a> {
+    name: &'a str,
+    source: &'a str,
+    surfaces: usize,
+    emitters: usize,
+    bounding_box_diagonal: f64,
+}
+
+#[derive(Serialize)]
+struct Method {
+    mesh: crate::pipeline::MeshMethod,
+    solver: &'static str,
+    max_elements: usize,
+    epsilon: f64,
+    max_shots: usize,
+    visibility_rays: usize,
+    elements_per_patch: usize,
+    direct_only: bool,
+    seed: u64,
+    threads: usize,
+}
+
+#[derive(Serialize)]
+struct Counts {
+    triangles: usize,
+    vertices: usize,
+    patches: usize,
+    discontinuity_segments: usize,
+}
+
+/// Where the emitted power went, per channel, and as fractions of the emitted power (means).
+#[derive(Serialize)]
+struct Energy {
+    emitted: Rgb,
+    absorbed: Rgb,
+    escaped: Rgb,
+    unshot: Rgb,
+    absorbed_fraction: f64,
+    escaped_fraction: f64,
+    unshot_fraction: f64,
+}
+
+#[derive(Serialize)]
+struct RenderSummary {
+    width: u32,
+    height: u32,
+    exposure: f64,
+    ambient: Rgb,
+}
+
+pub fn report_json(result: &RunResult) -> String {
+    let scene = &result.loaded.scene;
+    let stats = &result.solution.stats;
+    let opts = &result.options;
+    let fraction = |p: Rgb| p.mean() / stats.emitted.mean().max(f64::MIN_POSITIVE);
+    let report = Report {
+        format: REPORT_FORMAT,
+        scene: SceneSummary {
+            name: &scene.name,
+            source: &result.loaded.source,
+            surfaces: scene.surfaces.len(),
+            emitters: scene.emitters().count(),
+            bounding_box_diagonal: scene.diagonal(),
+        },
+        warnings: &result.loaded.warnings,
+        method: Method {
+            mesh: opts.mesh,
+            solver: if opts.solver.direct_only {
+                "direct"
+            } else {
+                "progressive"
+            },
+            max_elements: opts.max_elements,
+            epsilon: opts.solver.epsilon,
+            max_shots: opts.solver.max_shots,
+            visibility_rays: opts.solver.visibility_rays,
+            elements_per_patch: opts.solver.elements_per_patch,
+            direct_only: opts.solver.direct_only,
+            seed: opts.solver.seed,
+            threads: rayon::current_num_threads(),
+        },
+        counts: Counts {
+            triangles: result.mesh.triangle_count(),
+            vertices: result.mesh.vertex_count(),
+            patches: stats.patches,
+            discontinuity_segments: 0,
+        },
+        times_seconds: &result.times,
+        solver: stats,
+        energy: Energy {
+            emitted: stats.emitted,
+            absorbed: stats.absorbed,
+            escaped: stats.escaped,
+            unshot: stats.unshot,
+            absorbed_fraction: fraction(stats.absorbed),
+            escaped_fraction: fraction(stats.escaped),
+            unshot_fraction: fraction(stats.unshot),
+        },
+        mesh_quality: result.mesh.quality(),
+        render: RenderSummary {
+            width: result.render.image.width(),
+            height: result.render.image.height(),
+            exposure: result.render.exposure,
+            ambient: result.solution.ambient,
+        },
+    };
+    to_json(&report)
+}
+
+fn to_json<T: Serialize>(value: &T) -> String {
+    // Serializing plain structs of numbers and strings cannot fail.
+    let mut s = serde_json::to_string_pretty(value).expect("serializable output (this is a bug)");
+    s.push('\n');
+    s
+}
+
+/// A file name for a surface's SVG: its index (names may clash once sanitized) and its name.
+pub fn svg_name(index: usize, name: &str) -> String {
+    let clean: String = name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    format!("{index:03}-{clean}.svg")
+}
+
+/// Writes `bytes` to `path` atomically: a temporary file in the same directory, then a rename.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let file_name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp = dir.join(format!(".{file_name}.tmp-{}", std::process::id()));
+    let result = (|| {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
+
+/// Writes every output of a run into `dir` (created if needed); returns the paths written.
+pub fn write_outputs(result: &RunResult, dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
+    use anyhow::Context;
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let svg_dir = dir.join("surfaces");
+    std::fs::create_dir_all(&svg_dir)
+        .with_context(|| format!("cannot create {}", svg_dir.display()))?;
+    let png = penumbra_viz::encode_png(&result.render.image)?;
+    let mut files: Vec<(PathBuf, Vec<u8>)> = vec![
+        (
+            dir.join("solution.json"),
+            solution_json(result).into_bytes(),
+        ),
+        (dir.join("report.json"), report_json(result).into_bytes()),
+        (dir.join("render.png"), png),
+    ];
+    let scene = &result.loaded.scene;
+    for (i, (s, m)) in scene.surfaces.iter().zip(&result.mesh.surfaces).enumerate() {
+        let svg = penumbra_viz::surface_svg(scene, m, Some(&result.solution.radiosity[i]));
+        files.push((svg_dir.join(svg_name(i, &s.name)), svg.into_bytes()));
+    }
+    for (path, bytes) in &files {
+        write_atomic(path, bytes).with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    Ok(files.into_iter().map(|(p, _)| p).collect())
+}

@@ -1,0 +1,130 @@
+//! The pipeline: load, mesh, build visibility, solve, render. Pure computation; writing the
+//! results is [`crate::outputs`]' job.
+
+use std::time::Instant;
+
+use penumbra_meshing::{MeshError, SceneMesh, mesh_scene_uniform};
+use penumbra_scenes::{LoadedScene, Visibility};
+use penumbra_solver::{Progress, Solution, SolveError, SolverOptions, solve_progressive};
+use penumbra_viz::{Render, RenderOptions, VizError};
+use serde::Serialize;
+
+/// How surfaces are meshed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MeshMethod {
+    /// Constrained Delaunay triangulation of each polygon, refined to a uniform size.
+    Uniform,
+}
+
+/// Default cap on triangles for the whole scene.
+pub const DEFAULT_MAX_ELEMENTS: usize = 10_000;
+
+#[derive(Clone, Debug)]
+pub struct RunOptions {
+    pub mesh: MeshMethod,
+    pub max_elements: usize,
+    pub solver: SolverOptions,
+    pub render: RenderOptions,
+}
+
+impl Default for RunOptions {
+    fn default() -> Self {
+        RunOptions {
+            mesh: MeshMethod::Uniform,
+            max_elements: DEFAULT_MAX_ELEMENTS,
+            solver: SolverOptions::default(),
+            render: RenderOptions::default(),
+        }
+    }
+}
+
+/// Wall-clock seconds per stage.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct StageTimes {
+    pub mesh: f64,
+    pub visibility: f64,
+    pub direct: f64,
+    pub shooting: f64,
+    pub render: f64,
+    pub total: f64,
+}
+
+/// Everything a run computes.
+#[derive(Debug)]
+pub struct RunResult {
+    pub loaded: LoadedScene,
+    pub options: RunOptions,
+    pub mesh: SceneMesh,
+    pub solution: Solution,
+    pub render: Render,
+    pub times: StageTimes,
+}
+
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum RunError {
+    #[error(transparent)]
+    Mesh(#[from] MeshError),
+    #[error(transparent)]
+    Solve(#[from] SolveError),
+    #[error(transparent)]
+    Render(#[from] VizError),
+}
+
+impl RunError {
+    /// Whether the error is the user's to fix (bad options) rather than a failure of the run.
+    pub fn is_usage(&self) -> bool {
+        matches!(
+            self,
+            RunError::Mesh(MeshError::BudgetTooSmall { .. })
+                | RunError::Solve(SolveError::InvalidOption { .. })
+        )
+    }
+}
+
+/// Runs the whole pipeline on a loaded scene.
+pub fn run(
+    loaded: LoadedScene,
+    options: &RunOptions,
+    progress: &dyn Progress,
+) -> Result<RunResult, RunError> {
+    options.solver.validate()?;
+    let started = Instant::now();
+    let mut times = StageTimes::default();
+    let scene = &loaded.scene;
+
+    let t = Instant::now();
+    progress.start("meshing", 1);
+    let mesh = match options.mesh {
+        MeshMethod::Uniform => mesh_scene_uniform(scene, options.max_elements)?,
+    };
+    progress.finish();
+    times.mesh = t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
+    let visibility = Visibility::build(scene);
+    times.visibility = t.elapsed().as_secs_f64();
+
+    let solution = solve_progressive(scene, &mesh, &visibility, &options.solver, progress)?;
+    times.direct = solution.stats.direct_seconds;
+    times.shooting = solution.stats.shooting_seconds;
+
+    let t = Instant::now();
+    let render_options = RenderOptions {
+        ambient: solution.ambient,
+        ..options.render
+    };
+    let render = penumbra_viz::render(scene, &mesh, &solution.radiosity, &render_options)?;
+    times.render = t.elapsed().as_secs_f64();
+    times.total = started.elapsed().as_secs_f64();
+
+    Ok(RunResult {
+        loaded,
+        options: options.clone(),
+        mesh,
+        solution,
+        render,
+        times,
+    })
+}
