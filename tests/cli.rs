@@ -1,0 +1,151 @@
+//! The command line as a user meets it: outputs, exit codes, messages, determinism.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn penumbra(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_penumbra"))
+        .args(args)
+        .output()
+        .expect("the penumbra binary runs")
+}
+
+fn json(path: &Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(path).expect("output file exists");
+    serde_json::from_str(&text).expect("output is valid JSON")
+}
+
+/// Every radiosity in a solution is finite and non-negative; returns how many there are.
+fn check_radiosity(solution: &serde_json::Value) -> usize {
+    let mut n = 0;
+    for s in solution["surfaces"].as_array().expect("surfaces") {
+        let vertices = s["vertices"].as_array().expect("vertices").len();
+        let radiosity = s["radiosity"].as_array().expect("radiosity");
+        assert_eq!(radiosity.len(), vertices);
+        for c in radiosity.iter().flat_map(|c| c.as_array().expect("rgb")) {
+            let v = c.as_f64().expect("a number, not null (NaN)");
+            assert!(v.is_finite() && v >= 0.0, "radiosity {v}");
+            n += 1;
+        }
+        for t in s["triangles"].as_array().expect("triangles") {
+            for i in t.as_array().expect("index triple") {
+                assert!((i.as_u64().expect("index") as usize) < vertices);
+            }
+        }
+    }
+    n
+}
+
+#[test]
+fn run_writes_every_output() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("out");
+    let o = penumbra(&["run", "textbook", "--out", out.to_str().expect("utf-8"), "--max-elements", "1500", "--quiet"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(o.stdout.is_empty(), "--quiet prints nothing");
+
+    let solution = json(&out.join("solution.json"));
+    assert_eq!(solution["format"], "penumbra-solution/1");
+    assert_eq!(solution["scene"], "textbook");
+    let names: Vec<&str> = solution["surfaces"]
+        .as_array()
+        .expect("surfaces")
+        .iter()
+        .map(|s| s["name"].as_str().expect("name"))
+        .collect();
+    assert_eq!(names, ["light", "blocker", "floor"]);
+    assert!(check_radiosity(&solution) > 0);
+
+    let report = json(&out.join("report.json"));
+    assert_eq!(report["format"], "penumbra-report/1");
+    let triangles = report["counts"]["triangles"].as_u64().expect("count");
+    assert!(triangles > 1000 && triangles <= 1500, "{triangles}");
+    assert_eq!(report["solver"]["stop"], "converged");
+    assert!(report["energy"]["unshot_fraction"].as_f64().expect("fraction") < 1e-3);
+    assert!(report["mesh_quality"]["min_angle_deg"].as_f64().expect("angle") > 20.0);
+    for stage in ["mesh", "visibility", "direct", "shooting", "render", "total"] {
+        assert!(report["times_seconds"][stage].as_f64().is_some(), "{stage}");
+    }
+
+    let png = std::fs::read(out.join("render.png")).expect("render");
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    for (i, name) in names.iter().enumerate() {
+        let svg = std::fs::read_to_string(out.join("surfaces").join(format!("{i:03}-{name}.svg")))
+            .expect("one SVG per surface");
+        assert!(svg.contains("<svg") && svg.contains(name));
+    }
+    // Nothing half-written is left behind.
+    let leftovers: Vec<_> = std::fs::read_dir(&out)
+        .expect("out dir")
+        .filter_map(Result::ok)
+        .filter(|e| e.file_name().to_string_lossy().contains(".tmp-"))
+        .collect();
+    assert!(leftovers.is_empty());
+}
+
+#[test]
+fn bad_input_exits_2_names_the_problem_and_writes_nothing() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scene = dir.path().join("bad.json");
+    std::fs::write(
+        &scene,
+        r#"{"surfaces": [
+            {"name": "lamp", "polygon": [[0,0,2],[0,1,2],[1,1,2],[1,0,2]], "emission": [1,1,1], "reflectance": [0,0,0]},
+            {"name": "floor", "polygon": [[0,0,0],[1,0,0],[1,1,0],[0,1,0]], "reflectance": [1.5, 0.5, 0.5]}
+        ]}"#,
+    )
+    .expect("write scene");
+    let out = dir.path().join("out");
+    let o = penumbra(&["run", scene.to_str().expect("utf-8"), "--out", out.to_str().expect("utf-8")]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("bad.json"), "{err}");
+    assert!(err.contains("surface \"floor\"") && err.contains("below 1"), "{err}");
+    assert!(!out.exists(), "no output for bad input");
+
+    // A syntax error gives the file, line and column.
+    std::fs::write(&scene, "{\"surfaces\": [\n  {\"name\": \"x\",,}\n]}").expect("write scene");
+    let o = penumbra(&["check", scene.to_str().expect("utf-8")]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("bad.json:2:"), "{err}");
+
+    // Unknown scenes and bad options are usage errors too.
+    assert_eq!(penumbra(&["run", "nowhere"]).status.code(), Some(2));
+    assert_eq!(penumbra(&["run", "textbook", "--epsilon", "2"]).status.code(), Some(2));
+    assert_eq!(penumbra(&["run", "textbook", "--max-elements", "1"]).status.code(), Some(2));
+    assert_eq!(penumbra(&["run", "textbook", "--mesh", "fancy"]).status.code(), Some(2));
+}
+
+#[test]
+fn scenes_and_check() {
+    let o = penumbra(&["scenes"]);
+    assert!(o.status.success());
+    let text = String::from_utf8_lossy(&o.stdout);
+    for name in ["cornell", "textbook", "furnace"] {
+        assert!(text.contains(name), "{text}");
+    }
+    let o = penumbra(&["check", "cornell"]);
+    assert!(o.status.success());
+    assert!(String::from_utf8_lossy(&o.stdout).contains("17 surfaces, 1 emitting"));
+}
+
+#[test]
+fn solutions_are_byte_identical_whatever_the_thread_count() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut solutions = Vec::new();
+    for threads in ["1", "2", "2"] {
+        let out = dir.path().join(format!("out{}", solutions.len()));
+        let o = penumbra(&[
+            "run", "cornell", "--out", out.to_str().expect("utf-8"), "--max-elements", "1500", "--threads", threads,
+            "--quiet",
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        solutions.push(std::fs::read(out.join("solution.json")).expect("solution"));
+        assert_eq!(
+            std::fs::read(out.join("render.png")).expect("render"),
+            std::fs::read(dir.path().join("out0").join("render.png")).expect("render")
+        );
+    }
+    assert!(solutions.windows(2).all(|w| w[0] == w[1]));
+}
