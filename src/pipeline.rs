@@ -4,7 +4,7 @@
 use std::time::Instant;
 
 use penumbra_meshing::{MeshError, SceneMesh, mesh_scene_uniform};
-use penumbra_scenes::{LoadedScene, Visibility};
+use penumbra_scenes::{LoadedScene, Rgb, Visibility};
 use penumbra_solver::{Progress, Solution, SolveError, SolverOptions, solve_progressive};
 use penumbra_viz::{Render, RenderOptions, VizError};
 use serde::Serialize;
@@ -111,11 +111,20 @@ pub fn run(
     times.shooting = solution.stats.shooting_seconds;
 
     let t = Instant::now();
-    let render_options = RenderOptions {
-        ambient: solution.ambient,
-        ..options.render
-    };
-    let render = penumbra_viz::render(scene, &mesh, &solution.radiosity, &render_options)?;
+    // Cohen et al.'s ambient term, for display only: each surface reflects its share of the
+    // light not shot yet.
+    let display: Vec<Vec<Rgb>> = mesh
+        .surfaces
+        .iter()
+        .zip(&solution.radiosity)
+        .map(|(m, b)| {
+            let extra = scene.surfaces[m.surface]
+                .reflectance
+                .mul_rgb(solution.ambient);
+            b.iter().map(|&c| c + extra).collect()
+        })
+        .collect();
+    let render = penumbra_viz::render(scene, &mesh, &display, &options.render)?;
     times.render = t.elapsed().as_secs_f64();
     times.total = started.elapsed().as_secs_f64();
 

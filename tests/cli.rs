@@ -40,7 +40,15 @@ fn check_radiosity(solution: &serde_json::Value) -> usize {
 fn run_writes_every_output() {
     let dir = tempfile::tempdir().expect("temp dir");
     let out = dir.path().join("out");
-    let o = penumbra(&["run", "textbook", "--out", out.to_str().expect("utf-8"), "--max-elements", "1500", "--quiet"]);
+    let o = penumbra(&[
+        "run",
+        "textbook",
+        "--out",
+        out.to_str().expect("utf-8"),
+        "--max-elements",
+        "1500",
+        "--quiet",
+    ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(o.stdout.is_empty(), "--quiet prints nothing");
 
@@ -61,9 +69,26 @@ fn run_writes_every_output() {
     let triangles = report["counts"]["triangles"].as_u64().expect("count");
     assert!(triangles > 1000 && triangles <= 1500, "{triangles}");
     assert_eq!(report["solver"]["stop"], "converged");
-    assert!(report["energy"]["unshot_fraction"].as_f64().expect("fraction") < 1e-3);
-    assert!(report["mesh_quality"]["min_angle_deg"].as_f64().expect("angle") > 20.0);
-    for stage in ["mesh", "visibility", "direct", "shooting", "render", "total"] {
+    assert!(
+        report["energy"]["unshot_fraction"]
+            .as_f64()
+            .expect("fraction")
+            < 1e-3
+    );
+    assert!(
+        report["mesh_quality"]["min_angle_deg"]
+            .as_f64()
+            .expect("angle")
+            > 20.0
+    );
+    for stage in [
+        "mesh",
+        "visibility",
+        "direct",
+        "shooting",
+        "render",
+        "total",
+    ] {
         assert!(report["times_seconds"][stage].as_f64().is_some(), "{stage}");
     }
 
@@ -96,11 +121,19 @@ fn bad_input_exits_2_names_the_problem_and_writes_nothing() {
     )
     .expect("write scene");
     let out = dir.path().join("out");
-    let o = penumbra(&["run", scene.to_str().expect("utf-8"), "--out", out.to_str().expect("utf-8")]);
+    let o = penumbra(&[
+        "run",
+        scene.to_str().expect("utf-8"),
+        "--out",
+        out.to_str().expect("utf-8"),
+    ]);
     assert_eq!(o.status.code(), Some(2));
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("bad.json"), "{err}");
-    assert!(err.contains("surface \"floor\"") && err.contains("below 1"), "{err}");
+    assert!(
+        err.contains("surface \"floor\"") && err.contains("below 1"),
+        "{err}"
+    );
     assert!(!out.exists(), "no output for bad input");
 
     // A syntax error gives the file, line and column.
@@ -112,9 +145,24 @@ fn bad_input_exits_2_names_the_problem_and_writes_nothing() {
 
     // Unknown scenes and bad options are usage errors too.
     assert_eq!(penumbra(&["run", "nowhere"]).status.code(), Some(2));
-    assert_eq!(penumbra(&["run", "textbook", "--epsilon", "2"]).status.code(), Some(2));
-    assert_eq!(penumbra(&["run", "textbook", "--max-elements", "1"]).status.code(), Some(2));
-    assert_eq!(penumbra(&["run", "textbook", "--mesh", "fancy"]).status.code(), Some(2));
+    assert_eq!(
+        penumbra(&["run", "textbook", "--epsilon", "2"])
+            .status
+            .code(),
+        Some(2)
+    );
+    assert_eq!(
+        penumbra(&["run", "textbook", "--max-elements", "1"])
+            .status
+            .code(),
+        Some(2)
+    );
+    assert_eq!(
+        penumbra(&["run", "textbook", "--mesh", "fancy"])
+            .status
+            .code(),
+        Some(2)
+    );
 }
 
 #[test]
@@ -137,7 +185,14 @@ fn solutions_are_byte_identical_whatever_the_thread_count() {
     for threads in ["1", "2", "2"] {
         let out = dir.path().join(format!("out{}", solutions.len()));
         let o = penumbra(&[
-            "run", "cornell", "--out", out.to_str().expect("utf-8"), "--max-elements", "1500", "--threads", threads,
+            "run",
+            "cornell",
+            "--out",
+            out.to_str().expect("utf-8"),
+            "--max-elements",
+            "1500",
+            "--threads",
+            threads,
             "--quiet",
         ]);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
