@@ -201,41 +201,81 @@ pub fn textbook() -> Scene {
 /// A closed unit cube whose six inward faces all emit `emission` and reflect `reflectance`: the
 /// exact radiosity is `emission / (1 - reflectance)` everywhere.
 pub fn furnace(emission: f64, reflectance: f64) -> Scene {
-    let inside = DVec3::splat(0.5);
+    let mut scene = closed_box(DVec3::ONE, emission, reflectance);
+    scene.name = "furnace".into();
+    scene.camera = Some(Camera {
+        eye: v(0.5, 0.02, 0.5),
+        target: v(0.5, 1.0, 0.5),
+        up: v(0.0, 0.0, 1.0),
+        fov_deg: 100.0,
+    });
+    scene
+}
+
+/// A closed box `[0, size.x] x [0, size.y] x [0, size.z]` whose six faces face inward, each
+/// emitting `emission` and reflecting `reflectance`.
+pub fn closed_box(size: DVec3, emission: f64, reflectance: f64) -> Scene {
+    let inside = 0.5 * size;
+    let corner = |x: f64, y: f64, z: f64| v(x, y, z) * size;
     let faces = [
         (
             "floor",
-            [v(0., 0., 0.), v(1., 0., 0.), v(1., 1., 0.), v(0., 1., 0.)],
+            [
+                corner(0., 0., 0.),
+                corner(1., 0., 0.),
+                corner(1., 1., 0.),
+                corner(0., 1., 0.),
+            ],
         ),
         (
             "ceiling",
-            [v(0., 0., 1.), v(1., 0., 1.), v(1., 1., 1.), v(0., 1., 1.)],
+            [
+                corner(0., 0., 1.),
+                corner(1., 0., 1.),
+                corner(1., 1., 1.),
+                corner(0., 1., 1.),
+            ],
         ),
         (
             "south",
-            [v(0., 0., 0.), v(1., 0., 0.), v(1., 0., 1.), v(0., 0., 1.)],
+            [
+                corner(0., 0., 0.),
+                corner(1., 0., 0.),
+                corner(1., 0., 1.),
+                corner(0., 0., 1.),
+            ],
         ),
         (
             "north",
-            [v(0., 1., 0.), v(1., 1., 0.), v(1., 1., 1.), v(0., 1., 1.)],
+            [
+                corner(0., 1., 0.),
+                corner(1., 1., 0.),
+                corner(1., 1., 1.),
+                corner(0., 1., 1.),
+            ],
         ),
         (
             "west",
-            [v(0., 0., 0.), v(0., 1., 0.), v(0., 1., 1.), v(0., 0., 1.)],
+            [
+                corner(0., 0., 0.),
+                corner(0., 1., 0.),
+                corner(0., 1., 1.),
+                corner(0., 0., 1.),
+            ],
         ),
         (
             "east",
-            [v(1., 0., 0.), v(1., 1., 0.), v(1., 1., 1.), v(1., 0., 1.)],
+            [
+                corner(1., 0., 0.),
+                corner(1., 1., 0.),
+                corner(1., 1., 1.),
+                corner(1., 0., 1.),
+            ],
         ),
     ];
     Scene {
-        name: "furnace".into(),
-        camera: Some(Camera {
-            eye: v(0.5, 0.02, 0.5),
-            target: v(0.5, 1.0, 0.5),
-            up: v(0.0, 0.0, 1.0),
-            fov_deg: 100.0,
-        }),
+        name: "box".into(),
+        camera: None,
         surfaces: faces
             .into_iter()
             .map(|(name, p)| {

@@ -24,6 +24,7 @@ pub mod load;
 pub mod model;
 pub mod obj;
 pub mod polygon;
+pub mod rng;
 pub mod validate;
 pub mod visibility;
 

@@ -364,18 +364,7 @@ pub fn intersect_watertight(origin: DVec3, direction: DVec3, v: &[DVec3; 3]) -> 
 mod tests {
     use super::*;
     use crate::builtin;
-
-    /// A small deterministic generator for test rays.
-    struct Lcg(u64);
-    impl Lcg {
-        fn next(&mut self) -> f64 {
-            self.0 = self
-                .0
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (self.0 >> 11) as f64 / (1u64 << 53) as f64
-        }
-    }
+    use crate::rng::SplitMix64;
 
     #[test]
     fn closed_box_does_not_leak_through_shared_edges_and_corners() {
@@ -383,21 +372,21 @@ mod tests {
         // shared diagonals of its triangulated faces, must all hit the cube.
         let scene = builtin::furnace(1.0, 0.5);
         let vis = Visibility::build(&scene);
-        let mut rng = Lcg(7);
+        let mut rng = SplitMix64::new(7);
         let mut misses = 0;
         for _ in 0..20_000 {
             let o = DVec3::new(
-                0.05 + 0.9 * rng.next(),
-                0.05 + 0.9 * rng.next(),
-                0.05 + 0.9 * rng.next(),
+                0.05 + 0.9 * rng.next_f64(),
+                0.05 + 0.9 * rng.next_f64(),
+                0.05 + 0.9 * rng.next_f64(),
             );
             // A target on an edge of the cube (two coordinates in {0, 1}) or a face diagonal.
-            let s = rng.next();
+            let s = rng.next_f64();
             let (a, b) = (
-                if rng.next() < 0.5 { 0.0 } else { 1.0 },
-                if rng.next() < 0.5 { 0.0 } else { 1.0 },
+                if rng.next_f64() < 0.5 { 0.0 } else { 1.0 },
+                if rng.next_f64() < 0.5 { 0.0 } else { 1.0 },
             );
-            let target = match (rng.next() * 5.0) as usize {
+            let target = match (rng.next_f64() * 5.0) as usize {
                 0 => DVec3::new(s, a, b),
                 1 => DVec3::new(a, s, b),
                 2 => DVec3::new(a, b, s),
@@ -437,15 +426,19 @@ mod tests {
     fn segments_out_of_a_closed_box_are_always_blocked() {
         let scene = builtin::furnace(1.0, 0.5);
         let vis = Visibility::build(&scene);
-        let mut rng = Lcg(11);
+        let mut rng = SplitMix64::new(11);
         for _ in 0..20_000 {
             let o = DVec3::new(
-                0.1 + 0.8 * rng.next(),
-                0.1 + 0.8 * rng.next(),
-                0.1 + 0.8 * rng.next(),
+                0.1 + 0.8 * rng.next_f64(),
+                0.1 + 0.8 * rng.next_f64(),
+                0.1 + 0.8 * rng.next_f64(),
             );
             // Through an edge or corner of the cube to a far point outside.
-            let through = DVec3::new(rng.next().round(), rng.next().round(), rng.next());
+            let through = DVec3::new(
+                rng.next_f64().round(),
+                rng.next_f64().round(),
+                rng.next_f64(),
+            );
             let far = o + (through - o) * 3.0;
             assert!(
                 vis.occluded(o, far, [usize::MAX, usize::MAX]),
@@ -458,14 +451,18 @@ mod tests {
     fn closest_hit_matches_brute_force_on_cornell() {
         let scene = builtin::cornell();
         let vis = Visibility::build(&scene);
-        let mut rng = Lcg(3);
+        let mut rng = SplitMix64::new(3);
         for _ in 0..2000 {
             let o = DVec3::new(
-                20.0 + 500.0 * rng.next(),
-                20.0 + 500.0 * rng.next(),
-                20.0 + 500.0 * rng.next(),
+                20.0 + 500.0 * rng.next_f64(),
+                20.0 + 500.0 * rng.next_f64(),
+                20.0 + 500.0 * rng.next_f64(),
             );
-            let d = DVec3::new(rng.next() - 0.5, rng.next() - 0.5, rng.next() - 0.5);
+            let d = DVec3::new(
+                rng.next_f64() - 0.5,
+                rng.next_f64() - 0.5,
+                rng.next_f64() - 0.5,
+            );
             let hit = vis.closest_hit(o, d, 0.0, f64::INFINITY, None);
             let brute = vis
                 .triangles()

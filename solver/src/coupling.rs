@@ -8,7 +8,7 @@ use penumbra_scenes::Visibility;
 
 use crate::elements::{Discretization, Element, Patch};
 use crate::lambert::{ReceivingPoint, edge_term, form_factor};
-use crate::rng::SplitMix64;
+use penumbra_scenes::rng::SplitMix64;
 
 /// Form factors from receivers (mesh vertices) to shooting patches.
 #[derive(Debug)]

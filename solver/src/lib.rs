@@ -25,7 +25,6 @@ pub mod error;
 pub mod lambert;
 pub mod progress;
 pub mod progressive;
-pub mod rng;
 
 pub use direct::DirectLight;
 pub use elements::Discretization;

@@ -56,61 +56,11 @@ fn closed_cube_patch_rows_sum_to_one() {
     assert!(worst_row < 1e-3, "row sums off by {worst_row}");
 }
 
-/// A closed 1 x 2 x 3 box, faces inward, one patch per face.
-fn box_123() -> penumbra_scenes::Scene {
-    use glam::DVec3;
-    use penumbra_scenes::{Rgb, Scene, Surface};
-    let (a, b, c) = (1.0, 2.0, 3.0);
-    let v = |x: f64, y: f64, z: f64| DVec3::new(x * a, y * b, z * c);
-    let quads = [
-        (
-            "z0",
-            [v(0., 0., 0.), v(0., 1., 0.), v(1., 1., 0.), v(1., 0., 0.)],
-        ),
-        (
-            "z1",
-            [v(0., 0., 1.), v(1., 0., 1.), v(1., 1., 1.), v(0., 1., 1.)],
-        ),
-        (
-            "y0",
-            [v(0., 0., 0.), v(1., 0., 0.), v(1., 0., 1.), v(0., 0., 1.)],
-        ),
-        (
-            "y1",
-            [v(0., 1., 0.), v(0., 1., 1.), v(1., 1., 1.), v(1., 1., 0.)],
-        ),
-        (
-            "x0",
-            [v(0., 0., 0.), v(0., 0., 1.), v(0., 1., 1.), v(0., 1., 0.)],
-        ),
-        (
-            "x1",
-            [v(1., 0., 0.), v(1., 1., 0.), v(1., 1., 1.), v(1., 0., 1.)],
-        ),
-    ];
-    Scene {
-        name: "box123".into(),
-        camera: None,
-        surfaces: quads
-            .into_iter()
-            .map(|(n, q)| {
-                let mut q = q.to_vec();
-                let s = Surface::new(n, q.clone(), Rgb::splat(0.5));
-                let c = q.iter().copied().sum::<DVec3>() / 4.0;
-                if s.normal().dot(v(0.5, 0.5, 0.5) - c) < 0.0 {
-                    q.reverse();
-                }
-                Surface::new(n, q, Rgb::splat(0.5)).with_emission(Rgb::splat(1.0))
-            })
-            .collect(),
-    }
-}
-
 /// Section 2.1 of the analytic notes: the 1 x 2 x 3 box's face-to-face form factors, their row
 /// sums and their reciprocity, from the solver's vertex quadrature.
 #[test]
 fn box_face_factors_match_closed_forms_sum_to_one_and_are_reciprocal() {
-    let scene = box_123();
+    let scene = builtin::closed_box(glam::DVec3::new(1.0, 2.0, 3.0), 1.0, 0.5);
     assert!(penumbra_scenes::validate(&scene).is_empty());
     let inward = scene.surfaces.iter().all(|s| {
         let c = s.polygon.iter().copied().sum::<glam::DVec3>() / 4.0;

@@ -150,18 +150,7 @@ fn row_span(p: &[DVec2; 3], y: f64) -> Option<(f64, f64)> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// A deterministic stream of numbers in [0, 1).
-    struct Lcg(u64);
-    impl Lcg {
-        fn next(&mut self) -> f64 {
-            self.0 = self
-                .0
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (self.0 >> 11) as f64 / (1u64 << 53) as f64
-        }
-    }
+    use penumbra_scenes::rng::SplitMix64;
 
     fn coverage(triangles: &[ScreenTriangle], size: u32) -> Vec<u32> {
         let mut count = vec![0; (size * size) as usize];
@@ -226,18 +215,19 @@ mod tests {
 
     #[test]
     fn random_fans_cover_each_pixel_once() {
-        let mut rng = Lcg(7);
+        let mut rng = SplitMix64::new(7);
         for _ in 0..20 {
             // A convex polygon around a centre, fanned from an interior point.
-            let centre = DVec2::new(16.0 + rng.next(), 16.0 + rng.next());
-            let n = 5 + (rng.next() * 8.0) as usize;
+            let centre = DVec2::new(16.0 + rng.next_f64(), 16.0 + rng.next_f64());
+            let n = 5 + (rng.next_f64() * 8.0) as usize;
             let ring: Vec<DVec2> = (0..n)
                 .map(|k| {
-                    let angle = (k as f64 + 0.8 * rng.next()) / n as f64 * std::f64::consts::TAU;
+                    let angle =
+                        (k as f64 + 0.8 * rng.next_f64()) / n as f64 * std::f64::consts::TAU;
                     centre + DVec2::from_angle(angle) * 13.0
                 })
                 .collect();
-            let hub = centre + DVec2::new(rng.next() - 0.5, rng.next() - 0.5) * 4.0;
+            let hub = centre + DVec2::new(rng.next_f64() - 0.5, rng.next_f64() - 0.5) * 4.0;
             let triangles: Vec<ScreenTriangle> = (0..n)
                 .map(|k| ScreenTriangle {
                     corners: [hub, ring[k], ring[(k + 1) % n]],

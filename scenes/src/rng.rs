@@ -1,4 +1,6 @@
 //! A small, seedable generator (SplitMix64): the same numbers on every machine and thread count.
+//! Every random choice in penumbra (visibility samples, Monte Carlo references, test inputs)
+//! comes from it, keyed by what it is for, so results never depend on scheduling.
 
 /// SplitMix64 (Steele, Lea & Flood 2014): fast, statistically sound for sampling, and seedable
 /// from any 64-bit value, so each (shooter, receiver) pair gets its own reproducible stream.
