@@ -21,3 +21,4 @@ pub use error::MeshError;
 pub use mesh::{MeshQuality, SurfaceMesh, quality_of};
 pub use scene_mesh::{SceneMesh, mesh_scene_uniform, spread_by_area};
 pub use uniform::{MeshCoordinates, mesh_surface_uniform};
+pub mod discontinuity;

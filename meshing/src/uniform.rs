@@ -11,7 +11,7 @@ use penumbra_scenes::{PlaneFrame, Surface, SurfaceId};
 use spade::handles::{FixedFaceHandle, InnerTag};
 use spade::{
     AngleLimit, ConstrainedDelaunayTriangulation, HierarchyHintGenerator, Point2,
-    RefinementParameters, Triangulation,
+    RefinementParameters, Triangulation as _,
 };
 
 use crate::error::MeshError;
@@ -22,7 +22,7 @@ pub const SNAP_BITS: i32 = 36;
 /// Smallest angle the refinement aims for.
 pub const MIN_ANGLE_DEG: f64 = 25.0;
 
-pub(crate) type Cdt =
+pub type Cdt =
     ConstrainedDelaunayTriangulation<Point2<f64>, (), (), (), HierarchyHintGenerator<f64>>;
 
 pub(crate) fn snap(x: f64) -> f64 {
@@ -107,38 +107,70 @@ fn outside_faces(cdt: &mut Cdt) -> Vec<FixedFaceHandle<InnerTag>> {
     .excluded_faces
 }
 
-/// Meshes one surface with about `target` triangles (never more, unless the polygon itself needs
-/// more than `target` to be triangulated at all).
-pub fn mesh_surface_uniform(
-    id: SurfaceId,
-    surface: &Surface,
-    target: usize,
-) -> Result<SurfaceMesh, MeshError> {
-    let coords = MeshCoordinates::of_surface(id, surface)?;
-    let mut base = boundary_cdt(id, &coords)?;
-    let base_outside = outside_faces(&mut base);
-    let base_count = base.num_inner_faces() - base_outside.len();
+/// A surface's constrained triangulation in mesh coordinates, with the faces outside its polygon.
+#[derive(Clone)]
+pub(crate) struct SurfaceTriangulation {
+    pub coords: MeshCoordinates,
+    pub cdt: Cdt,
+    pub outside: Vec<FixedFaceHandle<InnerTag>>,
+}
 
-    let mut best = (base.clone(), base_outside, base_count);
-    let polygon_area = signed_area_2d(&coords.boundary);
-    if target > base_count {
+impl SurfaceTriangulation {
+    /// The polygon's own constrained Delaunay triangulation, unrefined.
+    pub fn of_surface(id: SurfaceId, surface: &Surface) -> Result<SurfaceTriangulation, MeshError> {
+        let coords = MeshCoordinates::of_surface(id, surface)?;
+        let cdt = boundary_cdt(id, &coords)?;
+        let mut t = SurfaceTriangulation {
+            coords,
+            cdt,
+            outside: Vec::new(),
+        };
+        t.find_outside();
+        Ok(t)
+    }
+
+    /// Recomputes the faces outside the polygon after the triangulation changed.
+    pub fn find_outside(&mut self) {
+        self.outside = outside_faces(&mut self.cdt);
+    }
+
+    /// Triangles inside the polygon.
+    pub fn count(&self) -> usize {
+        self.cdt.num_inner_faces() - self.outside.len()
+    }
+
+    /// A refinement with about `target` triangles (never more, unless the triangulation already
+    /// has more) and angles of at least `min_angle_deg` where the budget allows.
+    pub fn refined(&self, target: usize, min_angle_deg: f64) -> SurfaceTriangulation {
+        let mut best = self.clone();
+        let base_count = self.count();
+        if target <= base_count {
+            return best;
+        }
+        let mut best_count = base_count;
+        let polygon_area = signed_area_2d(&self.coords.boundary);
         // Area-bounded refinement leaves triangles of about 0.6 of the bound; calibrate the
         // bound from the counts of a few trial runs.
         let mut max_area = 1.6 * polygon_area / target as f64;
         for _ in 0..8 {
-            let mut cdt = base.clone();
+            let mut cdt = self.cdt.clone();
             let result = cdt.refine(
                 RefinementParameters::<f64>::new()
                     .exclude_outer_faces(true)
-                    .with_angle_limit(AngleLimit::from_deg(MIN_ANGLE_DEG))
+                    .with_angle_limit(AngleLimit::from_deg(min_angle_deg))
                     .with_max_allowed_area(max_area)
                     .with_min_required_area(1e-3 * max_area)
                     .with_max_additional_vertices(target + 64),
             );
             let count = cdt.num_inner_faces() - result.excluded_faces.len();
             let ratio = count as f64 / target as f64;
-            if count <= target && count > best.2 {
-                best = (cdt, result.excluded_faces, count);
+            if count <= target && count > best_count {
+                best_count = count;
+                best = SurfaceTriangulation {
+                    coords: self.coords.clone(),
+                    cdt,
+                    outside: result.excluded_faces,
+                };
             }
             if (0.9..=1.0).contains(&ratio) {
                 break;
@@ -149,9 +181,24 @@ pub fn mesh_surface_uniform(
                 ratio * 0.98
             };
         }
+        best
     }
-    let (cdt, outside, _) = best;
-    Ok(extract(id, surface, coords, &cdt, &outside))
+
+    pub fn into_mesh(self, id: SurfaceId, surface: &Surface) -> SurfaceMesh {
+        extract(id, surface, self.coords, &self.cdt, &self.outside)
+    }
+}
+
+/// Meshes one surface with about `target` triangles (never more, unless the polygon itself needs
+/// more than `target` to be triangulated at all).
+pub fn mesh_surface_uniform(
+    id: SurfaceId,
+    surface: &Surface,
+    target: usize,
+) -> Result<SurfaceMesh, MeshError> {
+    Ok(SurfaceTriangulation::of_surface(id, surface)?
+        .refined(target, MIN_ANGLE_DEG)
+        .into_mesh(id, surface))
 }
 
 /// Copies the inside faces of a triangulation into a `SurfaceMesh`.

@@ -1,0 +1,179 @@
+//! Coincident critical lines merged into one: in the parallel case the EV wedges of both ends of a
+//! blocker edge and the VE wedges of its emitter vertices all lie in one plane.
+
+use glam::DVec2;
+
+/// A segment on a receiver in its plane-frame coordinates, with what generated it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FlatSegment<T> {
+    pub from: DVec2,
+    pub to: DVec2,
+    pub tag: T,
+}
+
+/// Merges segments that lie on one line (every endpoint of each within `tol` of the other's line)
+/// and overlap or touch (within `tol`) into their union. Tags of merged pieces combine with
+/// `combine`. The result is in a deterministic order.
+pub fn merge_collinear<T: Copy>(
+    segments: &[FlatSegment<T>],
+    tol: f64,
+    combine: impl Fn(T, T) -> T,
+) -> Vec<FlatSegment<T>> {
+    let segments: Vec<&FlatSegment<T>> = segments
+        .iter()
+        .filter(|s| s.from.distance(s.to) > tol)
+        .collect();
+    let n = segments.len();
+    // Bucket lines by the doubled angle of their direction (the same for both orientations, so
+    // no sign to canonicalize) and by their distance from the origin along the canonical normal.
+    let angle_cell = 1e-6;
+    let offset_cell = 4.0 * tol.max(f64::MIN_POSITIVE);
+    let key = |s: &FlatSegment<T>| {
+        let d = (s.to - s.from).normalize();
+        let phi = (2.0 * d.x * d.y).atan2(d.x * d.x - d.y * d.y);
+        let half = DVec2::new((phi / 2.0).cos(), (phi / 2.0).sin());
+        let offset = half.perp_dot(s.from);
+        (
+            (phi / angle_cell).floor() as i64,
+            (offset / offset_cell).floor() as i64,
+        )
+    };
+    let keys: Vec<(i64, i64)> = segments.iter().map(|s| key(s)).collect();
+    let wrap = (std::f64::consts::PI / angle_cell).floor() as i64;
+    let mut buckets: std::collections::HashMap<(i64, i64), Vec<usize>> = Default::default();
+    for (i, &k) in keys.iter().enumerate() {
+        buckets.entry(k).or_default().push(i);
+    }
+    let collinear = |a: &FlatSegment<T>, b: &FlatSegment<T>| {
+        let on = |s: &FlatSegment<T>, p: DVec2| {
+            let d = s.to - s.from;
+            d.perp_dot(p - s.from).abs() <= tol * d.length()
+        };
+        on(a, b.from) && on(a, b.to) && on(b, a.from) && on(b, a.to)
+    };
+    let mut parent: Vec<usize> = (0..n).collect();
+    fn find(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    for i in 0..n {
+        let (ka, ko) = keys[i];
+        for da in -1..=1 {
+            for doff in -1..=1 {
+                let mut a = ka + da;
+                let mut o = ko + doff;
+                // Across the doubled angle's wrap the canonical normal flips, and so does the offset.
+                if a > wrap {
+                    a -= 2 * wrap + 2;
+                    o = -o - 1;
+                } else if a < -wrap - 1 {
+                    a += 2 * wrap + 2;
+                    o = -o - 1;
+                }
+                let Some(others) = buckets.get(&(a, o)) else {
+                    continue;
+                };
+                for &j in others {
+                    if j > i && collinear(segments[i], segments[j]) {
+                        let (ri, rj) = (find(&mut parent, i), find(&mut parent, j));
+                        parent[ri.max(rj)] = ri.min(rj);
+                    }
+                }
+            }
+        }
+    }
+    let mut groups: std::collections::BTreeMap<usize, Vec<usize>> = Default::default();
+    for i in 0..n {
+        let r = find(&mut parent, i);
+        groups.entry(r).or_default().push(i);
+    }
+
+    let mut out = Vec::new();
+    for (root, members) in groups {
+        let reference = segments[root];
+        let origin = reference.from;
+        let dir = (reference.to - reference.from).normalize();
+        let mut intervals: Vec<(f64, f64, T)> = members
+            .iter()
+            .map(|&m| {
+                let s = segments[m];
+                let (a, b) = (dir.dot(s.from - origin), dir.dot(s.to - origin));
+                (a.min(b), a.max(b), s.tag)
+            })
+            .collect();
+        intervals.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.total_cmp(&y.1)));
+        let emit = |(lo, hi, tag): (f64, f64, T), out: &mut Vec<FlatSegment<T>>| {
+            out.push(FlatSegment {
+                from: origin + dir * lo,
+                to: origin + dir * hi,
+                tag,
+            });
+        };
+        let mut current: Option<(f64, f64, T)> = None;
+        for (lo, hi, tag) in intervals {
+            current = match current {
+                Some((clo, chi, ctag)) if lo <= chi + tol => {
+                    Some((clo, chi.max(hi), combine(ctag, tag)))
+                }
+                Some(done) => {
+                    emit(done, &mut out);
+                    Some((lo, hi, tag))
+                }
+                None => Some((lo, hi, tag)),
+            };
+        }
+        if let Some(done) = current {
+            emit(done, &mut out);
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn seg(a: (f64, f64), b: (f64, f64), tag: u8) -> FlatSegment<u8> {
+        FlatSegment {
+            from: DVec2::new(a.0, a.1),
+            to: DVec2::new(b.0, b.1),
+            tag,
+        }
+    }
+
+    #[test]
+    fn overlapping_collinear_segments_become_one() {
+        let input = [
+            seg((0.5, 1.0), (1.0, 1.0), 2),
+            seg((-1.0, 1.0), (0.0, 1.0), 1),
+            seg((0.5, 1.0), (-0.5, 1.0), 2), // reversed
+            seg((0.0, 0.0), (0.0, 2.0), 2),  // another line
+            seg((3.0, 1.0), (4.0, 1.0), 2),  // same line, apart
+            seg((0.0, 1.5), (0.0, 3.0), 1),  // continues the vertical line, reversed sign of x
+            seg((-1e-17, 3.0), (1e-17, 3.5), 2),
+        ];
+        let out = merge_collinear(&input, 1e-9, u8::min);
+        assert_eq!(out.len(), 3, "{out:?}");
+        let vertical = out
+            .iter()
+            .find(|s| s.from.x.abs() < 1e-9 && s.to.x.abs() < 1e-9)
+            .expect("vertical");
+        let (lo, hi) = (
+            vertical.from.y.min(vertical.to.y),
+            vertical.from.y.max(vertical.to.y),
+        );
+        assert!(lo.abs() < 1e-12 && (hi - 3.5).abs() < 1e-12, "{vertical:?}");
+        let long = out
+            .iter()
+            .find(|s| (s.from.y - 1.0).abs() < 1e-12 && s.tag == 1)
+            .expect("merged line");
+        let (lo, hi) = (long.from.x.min(long.to.x), long.from.x.max(long.to.x));
+        assert!(
+            (lo + 1.0).abs() < 1e-12 && (hi - 1.0).abs() < 1e-12,
+            "{long:?}"
+        );
+    }
+}

@@ -1,0 +1,503 @@
+//! Discontinuity meshing, first half: where on each receiver the direct light from each emitter
+//! changes its analytic form (Heckbert 1992; Lischinski, Tampieri & Greenberg 1992).
+//!
+//! For every emitter and receiver, the blockers inside the shaft between them (BVH box query)
+//! contribute their silhouette features: EV wedges (emitter edge, blocker vertex) and VE wedges
+//! (emitter vertex, blocker edge). Each wedge meets the receiver's plane in a line, clipped to the
+//! receiver polygon and trimmed to where its generating rays are unobstructed. Coincident lines
+//! (the parallel case) are merged. Blockers touching the receiver add contact (D0) lines. Every
+//! segment is classified by what lies on either side: umbra, penumbra or lit.
+
+pub mod contact;
+pub mod merge;
+pub mod topology;
+pub mod trim;
+pub mod wedge;
+
+use std::collections::BTreeSet;
+use std::time::Instant;
+
+use glam::{DVec2, DVec3};
+use penumbra_scenes::{Bounds, PlaneFrame, Scene, SurfaceId, Visibility};
+use serde::Serialize;
+
+use merge::{FlatSegment, merge_collinear};
+use topology::Topology;
+pub use wedge::{Event, Wedge};
+
+/// What a discontinuity line bounds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Boundary {
+    /// One side sees none of the emitter.
+    Umbra,
+    /// One side sees all of it: the outer edge of the penumbra.
+    Penumbra,
+    /// Inside the penumbra: both sides see part of the emitter.
+    Inner,
+}
+
+impl Boundary {
+    pub fn name(self) -> &'static str {
+        match self {
+            Boundary::Umbra => "umbra",
+            Boundary::Penumbra => "penumbra",
+            Boundary::Inner => "inner",
+        }
+    }
+}
+
+/// A segment on a receiver across which the direct light from `emitter` is not smooth.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DiscontinuitySegment {
+    pub surface: SurfaceId,
+    pub emitter: SurfaceId,
+    pub from: DVec3,
+    pub to: DVec3,
+    pub event: Event,
+    pub boundary: Boundary,
+    /// 0: the value jumps; 1: the slope jumps; 2: the curvature jumps.
+    pub order: u8,
+}
+
+/// Options of discontinuity finding.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DiscontinuityOptions {
+    /// Samples along each wedge segment when trimming it.
+    pub trim_samples: usize,
+    /// Trim points are located to this fraction of the receiver's diameter.
+    pub trim_tolerance: f64,
+}
+
+impl Default for DiscontinuityOptions {
+    fn default() -> Self {
+        DiscontinuityOptions {
+            trim_samples: 16,
+            trim_tolerance: 1e-9,
+        }
+    }
+}
+
+/// What discontinuity finding did.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct DiscontinuityStats {
+    /// Emitter–receiver pairs that face each other.
+    pub pairs: usize,
+    /// Pairs whose shaft holds no blocker: nothing to do for them.
+    pub pairs_without_blockers: usize,
+    /// Blocker surfaces found in shafts, summed over pairs.
+    pub blockers_in_shafts: usize,
+    /// Feature pairs that could form a wedge (in front of both emitter and receiver).
+    pub wedges_considered: usize,
+    /// Of those, not tangent to the emitter or the blocker's silhouette.
+    pub wedges_culled: usize,
+    /// Wedges that left a segment on their receiver.
+    pub wedges_kept: usize,
+    /// Wedge segments shortened or split by trimming, and removed by it entirely.
+    pub segments_trimmed: usize,
+    pub segments_hidden: usize,
+    /// Contact lines where blockers touch receivers.
+    pub contact_segments: usize,
+    /// EEE events (ruled quadric critical surfaces); not computed.
+    pub eee_events: usize,
+    /// Segments after merging coincident ones.
+    pub segments: usize,
+    pub seconds: f64,
+}
+
+/// Every receiver's discontinuity segments (indexed by surface), and the figures of the search.
+#[derive(Clone, Debug, Default)]
+pub struct Discontinuities {
+    pub segments: Vec<Vec<DiscontinuitySegment>>,
+    pub stats: DiscontinuityStats,
+}
+
+/// Finds the discontinuities of the direct light on every surface of a scene.
+pub fn find_discontinuities(
+    scene: &Scene,
+    visibility: &Visibility,
+    options: &DiscontinuityOptions,
+) -> Discontinuities {
+    let started = Instant::now();
+    let tol = visibility.contact_distance();
+    let topology = Topology::new(scene, tol);
+    let reach = 4.0 * scene.diagonal();
+    let mut stats = DiscontinuityStats::default();
+    let mut raw: Vec<Vec<DiscontinuitySegment>> = vec![Vec::new(); scene.surfaces.len()];
+
+    let frames: Vec<Option<PlaneFrame>> = scene
+        .surfaces
+        .iter()
+        .map(|s| PlaneFrame::of_polygon(&s.polygon))
+        .collect();
+
+    for (e, emitter) in scene.emitters() {
+        let Some(ef) = frames[e] else { continue };
+        let e_loop = &topology.loops[e];
+        for (r, receiver) in scene.surfaces.iter().enumerate() {
+            if r == e {
+                continue;
+            }
+            let Some(rf) = frames[r] else { continue };
+            let faces = emitter.polygon.iter().any(|&p| rf.height(p) > tol)
+                && receiver.polygon.iter().any(|&p| ef.height(p) > tol);
+            if !faces {
+                continue;
+            }
+            stats.pairs += 1;
+            let blockers = shaft_blockers(
+                visibility,
+                emitter.bounds().union(receiver.bounds()),
+                e,
+                r,
+                |s| {
+                    scene.surfaces[s]
+                        .polygon
+                        .iter()
+                        .any(|&p| ef.height(p) > tol && rf.height(p) > tol)
+                },
+            );
+            if blockers.is_empty() {
+                stats.pairs_without_blockers += 1;
+                continue;
+            }
+            stats.blockers_in_shafts += blockers.len();
+            let mut vertices = BTreeSet::new();
+            let mut edges = BTreeSet::new();
+            for &b in &blockers {
+                let l = &topology.loops[b];
+                for k in 0..l.len() {
+                    let (u, w) = (l[k], l[(k + 1) % l.len()]);
+                    vertices.insert(u);
+                    if u != w {
+                        edges.insert((u.min(w), u.max(w)));
+                    }
+                }
+            }
+            let not_pair = |s: SurfaceId| s != e && s != r;
+            let in_front = |p: DVec3| ef.height(p) > tol && rf.height(p) > tol;
+            let mut wedges = Vec::new();
+            // EV: each emitter edge with each silhouette vertex.
+            for k in 0..e_loop.len() {
+                let (ia, ib) = (e_loop[k], e_loop[(k + 1) % e_loop.len()]);
+                let Some(source) = clip_segment(topology.points[ia], topology.points[ib], |p| {
+                    rf.height(p) - tol
+                }) else {
+                    continue;
+                };
+                for &v in &vertices {
+                    let pv = topology.points[v];
+                    if !in_front(pv) || e_loop.contains(&v) {
+                        continue;
+                    }
+                    let n =
+                        (topology.points[ib] - topology.points[ia]).cross(pv - topology.points[ia]);
+                    let Some(n) = n.try_normalize() else { continue };
+                    stats.wedges_considered += 1;
+                    if !topology.vertex_is_tangent(v, n, not_pair) {
+                        stats.wedges_culled += 1;
+                        continue;
+                    }
+                    let order = if topology.plane_holds_an_edge_at(v, n, not_pair) {
+                        1
+                    } else {
+                        2
+                    };
+                    wedges.push(Wedge {
+                        emitter: e,
+                        event: Event::Ev,
+                        source,
+                        through: [pv, pv],
+                        order,
+                    });
+                }
+            }
+            // VE: each emitter vertex with each silhouette edge.
+            for &ia in e_loop {
+                let pa = topology.points[ia];
+                if rf.height(pa) <= tol {
+                    continue;
+                }
+                for &(u, w) in &edges {
+                    let Some(through) = clip_segment(topology.points[u], topology.points[w], |p| {
+                        (ef.height(p) - tol).min(rf.height(p) - tol)
+                    }) else {
+                        continue;
+                    };
+                    if u == ia || w == ia {
+                        continue;
+                    }
+                    let Some(n) = (through[0] - pa).cross(through[1] - pa).try_normalize() else {
+                        continue;
+                    };
+                    stats.wedges_considered += 1;
+                    if !topology.vertex_is_tangent(ia, n, |s| s == e)
+                        || !topology.edge_is_tangent(u, w, n, not_pair)
+                    {
+                        stats.wedges_culled += 1;
+                        continue;
+                    }
+                    let order = if topology.plane_holds_an_edge_at(ia, n, |s| s == e) {
+                        1
+                    } else {
+                        2
+                    };
+                    wedges.push(Wedge {
+                        emitter: e,
+                        event: Event::Ve,
+                        source: [pa, pa],
+                        through,
+                        order,
+                    });
+                }
+            }
+            for wedge in wedges {
+                let Some([p, q]) = wedge.meet_plane(rf.origin, rf.normal, reach) else {
+                    continue;
+                };
+                let pieces = clip_to_polygon(&rf, &receiver.polygon, p, q);
+                let mut kept = false;
+                let trim_tol =
+                    options.trim_tolerance * penumbra_scenes::polygon::diameter(&receiver.polygon);
+                for [a, b] in pieces {
+                    let runs = trim::visible_runs(
+                        visibility,
+                        &wedge,
+                        r,
+                        a,
+                        b,
+                        options.trim_samples,
+                        trim_tol,
+                    );
+                    match runs.as_slice() {
+                        [] => stats.segments_hidden += 1,
+                        [[x, y]] if x.distance(a) <= trim_tol && y.distance(b) <= trim_tol => {}
+                        _ => stats.segments_trimmed += 1,
+                    }
+                    for [x, y] in runs {
+                        kept = true;
+                        raw[r].push(DiscontinuitySegment {
+                            surface: r,
+                            emitter: e,
+                            from: x,
+                            to: y,
+                            event: wedge.event,
+                            boundary: Boundary::Inner,
+                            order: wedge.order,
+                        });
+                    }
+                }
+                stats.wedges_kept += usize::from(kept);
+            }
+        }
+    }
+
+    // Contact lines, for every receiver that something touches.
+    for (r, contacts) in contact::contact_lines(scene, &frames, visibility) {
+        stats.contact_segments += contacts.len();
+        for (from, to) in contacts {
+            for (e, _) in scene.emitters() {
+                raw[r].push(DiscontinuitySegment {
+                    surface: r,
+                    emitter: e,
+                    from,
+                    to,
+                    event: Event::Contact,
+                    boundary: Boundary::Umbra,
+                    order: 0,
+                });
+            }
+        }
+    }
+
+    let mut segments = Vec::with_capacity(raw.len());
+    for (r, list) in raw.into_iter().enumerate() {
+        let Some(rf) = frames[r] else {
+            segments.push(Vec::new());
+            continue;
+        };
+        let merged = merge_on_receiver(&rf, list, tol);
+        let classified: Vec<DiscontinuitySegment> = merged
+            .into_iter()
+            .map(|s| DiscontinuitySegment {
+                boundary: classify(scene, visibility, &rf, &s),
+                ..s
+            })
+            .collect();
+        stats.segments += classified.len();
+        segments.push(classified);
+    }
+    stats.seconds = started.elapsed().as_secs_f64();
+    Discontinuities { segments, stats }
+}
+
+/// Surfaces other than `e` and `r` with a triangle in `bounds` for which `keep` holds, sorted.
+fn shaft_blockers(
+    visibility: &Visibility,
+    bounds: Bounds,
+    e: SurfaceId,
+    r: SurfaceId,
+    keep: impl Fn(SurfaceId) -> bool,
+) -> Vec<SurfaceId> {
+    let mut found = BTreeSet::new();
+    visibility.triangles_overlapping(bounds, |t| {
+        let s = visibility.triangles()[t].surface;
+        if s != e && s != r {
+            found.insert(s);
+        }
+    });
+    found.into_iter().filter(|&s| keep(s)).collect()
+}
+
+/// The part of segment `a-b` where `h >= 0` (h linear along it), if any length remains.
+fn clip_segment(a: DVec3, b: DVec3, h: impl Fn(DVec3) -> f64) -> Option<[DVec3; 2]> {
+    let (ha, hb) = (h(a), h(b));
+    match (ha >= 0.0, hb >= 0.0) {
+        (true, true) => Some([a, b]),
+        (false, false) => None,
+        (true, false) => Some([a, a.lerp(b, ha / (ha - hb))]),
+        (false, true) => Some([a.lerp(b, ha / (ha - hb)), b]),
+    }
+}
+
+/// The pieces of segment `p-q` (on the polygon's plane) inside the polygon.
+pub(crate) fn clip_to_polygon(
+    frame: &PlaneFrame,
+    polygon: &[DVec3],
+    p: DVec3,
+    q: DVec3,
+) -> Vec<[DVec3; 2]> {
+    let flat: Vec<DVec2> = polygon.iter().map(|&x| frame.to_2d(x)).collect();
+    let (a, b) = (frame.to_2d(p), frame.to_2d(q));
+    let d = b - a;
+    let mut cuts = vec![0.0, 1.0];
+    let n = flat.len();
+    for i in 0..n {
+        let (c, e) = (flat[i], flat[(i + 1) % n]);
+        let f = e - c;
+        let den = d.perp_dot(f);
+        if den == 0.0 {
+            continue;
+        }
+        let t = (c - a).perp_dot(f) / den;
+        let u = (c - a).perp_dot(d) / den;
+        if (0.0..=1.0).contains(&t) && (0.0..=1.0).contains(&u) {
+            cuts.push(t);
+        }
+    }
+    cuts.sort_by(f64::total_cmp);
+    cuts.dedup();
+    cuts.windows(2)
+        .filter(|w| w[1] > w[0] && point_in_polygon(a + d * (0.5 * (w[0] + w[1])), &flat))
+        .map(|w| [p.lerp(q, w[0]), p.lerp(q, w[1])])
+        .collect()
+}
+
+/// Even-odd point-in-polygon test.
+pub(crate) fn point_in_polygon(p: DVec2, polygon: &[DVec2]) -> bool {
+    let n = polygon.len();
+    let mut inside = false;
+    for i in 0..n {
+        let (a, b) = (polygon[i], polygon[(i + 1) % n]);
+        if (a.y > p.y) != (b.y > p.y) {
+            let x = a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x);
+            if p.x < x {
+                inside = !inside;
+            }
+        }
+    }
+    inside
+}
+
+/// Merges a receiver's coincident segments (per emitter) in its plane frame.
+fn merge_on_receiver(
+    frame: &PlaneFrame,
+    list: Vec<DiscontinuitySegment>,
+    tol: f64,
+) -> Vec<DiscontinuitySegment> {
+    let mut by_emitter: std::collections::BTreeMap<
+        SurfaceId,
+        Vec<FlatSegment<DiscontinuitySegment>>,
+    > = Default::default();
+    for s in list {
+        by_emitter.entry(s.emitter).or_default().push(FlatSegment {
+            from: frame.to_2d(s.from),
+            to: frame.to_2d(s.to),
+            tag: s,
+        });
+    }
+    let mut out = Vec::new();
+    for (_, flat) in by_emitter {
+        // The most significant description wins: the lowest order, then the first event kind.
+        let combine = |a: DiscontinuitySegment, b: DiscontinuitySegment| {
+            if (b.order, b.event) < (a.order, a.event) {
+                b
+            } else {
+                a
+            }
+        };
+        for m in merge_collinear(&flat, tol, combine) {
+            out.push(DiscontinuitySegment {
+                from: frame.to_3d(m.from),
+                to: frame.to_3d(m.to),
+                ..m.tag
+            });
+        }
+    }
+    out
+}
+
+/// Classifies a segment by probing both sides of its midpoint: how much of the emitter each side
+/// sees, by rays to points spread over the emitter.
+fn classify(
+    scene: &Scene,
+    visibility: &Visibility,
+    frame: &PlaneFrame,
+    s: &DiscontinuitySegment,
+) -> Boundary {
+    let emitter = &scene.surfaces[s.emitter];
+    let mid = 0.5 * (s.from + s.to);
+    let along = (s.to - s.from).normalize_or_zero();
+    let across = frame.normal.cross(along);
+    let step = 1e3 * visibility.contact_distance();
+    let samples = emitter_samples(&emitter.polygon);
+    let en = emitter.normal();
+    let fraction = |x: DVec3| {
+        let usable: Vec<&DVec3> = samples
+            .iter()
+            .filter(|&&y| en.dot(x - y) > 0.0 && frame.normal.dot(y - x) > 0.0)
+            .collect();
+        if usable.is_empty() {
+            return 0.0;
+        }
+        let open = usable
+            .iter()
+            .filter(|&&&y| !visibility.occluded(x, y, [s.surface, s.emitter]))
+            .count();
+        open as f64 / usable.len() as f64
+    };
+    let (a, b) = (fraction(mid + across * step), fraction(mid - across * step));
+    if a.min(b) == 0.0 {
+        Boundary::Umbra
+    } else if a.max(b) == 1.0 {
+        Boundary::Penumbra
+    } else {
+        Boundary::Inner
+    }
+}
+
+/// Points spread over a polygon: its vertices pulled slightly inward and a few interior points.
+fn emitter_samples(polygon: &[DVec3]) -> Vec<DVec3> {
+    let c = penumbra_scenes::polygon::centroid(polygon);
+    let mut out = vec![c];
+    for &p in polygon {
+        out.push(c.lerp(p, 0.98));
+        out.push(c.lerp(p, 0.5));
+    }
+    let n = polygon.len();
+    for i in 0..n {
+        let m = 0.5 * (polygon[i] + polygon[(i + 1) % n]);
+        out.push(c.lerp(m, 0.98));
+    }
+    out
+}

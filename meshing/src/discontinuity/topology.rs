@@ -1,0 +1,200 @@
+//! Which polygons meet where: vertices welded across surfaces, the faces around each vertex and
+//! edge, and the silhouette tests of visual events built on them.
+//!
+//! A blocker made of several faces (a box) casts shadow edges only from its silhouette as seen
+//! from the emitter feature: a vertex or an edge whose surrounding faces all lie on one side of
+//! the critical plane.
+
+use std::collections::{BTreeMap, HashMap};
+
+use glam::DVec3;
+use penumbra_scenes::{Scene, SurfaceId};
+
+/// One corner of one face: the face, and the welded ids of the corner and its two neighbours.
+#[derive(Clone, Copy, Debug)]
+pub struct Corner {
+    pub surface: SurfaceId,
+    pub prev: usize,
+    pub next: usize,
+}
+
+/// The welded vertices and edges of a scene.
+#[derive(Clone, Debug)]
+pub struct Topology {
+    /// Welded vertex positions.
+    pub points: Vec<DVec3>,
+    /// Each surface's polygon as welded vertex ids.
+    pub loops: Vec<Vec<usize>>,
+    /// The face corners at each welded vertex.
+    pub corners: Vec<Vec<Corner>>,
+    /// Each undirected edge `(lo, hi)` and the faces that have it, with the face's direction
+    /// (true when the face runs `lo -> hi`).
+    pub edges: BTreeMap<(usize, usize), Vec<(SurfaceId, bool)>>,
+    pub normals: Vec<DVec3>,
+    /// Distance under which two vertices are one.
+    pub weld: f64,
+}
+
+impl Topology {
+    pub fn new(scene: &Scene, weld: f64) -> Topology {
+        let mut points: Vec<DVec3> = Vec::new();
+        let mut grid: HashMap<(i64, i64, i64), Vec<usize>> = HashMap::new();
+        let cell = (4.0 * weld).max(f64::MIN_POSITIVE);
+        let key = |p: DVec3| {
+            let q = (p / cell).floor();
+            (q.x as i64, q.y as i64, q.z as i64)
+        };
+        let mut weld_point = |p: DVec3| -> usize {
+            let (kx, ky, kz) = key(p);
+            for dx in -1..=1 {
+                for dy in -1..=1 {
+                    for dz in -1..=1 {
+                        if let Some(ids) = grid.get(&(kx + dx, ky + dy, kz + dz)) {
+                            if let Some(&id) =
+                                ids.iter().find(|&&id| points[id].distance(p) <= weld)
+                            {
+                                return id;
+                            }
+                        }
+                    }
+                }
+            }
+            let id = points.len();
+            points.push(p);
+            grid.entry((kx, ky, kz)).or_default().push(id);
+            id
+        };
+        let loops: Vec<Vec<usize>> = scene
+            .surfaces
+            .iter()
+            .map(|s| s.polygon.iter().map(|&p| weld_point(p)).collect())
+            .collect();
+        let mut corners = vec![Vec::new(); points.len()];
+        let mut edges: BTreeMap<(usize, usize), Vec<(SurfaceId, bool)>> = BTreeMap::new();
+        for (surface, l) in loops.iter().enumerate() {
+            let n = l.len();
+            for i in 0..n {
+                let (prev, here, next) = (l[(i + n - 1) % n], l[i], l[(i + 1) % n]);
+                corners[here].push(Corner {
+                    surface,
+                    prev,
+                    next,
+                });
+                if here != next {
+                    edges
+                        .entry((here.min(next), here.max(next)))
+                        .or_default()
+                        .push((surface, here < next));
+                }
+            }
+        }
+        Topology {
+            points,
+            loops,
+            corners,
+            edges,
+            normals: scene.surfaces.iter().map(|s| s.normal()).collect(),
+            weld,
+        }
+    }
+
+    /// Side of `p` relative to the plane through `origin` with normal `n`: -1, 0 (within the
+    /// weld distance) or 1.
+    fn side(&self, n: DVec3, origin: DVec3, p: DVec3) -> i8 {
+        let h = n.dot(p - origin);
+        if h.abs() <= self.weld {
+            0
+        } else if h > 0.0 {
+            1
+        } else {
+            -1
+        }
+    }
+
+    /// Whether every face around vertex `v` for which `include` holds lies on one side of the
+    /// plane through `v` with unit normal `n`.
+    pub fn vertex_is_tangent(
+        &self,
+        v: usize,
+        n: DVec3,
+        include: impl Fn(SurfaceId) -> bool,
+    ) -> bool {
+        let origin = self.points[v];
+        let mut seen = 0i8;
+        for c in &self.corners[v] {
+            if !include(c.surface) {
+                continue;
+            }
+            let (a, b) = (self.points[c.prev], self.points[c.next]);
+            // A reflex corner wraps around the vertex: it straddles every plane through it.
+            let convex = (origin - a).cross(b - origin).dot(self.normals[c.surface]) >= 0.0;
+            let sides = [self.side(n, origin, a), self.side(n, origin, b)];
+            if !convex && sides.iter().all(|&s| s != 0) {
+                return false;
+            }
+            for s in sides {
+                if s != 0 {
+                    if seen != 0 && s != seen {
+                        return false;
+                    }
+                    seen = s;
+                }
+            }
+        }
+        true
+    }
+
+    /// Whether every face along the edge `(a, b)` for which `include` holds lies on one side of
+    /// the plane through the edge with unit normal `n`.
+    pub fn edge_is_tangent(
+        &self,
+        a: usize,
+        b: usize,
+        n: DVec3,
+        include: impl Fn(SurfaceId) -> bool,
+    ) -> bool {
+        let Some(faces) = self.edges.get(&(a.min(b), a.max(b))) else {
+            return true;
+        };
+        let (pa, pb) = (self.points[a.min(b)], self.points[a.max(b)]);
+        let mut seen = 0i8;
+        for &(surface, forward) in faces {
+            if !include(surface) {
+                continue;
+            }
+            // Into the face from its edge: left of the edge as the face runs it.
+            let along = if forward { pb - pa } else { pa - pb };
+            let inward = self.normals[surface].cross(along);
+            let s = self.side(
+                n,
+                DVec3::ZERO,
+                inward.normalize_or_zero() * (pa - pb).length(),
+            );
+            if s != 0 {
+                if seen != 0 && s != seen {
+                    return false;
+                }
+                seen = s;
+            }
+        }
+        true
+    }
+
+    /// Whether the plane through vertex `v` with unit normal `n` contains one of the edges of the
+    /// faces at `v`: the visual event is then degenerate (edge–edge) and of order 1.
+    pub fn plane_holds_an_edge_at(
+        &self,
+        v: usize,
+        n: DVec3,
+        include: impl Fn(SurfaceId) -> bool,
+    ) -> bool {
+        let origin = self.points[v];
+        self.corners[v]
+            .iter()
+            .filter(|c| include(c.surface))
+            .any(|c| {
+                self.side(n, origin, self.points[c.prev]) == 0
+                    || self.side(n, origin, self.points[c.next]) == 0
+            })
+    }
+}
