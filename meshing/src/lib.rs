@@ -12,13 +12,15 @@
 //! mesh.sanity_check().unwrap();
 //! ```
 
+pub mod constrained;
 pub mod error;
 pub mod mesh;
+pub mod planar;
 pub mod scene_mesh;
 pub mod uniform;
 
 pub use error::MeshError;
 pub use mesh::{MeshQuality, SurfaceMesh, quality_of};
-pub use scene_mesh::{SceneMesh, mesh_scene_uniform, spread_by_area};
+pub use scene_mesh::{SceneMesh, mesh_scene_discontinuity, mesh_scene_uniform, spread_by_area};
 pub use uniform::{MeshCoordinates, mesh_surface_uniform};
 pub mod discontinuity;

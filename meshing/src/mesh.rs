@@ -30,6 +30,8 @@ pub struct SurfaceMesh {
     pub triangles: Vec<[u32; 3]>,
     /// The meshed polygon in mesh coordinates (the surface polygon snapped to the grid).
     pub boundary: Vec<DVec2>,
+    /// Segments that must be chains of mesh edges (discontinuities), in mesh coordinates.
+    pub constraints: Vec<[DVec2; 2]>,
     /// Area of the surface's own polygon in 3D.
     pub polygon_area: f64,
 }
@@ -82,7 +84,8 @@ impl SurfaceMesh {
 
     /// Checks the invariants every mesh must hold:
     /// every triangle is strictly counter-clockwise (exact predicate), the triangles' areas sum to
-    /// the meshed polygon's area, and every boundary edge of the polygon is covered by mesh edges.
+    /// the meshed polygon's area, and every boundary edge of the polygon and every constraint is
+    /// covered by mesh edges.
     pub fn sanity_check(&self) -> Result<(), MeshError> {
         let fail = |what: String| {
             Err(MeshError::SanityCheck {
@@ -117,6 +120,13 @@ impl SurfaceMesh {
             let (p, q) = (self.boundary[k], self.boundary[(k + 1) % n]);
             if !self.edge_is_covered(p, q, &edges) {
                 return fail(format!("boundary edge {k} is not made of mesh edges"));
+            }
+        }
+        for (k, &[p, q]) in self.constraints.iter().enumerate() {
+            if !self.edge_is_covered(p, q, &edges) {
+                return fail(format!(
+                    "constraint {k} ({p} - {q}) is not made of mesh edges"
+                ));
             }
         }
         Ok(())

@@ -1,15 +1,21 @@
 //! Meshes for a whole scene, with the element budget spread over the surfaces by area.
 
-use penumbra_scenes::Scene;
+use penumbra_scenes::{PlaneFrame, Scene};
 
+use crate::constrained::{ConstrainedSurface, Constraint};
+use crate::discontinuity::{Discontinuities, DiscontinuitySegment, DiscontinuityStats, Event};
 use crate::error::MeshError;
 use crate::mesh::{MeshQuality, SurfaceMesh, quality_of};
 use crate::uniform::mesh_surface_uniform;
 
-/// One mesh per surface, in the scene's surface order.
+/// One mesh per surface, in the scene's surface order, and the discontinuities the meshes follow
+/// (none for uniform meshes).
 #[derive(Clone, Debug)]
 pub struct SceneMesh {
     pub surfaces: Vec<SurfaceMesh>,
+    /// Each surface's discontinuity segments (empty lists for uniform meshes).
+    pub discontinuities: Vec<Vec<DiscontinuitySegment>>,
+    pub discontinuity_stats: Option<DiscontinuityStats>,
 }
 
 impl SceneMesh {
@@ -27,6 +33,10 @@ impl SceneMesh {
 
     pub fn sanity_check(&self) -> Result<(), MeshError> {
         self.surfaces.iter().try_for_each(SurfaceMesh::sanity_check)
+    }
+
+    pub fn segment_count(&self) -> usize {
+        self.discontinuities.iter().map(Vec::len).sum()
     }
 }
 
@@ -81,7 +91,63 @@ pub fn mesh_scene_uniform(scene: &Scene, max_elements: usize) -> Result<SceneMes
         .enumerate()
         .map(|(id, (s, target))| mesh_surface_uniform(id, s, target))
         .collect::<Result<Vec<_>, _>>()?;
-    Ok(SceneMesh { surfaces })
+    Ok(SceneMesh {
+        discontinuities: vec![Vec::new(); surfaces.len()],
+        surfaces,
+        discontinuity_stats: None,
+    })
+}
+
+/// Discontinuity meshes: each surface's discontinuity segments become constraint edges, then the
+/// surfaces are refined to about `max_elements` triangles in all, spread by area.
+pub fn mesh_scene_discontinuity(
+    scene: &Scene,
+    found: Discontinuities,
+    max_elements: usize,
+) -> Result<SceneMesh, MeshError> {
+    let constrained = scene
+        .surfaces
+        .iter()
+        .enumerate()
+        .map(|(id, s)| {
+            let segments = found.segments.get(id).map(Vec::as_slice).unwrap_or(&[]);
+            let constraints: Vec<Constraint> = match PlaneFrame::of_polygon(&s.polygon) {
+                Some(frame) => segments
+                    .iter()
+                    .map(|g| Constraint {
+                        from: frame.to_2d(g.from),
+                        to: frame.to_2d(g.to),
+                        splits: g.event == Event::Contact,
+                    })
+                    .collect(),
+                None => Vec::new(),
+            };
+            ConstrainedSurface::new(id, s, &constraints)
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let areas: Vec<f64> = scene
+        .surfaces
+        .iter()
+        .map(penumbra_scenes::Surface::area)
+        .collect();
+    let minimum: Vec<usize> = constrained
+        .iter()
+        .map(ConstrainedSurface::minimum_triangles)
+        .collect();
+    let targets = spread_by_area(&areas, &minimum, max_elements)?;
+    let surfaces = constrained
+        .into_iter()
+        .zip(targets)
+        .zip(&scene.surfaces)
+        .map(|((c, target), s)| c.into_mesh(s, target))
+        .collect();
+    let mut discontinuities = found.segments;
+    discontinuities.resize(scene.surfaces.len(), Vec::new());
+    Ok(SceneMesh {
+        surfaces,
+        discontinuities,
+        discontinuity_stats: Some(found.stats),
+    })
 }
 
 #[cfg(test)]

@@ -77,22 +77,39 @@ impl MeshCoordinates {
 /// The polygon's constrained triangulation and the faces outside it.
 fn boundary_cdt(id: SurfaceId, coords: &MeshCoordinates) -> Result<Cdt, MeshError> {
     let mut cdt = Cdt::new();
-    let mut handles = Vec::with_capacity(coords.boundary.len());
-    for &p in &coords.boundary {
-        let h = cdt
-            .insert(Point2::new(p.x, p.y))
-            .map_err(|e| MeshError::Triangulation {
-                surface: id,
-                message: format!("{e:?}"),
-            })?;
-        handles.push(h);
-    }
-    let n = handles.len();
+    let n = coords.boundary.len();
     for k in 0..n {
         // The polygon is simple, so edges do not cross; splitting guards against the snap.
-        cdt.add_constraint_and_split(handles[k], handles[(k + 1) % n], |p| p);
+        insert_segment(
+            &mut cdt,
+            id,
+            coords.boundary[k],
+            coords.boundary[(k + 1) % n],
+        )?;
     }
     Ok(cdt)
+}
+
+/// Inserts the segment `a-b` as a constraint, splitting any constraint it crosses (and being
+/// split by it).
+pub(crate) fn insert_segment(
+    cdt: &mut Cdt,
+    id: SurfaceId,
+    a: DVec2,
+    b: DVec2,
+) -> Result<(), MeshError> {
+    let mut insert = |p: DVec2| {
+        cdt.insert(Point2::new(p.x, p.y))
+            .map_err(|e| MeshError::Triangulation {
+                surface: id,
+                message: format!("cannot insert {p}: {e:?}"),
+            })
+    };
+    let (ha, hb) = (insert(a)?, insert(b)?);
+    if ha != hb {
+        cdt.add_constraint_and_split(ha, hb, |q| q);
+    }
+    Ok(())
 }
 
 /// Faces of the triangulation outside the polygon (flood fill from the convex hull).
@@ -113,6 +130,10 @@ pub(crate) struct SurfaceTriangulation {
     pub coords: MeshCoordinates,
     pub cdt: Cdt,
     pub outside: Vec<FixedFaceHandle<InnerTag>>,
+    /// Whether every constraint edge lies on the polygon's boundary. spade tells inside from
+    /// outside by the parity of constraint edges crossed from the hull, which constraints inside
+    /// the polygon would upset; then faces are classified by their centroids instead.
+    pub boundary_only: bool,
 }
 
 impl SurfaceTriangulation {
@@ -120,18 +141,29 @@ impl SurfaceTriangulation {
     pub fn of_surface(id: SurfaceId, surface: &Surface) -> Result<SurfaceTriangulation, MeshError> {
         let coords = MeshCoordinates::of_surface(id, surface)?;
         let cdt = boundary_cdt(id, &coords)?;
+        Ok(SurfaceTriangulation::new(coords, cdt, true))
+    }
+
+    /// A triangulation of the polygon of `coords`; `boundary_only` when its only constraint
+    /// edges are the polygon's.
+    pub fn new(coords: MeshCoordinates, cdt: Cdt, boundary_only: bool) -> SurfaceTriangulation {
         let mut t = SurfaceTriangulation {
             coords,
             cdt,
             outside: Vec::new(),
+            boundary_only,
         };
         t.find_outside();
-        Ok(t)
+        t
     }
 
     /// Recomputes the faces outside the polygon after the triangulation changed.
     pub fn find_outside(&mut self) {
-        self.outside = outside_faces(&mut self.cdt);
+        self.outside = if self.boundary_only {
+            outside_faces(&mut self.cdt)
+        } else {
+            faces_outside_polygon(&self.cdt, &self.coords.boundary)
+        };
     }
 
     /// Triangles inside the polygon.
@@ -156,20 +188,26 @@ impl SurfaceTriangulation {
             let mut cdt = self.cdt.clone();
             let result = cdt.refine(
                 RefinementParameters::<f64>::new()
-                    .exclude_outer_faces(true)
+                    .exclude_outer_faces(self.boundary_only)
                     .with_angle_limit(AngleLimit::from_deg(min_angle_deg))
                     .with_max_allowed_area(max_area)
                     .with_min_required_area(1e-3 * max_area)
                     .with_max_additional_vertices(target + 64),
             );
-            let count = cdt.num_inner_faces() - result.excluded_faces.len();
+            let outside = if self.boundary_only {
+                result.excluded_faces
+            } else {
+                faces_outside_polygon(&cdt, &self.coords.boundary)
+            };
+            let count = cdt.num_inner_faces() - outside.len();
             let ratio = count as f64 / target as f64;
             if count <= target && count > best_count {
                 best_count = count;
                 best = SurfaceTriangulation {
                     coords: self.coords.clone(),
                     cdt,
-                    outside: result.excluded_faces,
+                    outside,
+                    boundary_only: self.boundary_only,
                 };
             }
             if (0.9..=1.0).contains(&ratio) {
@@ -187,6 +225,19 @@ impl SurfaceTriangulation {
     pub fn into_mesh(self, id: SurfaceId, surface: &Surface) -> SurfaceMesh {
         extract(id, surface, self.coords, &self.cdt, &self.outside)
     }
+}
+
+/// Faces whose centroid lies outside the polygon (exact even-odd test). Faces never straddle the
+/// boundary, whose edges are constraints.
+fn faces_outside_polygon(cdt: &Cdt, polygon: &[DVec2]) -> Vec<FixedFaceHandle<InnerTag>> {
+    cdt.inner_faces()
+        .filter(|f| {
+            let [a, b, c] = f.positions();
+            let centroid = DVec2::new((a.x + b.x + c.x) / 3.0, (a.y + b.y + c.y) / 3.0);
+            !crate::planar::inside_polygon(centroid, polygon)
+        })
+        .map(|f| f.fix())
+        .collect()
 }
 
 /// Meshes one surface with about `target` triangles (never more, unless the polygon itself needs
@@ -240,6 +291,7 @@ pub(crate) fn extract(
         points3,
         triangles,
         boundary: coords.boundary,
+        constraints: Vec::new(),
         polygon_area: surface.area(),
     }
 }

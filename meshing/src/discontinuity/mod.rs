@@ -317,8 +317,15 @@ pub fn find_discontinuities(
             continue;
         };
         let merged = merge_on_receiver(&rf, list, tol);
+        let boundary: Vec<DVec2> = scene.surfaces[r]
+            .polygon
+            .iter()
+            .map(|&p| rf.to_2d(p))
+            .collect();
         let classified: Vec<DiscontinuitySegment> = merged
             .into_iter()
+            // A line along the receiver's own edge is already an edge of every mesh of it.
+            .filter(|s| !on_polygon_edge(&boundary, rf.to_2d(s.from), rf.to_2d(s.to), tol))
             .map(|s| DiscontinuitySegment {
                 boundary: classify(scene, visibility, &rf, &s),
                 ..s
@@ -368,45 +375,10 @@ pub(crate) fn clip_to_polygon(
     q: DVec3,
 ) -> Vec<[DVec3; 2]> {
     let flat: Vec<DVec2> = polygon.iter().map(|&x| frame.to_2d(x)).collect();
-    let (a, b) = (frame.to_2d(p), frame.to_2d(q));
-    let d = b - a;
-    let mut cuts = vec![0.0, 1.0];
-    let n = flat.len();
-    for i in 0..n {
-        let (c, e) = (flat[i], flat[(i + 1) % n]);
-        let f = e - c;
-        let den = d.perp_dot(f);
-        if den == 0.0 {
-            continue;
-        }
-        let t = (c - a).perp_dot(f) / den;
-        let u = (c - a).perp_dot(d) / den;
-        if (0.0..=1.0).contains(&t) && (0.0..=1.0).contains(&u) {
-            cuts.push(t);
-        }
-    }
-    cuts.sort_by(f64::total_cmp);
-    cuts.dedup();
-    cuts.windows(2)
-        .filter(|w| w[1] > w[0] && point_in_polygon(a + d * (0.5 * (w[0] + w[1])), &flat))
-        .map(|w| [p.lerp(q, w[0]), p.lerp(q, w[1])])
+    crate::planar::clip_segment(frame.to_2d(p), frame.to_2d(q), &flat)
+        .into_iter()
+        .map(|[s, t]| [p.lerp(q, s), p.lerp(q, t)])
         .collect()
-}
-
-/// Even-odd point-in-polygon test.
-pub(crate) fn point_in_polygon(p: DVec2, polygon: &[DVec2]) -> bool {
-    let n = polygon.len();
-    let mut inside = false;
-    for i in 0..n {
-        let (a, b) = (polygon[i], polygon[(i + 1) % n]);
-        if (a.y > p.y) != (b.y > p.y) {
-            let x = a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x);
-            if p.x < x {
-                inside = !inside;
-            }
-        }
-    }
-    inside
 }
 
 /// Merges a receiver's coincident segments (per emitter) in its plane frame.
@@ -500,4 +472,18 @@ fn emitter_samples(polygon: &[DVec3]) -> Vec<DVec3> {
         out.push(c.lerp(m, 0.98));
     }
     out
+}
+
+/// Whether segment `a-b` lies along one edge of the polygon (within `tol`).
+fn on_polygon_edge(polygon: &[DVec2], a: DVec2, b: DVec2, tol: f64) -> bool {
+    let n = polygon.len();
+    let near = |p: DVec2, c: DVec2, d: DVec2| {
+        let e = d - c;
+        let t = ((p - c).dot(e) / e.length_squared()).clamp(0.0, 1.0);
+        p.distance(c + e * t) <= tol
+    };
+    (0..n).any(|i| {
+        let (c, d) = (polygon[i], polygon[(i + 1) % n]);
+        near(a, c, d) && near(b, c, d)
+    })
 }

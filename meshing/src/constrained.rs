@@ -1,0 +1,357 @@
+//! Discontinuity meshing, second half: the segments become constraint edges of each surface's
+//! constrained Delaunay triangulation, which is then refined for quality without losing them.
+//!
+//! Segments cross, overlap, share endpoints and come within rounding of each other. They are
+//! mapped into mesh coordinates and snapped to its grid, endpoints closer than
+//! [`MERGE_DISTANCE`] become one vertex, and each segment is inserted with spade's
+//! `add_constraint_and_split`, which splits both constraints where two cross. The result is
+//! checked: every segment must be a chain of mesh edges.
+//!
+//! Along value discontinuities (D0: a blocker standing on the receiver) the triangles on the two
+//! sides get separate vertices, so the mesh can carry the jump.
+
+use std::collections::HashMap;
+
+use glam::DVec2;
+use penumbra_scenes::{Surface, SurfaceId};
+
+use crate::error::MeshError;
+use crate::mesh::{ON_SEGMENT_TOLERANCE, SurfaceMesh};
+use crate::planar::clip_segment;
+use crate::uniform::{Cdt, MeshCoordinates, SurfaceTriangulation, insert_segment, snap};
+use spade::Triangulation as _;
+
+/// Constraint endpoints closer than this (in mesh units, where the polygon's extent is 1) are
+/// one vertex: 2^-30, about 1e-9.
+pub const MERGE_DISTANCE: f64 = 1.0 / (1u64 << 30) as f64;
+/// Margin of the frame around a constrained polygon, relative to its extent.
+const FRAME_MARGIN: f64 = 0.05;
+/// Smallest angle the refinement of constrained meshes aims for: constraints may meet at any
+/// angle, and 20 degrees keeps Ruppert's refinement from cascading around them.
+pub const CONSTRAINED_MIN_ANGLE_DEG: f64 = 20.0;
+
+/// A segment to be a chain of mesh edges, in the surface's plane-frame coordinates.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Constraint {
+    pub from: DVec2,
+    pub to: DVec2,
+    /// The light jumps across it: the two sides get separate vertices.
+    pub splits: bool,
+}
+
+/// A surface's triangulation with constraints inserted, before refinement.
+#[derive(Clone)]
+pub struct ConstrainedSurface {
+    id: SurfaceId,
+    triangulation: SurfaceTriangulation,
+    /// The constraints as inserted, in mesh coordinates.
+    segments: Vec<([DVec2; 2], bool)>,
+}
+
+impl std::fmt::Debug for ConstrainedSurface {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ConstrainedSurface")
+            .field("id", &self.id)
+            .field("segments", &self.segments.len())
+            .finish()
+    }
+}
+
+impl ConstrainedSurface {
+    /// Triangulates the surface's polygon with `constraints` inserted.
+    pub fn new(
+        id: SurfaceId,
+        surface: &Surface,
+        constraints: &[Constraint],
+    ) -> Result<ConstrainedSurface, MeshError> {
+        let coords = MeshCoordinates::of_surface(id, surface)?;
+        let to_mesh = |p: DVec2| {
+            let q = p / coords.scale;
+            DVec2::new(snap(q.x), snap(q.y))
+        };
+        let mut welder = Welder::new(MERGE_DISTANCE);
+        for &b in &coords.boundary {
+            welder.weld(b);
+        }
+        let mut segments = Vec::new();
+        for c in constraints {
+            let (a, b) = (to_mesh(c.from), to_mesh(c.to));
+            if !(a.is_finite() && b.is_finite()) {
+                continue;
+            }
+            // Snapping may move an end that was on the boundary just outside it.
+            for [s, t] in clip_segment(a, b, &coords.boundary) {
+                let (p, q) = (welder.weld(a.lerp(b, s)), welder.weld(a.lerp(b, t)));
+                if p != q {
+                    segments.push(([p, q], c.splits));
+                }
+            }
+        }
+        let (segments, boundary_splits) =
+            snap_t_junctions(&coords.boundary, segments, MERGE_DISTANCE);
+
+        let mut cdt = Cdt::new();
+        // spade panicked on some near-collinear input in the past; a panic here must become an
+        // error, not a crash.
+        let inserted = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            let n = coords.boundary.len();
+            for k in 0..n {
+                let mut chain = vec![coords.boundary[k]];
+                chain.extend(&boundary_splits[k]);
+                chain.push(coords.boundary[(k + 1) % n]);
+                for w in chain.windows(2) {
+                    insert_segment(&mut cdt, id, w[0], w[1])?;
+                }
+            }
+            segments
+                .iter()
+                .try_for_each(|&([a, b], _)| insert_segment(&mut cdt, id, a, b))?;
+            if !segments.is_empty() {
+                // A frame just outside the polygon: refinement then sees the whole neighbourhood
+                // of the boundary, not slivers between nearly straight boundary chains (split
+                // at T-junctions) and the convex hull.
+                let (lo, hi) = coords
+                    .boundary
+                    .iter()
+                    .fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), &p| {
+                        (lo.min(p), hi.max(p))
+                    });
+                let margin = FRAME_MARGIN * (hi - lo).max_element();
+                for corner in [
+                    DVec2::new(lo.x - margin, lo.y - margin),
+                    DVec2::new(hi.x + margin, lo.y - margin),
+                    DVec2::new(hi.x + margin, hi.y + margin),
+                    DVec2::new(lo.x - margin, hi.y + margin),
+                ] {
+                    cdt.insert(spade::Point2::new(corner.x, corner.y))
+                        .map_err(|e| MeshError::Triangulation {
+                            surface: id,
+                            message: format!("cannot insert the frame: {e:?}"),
+                        })?;
+                }
+            }
+            Ok(())
+        }));
+        match inserted {
+            Ok(result) => result?,
+            Err(_) => {
+                return Err(MeshError::Triangulation {
+                    surface: id,
+                    message: "spade failed while inserting constraints".into(),
+                });
+            }
+        }
+        let boundary_only = segments.is_empty();
+        Ok(ConstrainedSurface {
+            id,
+            triangulation: SurfaceTriangulation::new(coords, cdt, boundary_only),
+            segments,
+        })
+    }
+
+    /// Triangles before refinement: the least this surface can have.
+    pub fn minimum_triangles(&self) -> usize {
+        self.triangulation.count()
+    }
+
+    /// Refines to about `target` triangles and makes the mesh, with separate vertices on the two
+    /// sides of every value discontinuity.
+    pub fn into_mesh(self, surface: &Surface, target: usize) -> SurfaceMesh {
+        let refined = self
+            .triangulation
+            .refined(target, CONSTRAINED_MIN_ANGLE_DEG);
+        let mut mesh = refined.into_mesh(self.id, surface);
+        mesh.constraints = self.segments.iter().map(|s| s.0).collect();
+        let splits: Vec<[DVec2; 2]> = self.segments.iter().filter(|s| s.1).map(|s| s.0).collect();
+        if !splits.is_empty() {
+            split_along(&mut mesh, &splits);
+        }
+        mesh
+    }
+}
+
+/// Makes near T-junctions exact: a segment end within `tol` of another segment (or of a boundary
+/// edge), away from its ends, moves onto it, and that segment (or edge) is split there. Without
+/// this, the end and the segment would be two features a rounding error apart, which the
+/// refinement then chases with ever smaller triangles. Returns the segments and, for each
+/// boundary edge, the points to split it at, in order along it.
+#[allow(clippy::type_complexity)]
+fn snap_t_junctions(
+    boundary: &[DVec2],
+    mut segments: Vec<([DVec2; 2], bool)>,
+    tol: f64,
+) -> (Vec<([DVec2; 2], bool)>, Vec<Vec<DVec2>>) {
+    let n = boundary.len();
+    let mut splits: Vec<Vec<(f64, DVec2)>> = vec![Vec::new(); n];
+    // The projection of p onto segment a-b, if p is within tol of it and away from its ends.
+    let onto = |p: DVec2, a: DVec2, b: DVec2| -> Option<(f64, DVec2)> {
+        let d = b - a;
+        let len2 = d.length_squared();
+        let t = (p - a).dot(d) / len2;
+        let q = a + d * t;
+        let inner = t * len2.sqrt() > tol && (1.0 - t) * len2.sqrt() > tol;
+        (inner && p.distance(q) <= tol).then_some((t, q))
+    };
+    let mut i = 0;
+    while i < segments.len() {
+        for end in 0..2 {
+            let p = segments[i].0[end];
+            if let Some((k, (t, q))) =
+                (0..n).find_map(|k| onto(p, boundary[k], boundary[(k + 1) % n]).map(|x| (k, x)))
+            {
+                segments[i].0[end] = q;
+                splits[k].push((t, q));
+                continue;
+            }
+            let hit = (0..segments.len())
+                .filter(|&j| j != i)
+                .find_map(|j| onto(p, segments[j].0[0], segments[j].0[1]).map(|(_, q)| (j, q)));
+            if let Some((j, q)) = hit {
+                segments[i].0[end] = q;
+                let ([a, b], splits_d0) = segments[j];
+                segments[j].0 = [a, q];
+                segments.push(([q, b], splits_d0));
+            }
+        }
+        i += 1;
+    }
+    segments.retain(|s| s.0[0] != s.0[1]);
+    segments.sort_by(|x, y| {
+        let key = |s: &([DVec2; 2], bool)| [s.0[0].x, s.0[0].y, s.0[1].x, s.0[1].y];
+        key(x)
+            .partial_cmp(&key(y))
+            .unwrap_or(std::cmp::Ordering::Equal)
+    });
+    segments.dedup_by(|x, y| x.0 == y.0 || x.0 == [y.0[1], y.0[0]]);
+    let splits = splits
+        .into_iter()
+        .map(|mut v| {
+            v.sort_by(|a, b| a.0.total_cmp(&b.0));
+            v.dedup_by(|a, b| a.1 == b.1);
+            v.into_iter().map(|(_, q)| q).collect()
+        })
+        .collect();
+    (segments, splits)
+}
+
+/// Points within a distance of an earlier point are replaced by it (a hash grid of that size).
+struct Welder {
+    tol: f64,
+    grid: HashMap<(i64, i64), Vec<DVec2>>,
+}
+
+impl Welder {
+    fn new(tol: f64) -> Welder {
+        Welder {
+            tol,
+            grid: HashMap::new(),
+        }
+    }
+
+    fn weld(&mut self, p: DVec2) -> DVec2 {
+        let key = |q: DVec2| {
+            (
+                (q.x / self.tol).floor() as i64,
+                (q.y / self.tol).floor() as i64,
+            )
+        };
+        let (kx, ky) = key(p);
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                if let Some(found) = self
+                    .grid
+                    .get(&(kx + dx, ky + dy))
+                    .and_then(|v| v.iter().find(|&&q| q.distance(p) <= self.tol).copied())
+                {
+                    return found;
+                }
+            }
+        }
+        self.grid.entry((kx, ky)).or_default().push(p);
+        p
+    }
+}
+
+/// Gives the triangles on each side of the `lines` their own copies of the vertices on them:
+/// around each such vertex, the triangles that can reach each other without crossing a line
+/// keep one vertex.
+fn split_along(mesh: &mut SurfaceMesh, lines: &[[DVec2; 2]]) {
+    let on_line = |p: DVec2, [a, b]: [DVec2; 2]| {
+        let d = b - a;
+        let len = d.length();
+        let t = (p - a).dot(d) / (len * len);
+        d.perp_dot(p - a).abs() <= ON_SEGMENT_TOLERANCE * len.max(1.0)
+            && (-1e-12..=1.0 + 1e-12).contains(&t)
+    };
+    let n = mesh.local.len();
+    let touched: Vec<bool> = mesh
+        .local
+        .iter()
+        .map(|&p| lines.iter().any(|&l| on_line(p, l)))
+        .collect();
+    let is_cut = |u: u32, v: u32| {
+        let (p, q) = (mesh.local[u as usize], mesh.local[v as usize]);
+        touched[u as usize]
+            && touched[v as usize]
+            && lines.iter().any(|&l| on_line(p, l) && on_line(q, l))
+    };
+    let mut around: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        for &v in tri {
+            if touched[v as usize] {
+                around[v as usize].push(t);
+            }
+        }
+    }
+    // (vertex, triangle, component) for every triangle not in the vertex's first component.
+    let mut moves: Vec<(usize, usize, usize)> = Vec::new();
+    for v in 0..n {
+        let tris = &around[v];
+        if tris.len() < 2 {
+            continue;
+        }
+        // Union the triangles around v that share an uncut edge through v.
+        let mut group: Vec<usize> = (0..tris.len()).collect();
+        fn root(g: &mut [usize], mut i: usize) -> usize {
+            while g[i] != i {
+                g[i] = g[g[i]];
+                i = g[i];
+            }
+            i
+        }
+        for i in 0..tris.len() {
+            for j in i + 1..tris.len() {
+                let (ti, tj) = (mesh.triangles[tris[i]], mesh.triangles[tris[j]]);
+                let shared = ti.iter().find(|&&w| w != v as u32 && tj.contains(&w));
+                if let Some(&w) = shared
+                    && !is_cut(v as u32, w)
+                {
+                    let (a, b) = (root(&mut group, i), root(&mut group, j));
+                    group[a.max(b)] = a.min(b);
+                }
+            }
+        }
+        let first = root(&mut group, 0);
+        for i in 0..tris.len() {
+            let r = root(&mut group, i);
+            if r != first {
+                moves.push((v, tris[i], r));
+            }
+        }
+    }
+    let mut new_triangles = mesh.triangles.clone();
+    let mut copies: HashMap<(usize, usize), u32> = HashMap::new();
+    for (v, t, component) in moves {
+        let copy = *copies.entry((v, component)).or_insert_with(|| {
+            mesh.local.push(mesh.local[v]);
+            mesh.points3.push(mesh.points3[v]);
+            (mesh.local.len() - 1) as u32
+        });
+        for slot in new_triangles[t].iter_mut() {
+            if *slot == v as u32 {
+                *slot = copy;
+            }
+        }
+    }
+    mesh.triangles = new_triangles;
+}
