@@ -122,6 +122,76 @@ pub fn subtract_convex(piece: &[DVec2], hole: &[DVec2], min_width: f64, out: &mu
     }
 }
 
+/// Whether `p` lies inside or on a convex counter-clockwise polygon.
+pub fn inside_convex(p: DVec2, polygon: &[DVec2]) -> bool {
+    let n = polygon.len();
+    (0..n).all(|i| orient(polygon[i], polygon[(i + 1) % n], p) >= 0.0)
+}
+
+/// A half-plane `{c : normal . c + offset >= 0}`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HalfPlane {
+    pub normal: DVec2,
+    pub offset: f64,
+}
+
+impl HalfPlane {
+    fn value(&self, p: DVec2) -> f64 {
+        self.normal.dot(p) + self.offset
+    }
+
+    fn flipped(&self) -> HalfPlane {
+        HalfPlane {
+            normal: -self.normal,
+            offset: -self.offset,
+        }
+    }
+}
+
+/// The part of a convex polygon inside a half-plane.
+pub fn clip_half_plane(polygon: &[DVec2], h: &HalfPlane) -> Vec<DVec2> {
+    let n = polygon.len();
+    let values: Vec<f64> = polygon.iter().map(|&p| h.value(p)).collect();
+    if values.iter().all(|&v| v >= 0.0) {
+        return polygon.to_vec();
+    }
+    if values.iter().all(|&v| v <= 0.0) {
+        return Vec::new();
+    }
+    let mut out = Vec::with_capacity(n + 2);
+    for i in 0..n {
+        let j = (i + 1) % n;
+        if values[i] >= 0.0 {
+            out.push(polygon[i]);
+        }
+        if (values[i] > 0.0 && values[j] < 0.0) || (values[i] < 0.0 && values[j] > 0.0) {
+            out.push(polygon[i].lerp(polygon[j], values[i] / (values[i] - values[j])));
+        }
+    }
+    out
+}
+
+/// `piece` minus the convex region where every half-plane holds, as convex pieces no narrower
+/// than `min_width`.
+pub fn subtract_half_planes(
+    piece: &[DVec2],
+    region: &[HalfPlane],
+    min_width: f64,
+    out: &mut Vec<Vec<DVec2>>,
+) {
+    let mut rest = piece.to_vec();
+    for h in region {
+        let outside = clip_half_plane(&rest, &h.flipped());
+        if wider_than(&outside, min_width) {
+            out.push(outside);
+        }
+        rest = clip_half_plane(&rest, h);
+        if rest.len() < 3 {
+            return;
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

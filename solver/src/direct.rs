@@ -16,7 +16,10 @@ use glam::{DVec2, DVec3};
 use penumbra_scenes::polygon::{is_convex_ccw, triangulate_ccw};
 use penumbra_scenes::{Bounds, PlaneFrame, Rgb, Scene, SurfaceId, Visibility};
 
-use crate::clip::{area_2d, clip_polygon_3d, merge_close_vertices, subtract_convex, wider_than};
+use crate::clip::{
+    HalfPlane, area_2d, clip_polygon_3d, merge_close_vertices, subtract_convex,
+    subtract_half_planes, wider_than,
+};
 use crate::lambert::{ReceivingPoint, contour_sum};
 
 /// Visible pieces narrower than this many units in the last place of the coordinates involved
@@ -241,8 +244,20 @@ impl<'a> DirectLight<'a> {
             if occ.surface == receiver || occ.surface == e.surface {
                 continue;
             }
-            // A plane through x is seen edge-on: it hides nothing (up to the contact limit).
+            // A plane through x is seen edge-on: it hides nothing, unless x lies on the occluder
+            // itself (a blocker standing on the receiver); then the limit from inside the
+            // receiving surface sees it hide everything across its plane, within its corner.
             if occ.normal.dot(x.point - occ.polygon[0]).abs() <= tol {
+                for region in contact_shadow(x, occ, e, tol) {
+                    let mut next = Vec::with_capacity(visible.len() + 4);
+                    for v in &visible {
+                        subtract_half_planes(v, &region, min_width, &mut next);
+                    }
+                    visible = next;
+                }
+                if visible.is_empty() {
+                    break;
+                }
                 continue;
             }
             let mut poly = clip_polygon_3d(&occ.polygon, |p| e.frame.height(p));
@@ -282,6 +297,78 @@ impl<'a> DirectLight<'a> {
             }
         }
         visible
+    }
+}
+
+/// What an occluder whose plane holds x hides of the emitter's plane, in the one-sided limit from
+/// `x + eps * inward`: the directions that cross to the occluder's other side through its corner
+/// at x. Each region is an intersection of half-planes in the emitter's 2D frame; a reflex corner
+/// gives two. Empty when x is not on the occluder or the limit point stays in its plane.
+fn contact_shadow(
+    x: &ReceivingPoint,
+    occ: &ConvexPiece,
+    e: &Emitter,
+    tol: f64,
+) -> Vec<Vec<HalfPlane>> {
+    let n = occ.normal;
+    let along = n.dot(x.inward);
+    if along.abs() <= 1e-12 {
+        return Vec::new();
+    }
+    let side = along.signum();
+    // Edges of the occluder passing through x, with their inward normals in its plane.
+    let m = occ.polygon.len();
+    let mut through = Vec::new();
+    for k in 0..m {
+        let (a, b) = (occ.polygon[k], occ.polygon[(k + 1) % m]);
+        let d = b - a;
+        let t = ((x.point - a).dot(d) / d.length_squared()).clamp(0.0, 1.0);
+        if (a + d * t).distance(x.point) <= tol {
+            through.push((k, n.cross(d).normalize_or_zero()));
+        }
+    }
+    let inside = through.is_empty() && {
+        let frame = PlaneFrame {
+            origin: occ.polygon[0],
+            u: (occ.polygon[1] - occ.polygon[0]).normalize_or_zero(),
+            v: n.cross((occ.polygon[1] - occ.polygon[0]).normalize_or_zero()),
+            normal: n,
+        };
+        let flat: Vec<DVec2> = occ.polygon.iter().map(|&p| frame.to_2d(p)).collect();
+        crate::clip::inside_convex(frame.to_2d(x.point), &flat)
+    };
+    if through.is_empty() && !inside {
+        return Vec::new();
+    }
+    // A direction d is hidden when it crosses the plane (side * n . d < 0) and the point where the
+    // limit ray crosses lies in the occluder's corner: g_k . d >= 0 for each edge through x.
+    let to_half_plane = |g: DVec3| HalfPlane {
+        normal: DVec2::new(g.dot(e.frame.u), g.dot(e.frame.v)),
+        offset: g.dot(e.frame.origin - x.point),
+    };
+    let crossing = to_half_plane(-side * n);
+    let edge_condition =
+        |inward: DVec3| to_half_plane(along.abs() * inward - side * inward.dot(x.inward) * n);
+    match through.as_slice() {
+        [] => vec![vec![crossing]],
+        [(_, m0)] => vec![vec![crossing, edge_condition(*m0)]],
+        [(k0, m0), (k1, m1), ..] => {
+            // At a vertex: the corner between the two edges, convex or reflex.
+            let (first, second) = if (k0 + 1) % m == *k1 {
+                (k0, k1)
+            } else {
+                (k1, k0)
+            };
+            let d_in = occ.polygon[(first + 1) % m] - occ.polygon[*first];
+            let d_out = occ.polygon[(second + 1) % m] - occ.polygon[*second];
+            let convex = n.dot(d_in.cross(d_out)) >= 0.0;
+            let (c0, c1) = (edge_condition(*m0), edge_condition(*m1));
+            if convex {
+                vec![vec![crossing, c0, c1]]
+            } else {
+                vec![vec![crossing, c0], vec![crossing, c1]]
+            }
+        }
     }
 }
 
@@ -327,6 +414,90 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// Section 5, case 2 of the analytic notes: a 0.5 box standing on the floor under the light.
+    /// On the contact line the light jumps; each side's limit is exact.
+    #[test]
+    fn limits_on_both_sides_of_a_contact_line() {
+        use penumbra_scenes::{Rgb, Surface};
+        let mut scene = builtin::textbook();
+        scene.surfaces.retain(|s| s.name != "blocker");
+        let c = |x: f64, y: f64, z: f64| DVec3::new(x, y, z) * 0.25;
+        let faces = [
+            vec![
+                c(-1., -1., 2.),
+                c(1., -1., 2.),
+                c(1., 1., 2.),
+                c(-1., 1., 2.),
+            ],
+            vec![c(1., -1., 0.), c(1., 1., 0.), c(1., 1., 2.), c(1., -1., 2.)],
+            vec![
+                c(-1., 1., 0.),
+                c(-1., -1., 0.),
+                c(-1., -1., 2.),
+                c(-1., 1., 2.),
+            ],
+            vec![c(1., 1., 0.), c(-1., 1., 0.), c(-1., 1., 2.), c(1., 1., 2.)],
+            vec![
+                c(-1., -1., 0.),
+                c(1., -1., 0.),
+                c(1., -1., 2.),
+                c(-1., -1., 2.),
+            ],
+        ];
+        for (i, f) in faces.into_iter().enumerate() {
+            scene
+                .surfaces
+                .push(Surface::new(format!("box{i}"), f, Rgb::splat(0.5)));
+        }
+        assert!(penumbra_scenes::validate(&scene).is_empty());
+        let vis = Visibility::build(&scene);
+        let direct = DirectLight::new(&scene, &vis);
+        let floor = scene.surface_id("floor").expect("floor");
+        let on_line = DVec3::new(0.25, 0.0, 0.0);
+        let at = |inward: DVec3| ReceivingPoint {
+            point: on_line,
+            normal: DVec3::Z,
+            inward,
+        };
+        let outside = direct.irradiance(&at(DVec3::X), floor).r;
+        assert!((outside - 0.00864260029379876).abs() < 1e-12, "{outside}");
+        assert_eq!(direct.irradiance(&at(-DVec3::X), floor).r, 0.0);
+        // Just outside, the value tends to the limit.
+        let near = direct.irradiance(&floor_point(0.25 + 1e-7, 0.0), floor).r;
+        assert!((near - outside).abs() < 1e-7, "{near} vs {outside}");
+        // At the box's corner, from outside along the diagonal, the limit matches nearby points.
+        let corner = DVec3::new(0.25, 0.25, 0.0);
+        let diagonal = DVec3::new(1.0, 1.0, 0.0).normalize();
+        let limit = direct
+            .irradiance(
+                &ReceivingPoint {
+                    point: corner,
+                    normal: DVec3::Z,
+                    inward: diagonal,
+                },
+                floor,
+            )
+            .r;
+        let near = direct
+            .irradiance(&floor_point(0.25 + 1e-7, 0.25 + 1e-7), floor)
+            .r;
+        assert!(
+            limit > 0.0 && (limit - near).abs() < 1e-6,
+            "{limit} vs {near}"
+        );
+        let under = direct
+            .irradiance(
+                &ReceivingPoint {
+                    point: corner,
+                    normal: DVec3::Z,
+                    inward: -diagonal,
+                },
+                floor,
+            )
+            .r;
+        assert_eq!(under, 0.0);
     }
 
     #[test]
