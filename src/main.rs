@@ -39,6 +39,8 @@ enum Command {
 enum MeshArg {
     /// Constrained Delaunay triangulation of each polygon, refined to a uniform size.
     Uniform,
+    /// The same, with the umbra and penumbra boundaries of the direct light as mesh edges.
+    Discontinuity,
 }
 
 #[derive(clap::Args, Debug)]
@@ -48,9 +50,10 @@ struct RunArgs {
     /// Output directory.
     #[arg(long, default_value = "out")]
     out: PathBuf,
-    /// How surfaces are meshed.
-    #[arg(long, value_enum, default_value_t = MeshArg::Uniform)]
-    mesh: MeshArg,
+    /// How surfaces are meshed (default: discontinuity where the scene casts shadows, else
+    /// uniform).
+    #[arg(long, value_enum)]
+    mesh: Option<MeshArg>,
     /// Cap on triangles for the whole scene, spread over the surfaces by area.
     #[arg(long, default_value_t = DEFAULT_MAX_ELEMENTS)]
     max_elements: usize,
@@ -178,7 +181,9 @@ fn run(args: &RunArgs) -> Result<(), Failure> {
     }
     let options = RunOptions {
         mesh: match args.mesh {
-            MeshArg::Uniform => MeshMethod::Uniform,
+            None => MeshMethod::Auto,
+            Some(MeshArg::Uniform) => MeshMethod::Uniform,
+            Some(MeshArg::Discontinuity) => MeshMethod::Discontinuity,
         },
         max_elements: args.max_elements,
         solver: SolverOptions {
@@ -208,8 +213,15 @@ fn run(args: &RunArgs) -> Result<(), Failure> {
     if !args.quiet {
         let stats = &result.solution.stats;
         println!(
-            "{}: {} triangles, {} vertices, {} patches; {} shots ({:?}), unshot {:.2e} of emitted; {:.2} s",
+            "{}: {} mesh, {} discontinuity segments, {} triangles, {} vertices, {} patches; {} shots ({:?}), \
+             unshot {:.2e} of emitted; {:.2} s",
             result.loaded.scene.name,
+            if result.mesh.discontinuity_stats.is_some() {
+                "discontinuity"
+            } else {
+                "uniform"
+            },
+            result.mesh.segment_count(),
             result.mesh.triangle_count(),
             result.mesh.vertex_count(),
             stats.patches,

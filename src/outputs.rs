@@ -33,12 +33,12 @@ struct SurfaceSolution<'a> {
 
 /// A discontinuity segment of the direct light on a surface (none for uniform meshes).
 #[derive(Debug, Serialize)]
-pub struct Discontinuity {
-    pub from: [f64; 3],
-    pub to: [f64; 3],
-    pub event: &'static str,
-    pub boundary: &'static str,
-    pub order: u8,
+struct Discontinuity {
+    from: [f64; 3],
+    to: [f64; 3],
+    event: &'static str,
+    boundary: &'static str,
+    order: u8,
 }
 
 /// `solution.json`: per surface, vertices, triangles and radiosity (no display-only ambient term).
@@ -57,7 +57,16 @@ pub fn solution_json(result: &RunResult) -> String {
                 vertices: m.points3.iter().map(|p| p.to_array()).collect(),
                 triangles: &m.triangles,
                 radiosity: b.iter().map(|c| c.to_array()).collect(),
-                discontinuities: Vec::new(),
+                discontinuities: result.mesh.discontinuities[m.surface]
+                    .iter()
+                    .map(|g| Discontinuity {
+                        from: g.from.to_array(),
+                        to: g.to.to_array(),
+                        event: g.event.name(),
+                        boundary: g.boundary.name(),
+                        order: g.order,
+                    })
+                    .collect(),
             })
             .collect(),
     };
@@ -71,6 +80,7 @@ struct Report<'a> {
     warnings: &'a [String],
     method: Method,
     counts: Counts,
+    discontinuities: Option<&'a penumbra_meshing::discontinuity::DiscontinuityStats>,
     times_seconds: &'a StageTimes,
     solver: &'a SolveStats,
     energy: Energy,
@@ -89,7 +99,9 @@ struct SceneSummary<'a> {
 
 #[derive(Serialize)]
 struct Method {
-    mesh: crate::pipeline::MeshMethod,
+    /// The mesh that was built (`auto` chooses by whether the scene casts shadows).
+    mesh: &'static str,
+    mesh_requested: crate::pipeline::MeshMethod,
     solver: &'static str,
     max_elements: usize,
     epsilon: f64,
@@ -145,7 +157,12 @@ pub fn report_json(result: &RunResult) -> String {
         },
         warnings: &result.loaded.warnings,
         method: Method {
-            mesh: opts.mesh,
+            mesh: if result.mesh.discontinuity_stats.is_some() {
+                "discontinuity"
+            } else {
+                "uniform"
+            },
+            mesh_requested: opts.mesh,
             solver: if opts.solver.direct_only {
                 "direct"
             } else {
@@ -164,8 +181,9 @@ pub fn report_json(result: &RunResult) -> String {
             triangles: result.mesh.triangle_count(),
             vertices: result.mesh.vertex_count(),
             patches: stats.patches,
-            discontinuity_segments: 0,
+            discontinuity_segments: result.mesh.segment_count(),
         },
+        discontinuities: result.mesh.discontinuity_stats.as_ref(),
         times_seconds: &result.times,
         solver: stats,
         energy: Energy {
@@ -248,7 +266,12 @@ pub fn write_outputs(result: &RunResult, dir: &Path) -> anyhow::Result<Vec<PathB
     ];
     let scene = &result.loaded.scene;
     for (i, (s, m)) in scene.surfaces.iter().zip(&result.mesh.surfaces).enumerate() {
-        let svg = penumbra_viz::surface_svg(scene, m, Some(&result.solution.radiosity[i]));
+        let svg = penumbra_viz::surface_svg(
+            scene,
+            m,
+            Some(&result.solution.radiosity[i]),
+            &result.mesh.discontinuities[i],
+        );
         files.push((svg_dir.join(svg_name(i, &s.name)), svg.into_bytes()));
     }
     for (path, bytes) in &files {

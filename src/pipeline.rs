@@ -3,7 +3,8 @@
 
 use std::time::Instant;
 
-use penumbra_meshing::{MeshError, SceneMesh, mesh_scene_uniform};
+use penumbra_meshing::discontinuity::{DiscontinuityOptions, find_discontinuities};
+use penumbra_meshing::{MeshError, SceneMesh, mesh_scene_discontinuity, mesh_scene_uniform};
 use penumbra_scenes::{LoadedScene, Rgb, Visibility};
 use penumbra_solver::{Progress, Solution, SolveError, SolverOptions, solve_progressive};
 use penumbra_viz::{Render, RenderOptions, VizError};
@@ -15,6 +16,10 @@ use serde::Serialize;
 pub enum MeshMethod {
     /// Constrained Delaunay triangulation of each polygon, refined to a uniform size.
     Uniform,
+    /// The same, with the discontinuities of the direct light as constraint edges.
+    Discontinuity,
+    /// Discontinuity meshing where the scene casts shadows, uniform meshing where it has none.
+    Auto,
 }
 
 /// Default cap on triangles for the whole scene.
@@ -31,7 +36,7 @@ pub struct RunOptions {
 impl Default for RunOptions {
     fn default() -> Self {
         RunOptions {
-            mesh: MeshMethod::Uniform,
+            mesh: MeshMethod::Auto,
             max_elements: DEFAULT_MAX_ELEMENTS,
             solver: SolverOptions::default(),
             render: RenderOptions::default(),
@@ -42,8 +47,9 @@ impl Default for RunOptions {
 /// Wall-clock seconds per stage.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct StageTimes {
-    pub mesh: f64,
     pub visibility: f64,
+    pub discontinuities: f64,
+    pub mesh: f64,
     pub direct: f64,
     pub shooting: f64,
     pub render: f64,
@@ -95,16 +101,30 @@ pub fn run(
     let scene = &loaded.scene;
 
     let t = Instant::now();
+    let visibility = Visibility::build(scene);
+    times.visibility = t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
+    let found = match options.mesh {
+        MeshMethod::Uniform => None,
+        MeshMethod::Discontinuity | MeshMethod::Auto => Some(find_discontinuities(
+            scene,
+            &visibility,
+            &DiscontinuityOptions::default(),
+        )),
+    };
+    times.discontinuities = t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
     progress.start("meshing", 1);
-    let mesh = match options.mesh {
-        MeshMethod::Uniform => mesh_scene_uniform(scene, options.max_elements)?,
+    let mesh = match found {
+        Some(found) if options.mesh == MeshMethod::Discontinuity || found.stats.segments > 0 => {
+            mesh_scene_discontinuity(scene, found, options.max_elements)?
+        }
+        _ => mesh_scene_uniform(scene, options.max_elements)?,
     };
     progress.finish();
     times.mesh = t.elapsed().as_secs_f64();
-
-    let t = Instant::now();
-    let visibility = Visibility::build(scene);
-    times.visibility = t.elapsed().as_secs_f64();
 
     let solution = solve_progressive(scene, &mesh, &visibility, &options.solver, progress)?;
     times.direct = solution.stats.direct_seconds;

@@ -28,7 +28,7 @@
 //! let out = render(&scene, &mesh, &radiosity, &options).unwrap();
 //! assert_eq!(out.image.dimensions(), (48, 32));
 //! assert!(encode_png(&out.image).unwrap().starts_with(b"\x89PNG"));
-//! let svg = surface_svg(&scene, &mesh.surfaces[2], Some(&radiosity[2]));
+//! let svg = surface_svg(&scene, &mesh.surfaces[2], Some(&radiosity[2]), &[]);
 //! assert!(svg.contains("floor"));
 //! ```
 

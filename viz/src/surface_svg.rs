@@ -2,6 +2,7 @@
 
 use glam::DVec2;
 use penumbra_meshing::SurfaceMesh;
+use penumbra_meshing::discontinuity::{Boundary, DiscontinuitySegment};
 use penumbra_scenes::{Rgb, Scene};
 
 use crate::svg_plot::{LineStyle, SvgPlot};
@@ -14,8 +15,17 @@ use crate::tonemap::{auto_exposure, luminance, to_srgb8};
 /// With `radiosity` (one value per mesh vertex), each triangle is filled with the mean of its
 /// corners' radiosity, exposed so that the surface's own 95th percentile maps to 0.8 (see
 /// [`crate::tonemap::auto_exposure`]). Values that do not match the mesh are left out, and the
-/// figure says so. The same input always gives the same bytes.
-pub fn surface_svg(scene: &Scene, mesh: &SurfaceMesh, radiosity: Option<&[Rgb]>) -> String {
+/// figure says so.
+///
+/// `segments` (the surface's discontinuities, in 3D) are drawn over the mesh, coloured by the
+/// boundary they are — umbra, outer penumbra, inner penumbra line — with value jumps (D0) drawn
+/// dashed, and listed in the legend. The same input always gives the same bytes.
+pub fn surface_svg(
+    scene: &Scene,
+    mesh: &SurfaceMesh,
+    radiosity: Option<&[Rgb]>,
+    segments: &[DiscontinuitySegment],
+) -> String {
     let name = scene
         .surfaces
         .get(mesh.surface)
@@ -89,6 +99,39 @@ pub fn surface_svg(scene: &Scene, mesh: &SurfaceMesh, radiosity: Option<&[Rgb]>)
     plot.add_legend_entry("mesh edges", "triangles");
     plot.add_legend_entry("surface boundary", "boundary");
     plot.add_legend_entry("frame axes u, v", "axes");
+
+    // Discontinuities: one layer per kind, in a fixed order, only for kinds present.
+    let kinds = [
+        (Boundary::Umbra, false, "#6a1b9a", "umbra boundary"),
+        (
+            Boundary::Penumbra,
+            false,
+            "#e65100",
+            "outer penumbra boundary",
+        ),
+        (Boundary::Inner, false, "#2e7d32", "inner penumbra line"),
+        (Boundary::Umbra, true, "#6a1b9a", "contact (value jump, D0)"),
+    ];
+    for (boundary, jump, color, label) in kinds {
+        let lines: Vec<[DVec2; 2]> = segments
+            .iter()
+            .filter(|g| g.boundary == boundary && (g.order == 0) == jump)
+            .map(|g| [mesh.frame.to_2d(g.from), mesh.frame.to_2d(g.to)])
+            .collect();
+        if lines.is_empty() {
+            continue;
+        }
+        let class = format!("{}{}", boundary.name(), if jump { "-jump" } else { "" });
+        let mut style = LineStyle::solid(color, 2.5);
+        if jump {
+            style.dash_px = Some([7.0, 4.0]);
+        }
+        plot.add_layer(&class, style);
+        for [a, b] in lines {
+            plot.add_polyline(&[a, b], &class);
+        }
+        plot.add_legend_entry(label, &class);
+    }
     plot.finish()
 }
 
@@ -108,12 +151,12 @@ mod tests {
             .map(|i| Rgb::new(1.0 + i as f64, 2.0, 0.5))
             .collect();
         for radiosity in [None, Some(values.as_slice())] {
-            let svg = surface_svg(&scene, m, radiosity);
+            let svg = surface_svg(&scene, m, radiosity, &[]);
             assert!(svg.starts_with("<?xml") || svg.starts_with("<svg"));
             assert!(svg.trim_end().ends_with("</svg>"));
             assert_eq!(svg.matches("<polygon").count(), m.triangle_count());
             assert!(svg.contains("floor"));
-            assert_eq!(svg, surface_svg(&scene, m, radiosity));
+            assert_eq!(svg, surface_svg(&scene, m, radiosity, &[]));
             let filled = svg
                 .lines()
                 .filter(|l| l.starts_with("<polygon") && l.contains("fill="))
@@ -125,7 +168,7 @@ mod tests {
             };
             assert_eq!(filled, expected);
         }
-        let svg = surface_svg(&scene, m, Some(&values[1..]));
+        let svg = surface_svg(&scene, m, Some(&values[1..]), &[]);
         assert!(svg.contains("radiosity not shown"));
     }
 }

@@ -49,12 +49,11 @@ impl Topology {
             for dx in -1..=1 {
                 for dy in -1..=1 {
                     for dz in -1..=1 {
-                        if let Some(ids) = grid.get(&(kx + dx, ky + dy, kz + dz)) {
-                            if let Some(&id) =
-                                ids.iter().find(|&&id| points[id].distance(p) <= weld)
-                            {
-                                return id;
-                            }
+                        if let Some(&id) = grid
+                            .get(&(kx + dx, ky + dy, kz + dz))
+                            .and_then(|ids| ids.iter().find(|&&id| points[id].distance(p) <= weld))
+                        {
+                            return id;
                         }
                     }
                 }
