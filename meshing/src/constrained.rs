@@ -162,9 +162,10 @@ impl ConstrainedSurface {
             .refined(target, CONSTRAINED_MIN_ANGLE_DEG);
         let mut mesh = refined.into_mesh(self.id, surface);
         mesh.constraints = self.segments.iter().map(|s| s.0).collect();
-        let splits: Vec<[DVec2; 2]> = self.segments.iter().filter(|s| s.1).map(|s| s.0).collect();
-        if !splits.is_empty() {
-            split_along(&mut mesh, &splits);
+        let jumps: Vec<[DVec2; 2]> = self.segments.iter().filter(|s| s.1).map(|s| s.0).collect();
+        if !jumps.is_empty() {
+            let lines = mesh.constraints.clone();
+            split_along(&mut mesh, &jumps, &lines);
         }
         mesh
     }
@@ -272,10 +273,14 @@ impl Welder {
     }
 }
 
-/// Gives the triangles on each side of the `lines` their own copies of the vertices on them:
-/// around each such vertex, the triangles that can reach each other without crossing a line
-/// keep one vertex.
-fn split_along(mesh: &mut SurfaceMesh, lines: &[[DVec2; 2]]) {
+/// Gives the triangles on each side of the value discontinuities `jumps` their own copies of the
+/// vertices on them: around each such vertex, the triangles that can reach each other without
+/// crossing a jump keep one vertex.
+///
+/// Where a jump ends or meets another of the `lines` (a shadow line at a blocker's corner), the
+/// light's limit at the vertex depends on the direction of approach, continuously but steeply;
+/// there every triangle gets its own copy, whose value is the limit towards that triangle.
+fn split_along(mesh: &mut SurfaceMesh, jumps: &[[DVec2; 2]], lines: &[[DVec2; 2]]) {
     let on_line = |p: DVec2, [a, b]: [DVec2; 2]| {
         let d = b - a;
         let len = d.length();
@@ -287,13 +292,17 @@ fn split_along(mesh: &mut SurfaceMesh, lines: &[[DVec2; 2]]) {
     let touched: Vec<bool> = mesh
         .local
         .iter()
-        .map(|&p| lines.iter().any(|&l| on_line(p, l)))
+        .map(|&p| jumps.iter().any(|&l| on_line(p, l)))
         .collect();
     let is_cut = |u: u32, v: u32| {
         let (p, q) = (mesh.local[u as usize], mesh.local[v as usize]);
-        touched[u as usize]
-            && touched[v as usize]
-            && lines.iter().any(|&l| on_line(p, l) && on_line(q, l))
+        jumps.iter().any(|&l| on_line(p, l) && on_line(q, l))
+    };
+    // A junction: the end of a jump, or a point a jump shares with another line.
+    let is_junction = |p: DVec2| {
+        let ends_jump = jumps.iter().any(|&[a, b]| a == p || b == p);
+        let through = lines.iter().filter(|&&l| on_line(p, l)).count();
+        ends_jump || through >= 2
     };
     let mut around: Vec<Vec<usize>> = vec![Vec::new(); n];
     for (t, tri) in mesh.triangles.iter().enumerate() {
@@ -312,6 +321,7 @@ fn split_along(mesh: &mut SurfaceMesh, lines: &[[DVec2; 2]]) {
         }
         // Union the triangles around v that share an uncut edge through v.
         let mut group: Vec<usize> = (0..tris.len()).collect();
+        let junction = is_junction(mesh.local[v]);
         fn root(g: &mut [usize], mut i: usize) -> usize {
             while g[i] != i {
                 g[i] = g[g[i]];
@@ -324,6 +334,7 @@ fn split_along(mesh: &mut SurfaceMesh, lines: &[[DVec2; 2]]) {
                 let (ti, tj) = (mesh.triangles[tris[i]], mesh.triangles[tris[j]]);
                 let shared = ti.iter().find(|&&w| w != v as u32 && tj.contains(&w));
                 if let Some(&w) = shared
+                    && !junction
                     && !is_cut(v as u32, w)
                 {
                     let (a, b) = (root(&mut group, i), root(&mut group, j));

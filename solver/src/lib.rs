@@ -23,6 +23,7 @@ pub mod direct;
 pub mod elements;
 pub mod error;
 pub mod lambert;
+pub mod measure;
 pub mod progress;
 pub mod progressive;
 
