@@ -96,7 +96,8 @@ pub struct DiscontinuityStats {
     /// Wedge segments shortened or split by trimming, and removed by it entirely.
     pub segments_trimmed: usize,
     pub segments_hidden: usize,
-    /// Contact lines where blockers touch receivers.
+    /// Contact lines where blockers touch receivers (those along a receiver's own edge are
+    /// found too, then dropped: they are mesh edges already).
     pub contact_segments: usize,
     /// EEE events (ruled quadric critical surfaces); not computed.
     pub eee_events: usize,
