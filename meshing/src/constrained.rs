@@ -216,6 +216,19 @@ fn snap_t_junctions(
         }
         i += 1;
     }
+    // Projections made new points; weld them again so that ends a rounding error apart are one.
+    let mut welder = Welder::new(tol);
+    for &b in boundary {
+        welder.weld(b);
+    }
+    for list in &mut splits {
+        for (_, q) in list.iter_mut() {
+            *q = welder.weld(*q);
+        }
+    }
+    for s in &mut segments {
+        s.0 = s.0.map(|p| welder.weld(p));
+    }
     segments.retain(|s| s.0[0] != s.0[1]);
     segments.sort_by(|x, y| {
         let key = |s: &([DVec2; 2], bool)| [s.0[0].x, s.0[0].y, s.0[1].x, s.0[1].y];

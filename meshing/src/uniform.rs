@@ -10,8 +10,7 @@ use penumbra_scenes::polygon::signed_area_2d;
 use penumbra_scenes::{PlaneFrame, Surface, SurfaceId};
 use spade::handles::{FixedFaceHandle, InnerTag};
 use spade::{
-    AngleLimit, ConstrainedDelaunayTriangulation, HierarchyHintGenerator, Point2,
-    RefinementParameters, Triangulation as _,
+    AngleLimit, ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation as _,
 };
 
 use crate::error::MeshError;
@@ -22,8 +21,10 @@ pub const SNAP_BITS: i32 = 36;
 /// Smallest angle the refinement aims for.
 pub const MIN_ANGLE_DEG: f64 = 25.0;
 
-pub type Cdt =
-    ConstrainedDelaunayTriangulation<Point2<f64>, (), (), (), HierarchyHintGenerator<f64>>;
+/// The triangulation type. It keeps spade's default hint generator: with
+/// `HierarchyHintGenerator`, `add_constraint_and_split` panics on random crossing segments
+/// (spade 2.15.1: 125 of 2,000 random sets of up to 60 segments), and the default one does not.
+pub type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
 
 pub(crate) fn snap(x: f64) -> f64 {
     let grid = 2f64.powi(SNAP_BITS);

@@ -1,0 +1,98 @@
+//! Seeded property tests of constraint insertion: random segments — crossing, overlapping,
+//! sharing ends, nearly collinear, a rounding error apart — inserted in any order always give a
+//! sane mesh in which every segment is a chain of mesh edges.
+
+use glam::{DVec2, DVec3};
+use penumbra_meshing::constrained::{ConstrainedSurface, Constraint};
+use penumbra_scenes::rng::SplitMix64;
+use penumbra_scenes::{Rgb, Surface};
+
+fn square(size: f64) -> Surface {
+    Surface::new(
+        "s",
+        vec![
+            DVec3::ZERO,
+            DVec3::new(size, 0.0, 0.0),
+            DVec3::new(size, size, 0.0),
+            DVec3::new(0.0, size, 0.0),
+        ],
+        Rgb::splat(0.5),
+    )
+}
+
+/// Random segments in the square `[0, size]^2`, with the degeneracies insertion must survive.
+fn random_segments(rng: &mut SplitMix64, size: f64) -> Vec<Constraint> {
+    let pt = |rng: &mut SplitMix64| DVec2::new(rng.next_f64(), rng.next_f64()) * size;
+    let n = 1 + (rng.next_f64() * 24.0) as usize;
+    let mut out: Vec<Constraint> = Vec::new();
+    for _ in 0..n {
+        let kind = (rng.next_f64() * 6.0) as usize;
+        let (from, to) = match (kind, out.last().copied()) {
+            // Shares an end with the previous segment.
+            (1, Some(prev)) => (prev.to, pt(rng)),
+            // Nearly collinear with the previous one, overlapping it.
+            (2, Some(prev)) => {
+                let d = prev.to - prev.from;
+                let off = DVec2::new(-d.y, d.x) * 1e-13;
+                (
+                    prev.from.lerp(prev.to, 0.3) + off,
+                    prev.from.lerp(prev.to, 1.4) - off,
+                )
+            }
+            // A rounding error away from the previous one's end: a near T-junction.
+            (3, Some(prev)) => (prev.to + DVec2::new(1e-12, -1e-12) * size, pt(rng)),
+            // Ending exactly on the boundary.
+            (4, _) => (pt(rng), DVec2::new(rng.next_f64() * size, 0.0)),
+            // Sticking out of the polygon.
+            (5, _) => (pt(rng), pt(rng) * 1.5 - DVec2::splat(0.25 * size)),
+            _ => (pt(rng), pt(rng)),
+        };
+        out.push(Constraint {
+            from,
+            to,
+            splits: rng.next_f64() < 0.3,
+        });
+    }
+    out
+}
+
+#[test]
+fn random_segments_in_any_order_give_sane_meshes() {
+    for case in 0..96u64 {
+        let mut rng = SplitMix64::new(case);
+        let size = [1.0, 1e-6, 1e6][case as usize % 3];
+        let surface = square(size);
+        let mut segments = random_segments(&mut rng, size);
+        for order in 0..2 {
+            if order == 1 {
+                segments.reverse();
+            }
+            let constrained = ConstrainedSurface::new(0, &surface, &segments)
+                .unwrap_or_else(|e| panic!("case {case}: {e}"));
+            let target = 200 + (rng.next_f64() * 800.0) as usize;
+            let mesh = constrained.into_mesh(&surface, target);
+            mesh.sanity_check()
+                .unwrap_or_else(|e| panic!("case {case}, order {order}: {e}"));
+            assert!(
+                !mesh.constraints.is_empty()
+                    || segments.iter().all(|s| s.from.distance(s.to) < 1e-9 * size)
+            );
+        }
+    }
+}
+
+#[test]
+fn many_crossing_segments() {
+    let surface = square(1.0);
+    let mut rng = SplitMix64::new(99);
+    let segments: Vec<Constraint> = (0..300)
+        .map(|_| Constraint {
+            from: DVec2::new(rng.next_f64(), rng.next_f64()),
+            to: DVec2::new(rng.next_f64(), rng.next_f64()),
+            splits: false,
+        })
+        .collect();
+    let constrained = ConstrainedSurface::new(0, &surface, &segments).expect("inserts");
+    let mesh = constrained.into_mesh(&surface, 20_000);
+    mesh.sanity_check().expect("sane");
+}
