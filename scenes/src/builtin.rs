@@ -7,7 +7,7 @@ use crate::model::{Camera, Scene, Surface};
 use crate::polygon;
 
 /// Names and one-line descriptions of the built-in scenes.
-pub const NAMES: [(&str, &str); 3] = [
+pub const NAMES: [(&str, &str); 4] = [
     (
         "cornell",
         "the measured Cornell box (mm): red and green walls, two white blocks, ceiling light",
@@ -20,6 +20,10 @@ pub const NAMES: [(&str, &str); 3] = [
         "furnace",
         "closed unit cube, every face emitting (E = 1) and reflecting (rho = 0.5): B = E / (1 - rho)",
     ),
+    (
+        "boxworld",
+        "100 boxes of random size and turn standing on a floor under a square light (seed 1)",
+    ),
 ];
 
 /// The built-in scene called `name`.
@@ -28,6 +32,7 @@ pub fn builtin(name: &str) -> Option<Scene> {
         "cornell" => Some(cornell()),
         "textbook" => Some(textbook()),
         "furnace" => Some(furnace(1.0, 0.5)),
+        "boxworld" => Some(boxworld(100, 1)),
         _ => None,
     }
 }
@@ -287,6 +292,59 @@ pub fn closed_box(size: DVec3, emission: f64, reflectance: f64) -> Scene {
                 .with_emission(Rgb::splat(emission))
             })
             .collect(),
+    }
+}
+
+/// `count` boxes standing on a floor, one per cell of a square grid (2 m cells), each of random
+/// size, height and turn about the vertical, under a square light; blockers for benchmarks and
+/// soak tests. The same `count` and `seed` give the same scene.
+pub fn boxworld(count: usize, seed: u64) -> Scene {
+    let cells = (count as f64).sqrt().ceil().max(1.0) as usize;
+    let side = 2.0 * cells as f64;
+    let height = 0.6 * side.max(4.0);
+    let mut rng = crate::rng::SplitMix64::new(seed);
+    let white = Rgb::splat(0.6);
+    let light_half = 0.1 * side.max(4.0);
+    let center = 0.5 * side;
+    let mut light = vec![
+        v(center - light_half, center - light_half, height),
+        v(center + light_half, center - light_half, height),
+        v(center + light_half, center + light_half, height),
+        v(center - light_half, center + light_half, height),
+    ];
+    light.reverse(); // facing down
+    let mut surfaces = vec![
+        Surface::new("light", light, Rgb::ZERO).with_emission(Rgb::splat(100.0)),
+        Surface::new("floor", vec![v(0.0, 0.0, 0.0), v(side, 0.0, 0.0), v(side, side, 0.0), v(0.0, side, 0.0)], white),
+    ];
+    for k in 0..count {
+        let (i, j) = ((k % cells) as f64, (k / cells) as f64);
+        let (w, d, h) = (0.3 + 0.5 * rng.next_f64(), 0.3 + 0.5 * rng.next_f64(), 0.3 + 1.2 * rng.next_f64());
+        let turn = rng.next_f64() * std::f64::consts::PI;
+        let c = v(2.0 * i + 1.0 + 0.2 * (rng.next_f64() - 0.5), 2.0 * j + 1.0 + 0.2 * (rng.next_f64() - 0.5), 0.0);
+        let (cos, sin) = (turn.cos(), turn.sin());
+        let corner = |a: f64, b: f64, z: f64| c + v(a * w * cos - b * d * sin, a * w * sin + b * d * cos, z);
+        let top: Vec<DVec3> = [(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)]
+            .iter()
+            .map(|&(a, b)| corner(a, b, h))
+            .collect();
+        let axis = c + v(0.0, 0.0, 0.5 * h);
+        surfaces.push(Surface::new(format!("box{k}_top"), facing(top.clone(), axis, true), white));
+        for e in 0..4 {
+            let (a, b) = (top[e], top[(e + 1) % 4]);
+            let side_face = vec![v(a.x, a.y, 0.0), v(b.x, b.y, 0.0), b, a];
+            surfaces.push(Surface::new(format!("box{k}_side{e}"), facing(side_face, axis, true), white));
+        }
+    }
+    Scene {
+        name: format!("boxworld-{count}"),
+        camera: Some(Camera {
+            eye: v(center, -0.6 * side, 0.9 * height),
+            target: v(center, 0.45 * side, 0.0),
+            up: v(0.0, 0.0, 1.0),
+            fov_deg: 50.0,
+        }),
+        surfaces,
     }
 }
 

@@ -1,0 +1,40 @@
+//! Discontinuity finding on floors of 10, 100 and 1000 boxes: how its time grows with the number
+//! of blockers, and how many wedges it tests per second.
+
+use std::hint::black_box;
+use std::time::Instant;
+
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use penumbra_meshing::discontinuity::{DiscontinuityOptions, find_discontinuities};
+use penumbra_scenes::{Visibility, builtin};
+
+fn discontinuities(c: &mut Criterion) {
+    let mut group = c.benchmark_group("discontinuities");
+    group.sample_size(10);
+    for boxes in [10, 100, 1000] {
+        let scene = builtin::boxworld(boxes, 1);
+        let vis = Visibility::build(&scene);
+        let options = DiscontinuityOptions::default();
+        // One timed run for the figures criterion does not report.
+        let started = Instant::now();
+        let found = find_discontinuities(&scene, &vis, &options);
+        let seconds = started.elapsed().as_secs_f64();
+        let s = &found.stats;
+        eprintln!(
+            "{boxes} boxes: {:.3} s, {} wedges considered ({:.2e}/s), {} culled, {} kept, {} segments",
+            seconds,
+            s.wedges_considered,
+            s.wedges_considered as f64 / seconds,
+            s.wedges_culled,
+            s.wedges_kept,
+            s.segments
+        );
+        group.bench_with_input(BenchmarkId::from_parameter(boxes), &scene, |b, scene| {
+            b.iter(|| find_discontinuities(black_box(scene), &vis, &options));
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, discontinuities);
+criterion_main!(benches);
