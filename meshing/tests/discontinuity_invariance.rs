@@ -11,7 +11,13 @@ fn segments(scene: &Scene) -> Vec<Vec<(DVec3, DVec3, String)>> {
         .into_iter()
         .map(|list| {
             list.into_iter()
-                .map(|s| (s.from, s.to, format!("{:?} {:?} {}", s.event, s.boundary, s.order)))
+                .map(|s| {
+                    (
+                        s.from,
+                        s.to,
+                        format!("{:?} {:?} {}", s.event, s.boundary, s.order),
+                    )
+                })
                 .collect()
         })
         .collect()
@@ -32,14 +38,24 @@ fn moved_rotated_and_scaled_scenes_have_the_same_segments() {
             let back = map.inverse();
             let moved = segments(&scene.transformed(&map));
             for (r, (a, b)) in reference.iter().zip(&moved).enumerate() {
-                assert_eq!(a.len(), b.len(), "{} surface {r}, scale {scale}", scene.name);
+                assert_eq!(
+                    a.len(),
+                    b.len(),
+                    "{} surface {r}, scale {scale}",
+                    scene.name
+                );
                 for (from, to, kind) in b {
                     let (p, q) = (back.transform_point3(*from), back.transform_point3(*to));
                     let found = a.iter().any(|(x, y, k)| {
                         let close = |u: DVec3, v: DVec3| u.distance(v) <= 1e-9 * size;
-                        k == kind && ((close(p, *x) && close(q, *y)) || (close(p, *y) && close(q, *x)))
+                        k == kind
+                            && ((close(p, *x) && close(q, *y)) || (close(p, *y) && close(q, *x)))
                     });
-                    assert!(found, "{} surface {r}, scale {scale}: {p} - {q} ({kind}) has no match", scene.name);
+                    assert!(
+                        found,
+                        "{} surface {r}, scale {scale}: {p} - {q} ({kind}) has no match",
+                        scene.name
+                    );
                 }
             }
         }

@@ -315,25 +315,51 @@ pub fn boxworld(count: usize, seed: u64) -> Scene {
     light.reverse(); // facing down
     let mut surfaces = vec![
         Surface::new("light", light, Rgb::ZERO).with_emission(Rgb::splat(100.0)),
-        Surface::new("floor", vec![v(0.0, 0.0, 0.0), v(side, 0.0, 0.0), v(side, side, 0.0), v(0.0, side, 0.0)], white),
+        Surface::new(
+            "floor",
+            vec![
+                v(0.0, 0.0, 0.0),
+                v(side, 0.0, 0.0),
+                v(side, side, 0.0),
+                v(0.0, side, 0.0),
+            ],
+            white,
+        ),
     ];
     for k in 0..count {
         let (i, j) = ((k % cells) as f64, (k / cells) as f64);
-        let (w, d, h) = (0.3 + 0.5 * rng.next_f64(), 0.3 + 0.5 * rng.next_f64(), 0.3 + 1.2 * rng.next_f64());
+        let (w, d, h) = (
+            0.3 + 0.5 * rng.next_f64(),
+            0.3 + 0.5 * rng.next_f64(),
+            0.3 + 1.2 * rng.next_f64(),
+        );
         let turn = rng.next_f64() * std::f64::consts::PI;
-        let c = v(2.0 * i + 1.0 + 0.2 * (rng.next_f64() - 0.5), 2.0 * j + 1.0 + 0.2 * (rng.next_f64() - 0.5), 0.0);
+        let c = v(
+            2.0 * i + 1.0 + 0.2 * (rng.next_f64() - 0.5),
+            2.0 * j + 1.0 + 0.2 * (rng.next_f64() - 0.5),
+            0.0,
+        );
         let (cos, sin) = (turn.cos(), turn.sin());
-        let corner = |a: f64, b: f64, z: f64| c + v(a * w * cos - b * d * sin, a * w * sin + b * d * cos, z);
+        let corner =
+            |a: f64, b: f64, z: f64| c + v(a * w * cos - b * d * sin, a * w * sin + b * d * cos, z);
         let top: Vec<DVec3> = [(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)]
             .iter()
             .map(|&(a, b)| corner(a, b, h))
             .collect();
         let axis = c + v(0.0, 0.0, 0.5 * h);
-        surfaces.push(Surface::new(format!("box{k}_top"), facing(top.clone(), axis, true), white));
+        surfaces.push(Surface::new(
+            format!("box{k}_top"),
+            facing(top.clone(), axis, true),
+            white,
+        ));
         for e in 0..4 {
             let (a, b) = (top[e], top[(e + 1) % 4]);
             let side_face = vec![v(a.x, a.y, 0.0), v(b.x, b.y, 0.0), b, a];
-            surfaces.push(Surface::new(format!("box{k}_side{e}"), facing(side_face, axis, true), white));
+            surfaces.push(Surface::new(
+                format!("box{k}_side{e}"),
+                facing(side_face, axis, true),
+                white,
+            ));
         }
     }
     Scene {

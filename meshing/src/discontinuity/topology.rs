@@ -131,13 +131,8 @@ impl Topology {
             if !convex && sides.iter().all(|&s| s != 0) {
                 return false;
             }
-            for s in sides {
-                if s != 0 {
-                    if seen != 0 && s != seen {
-                        return false;
-                    }
-                    seen = s;
-                }
+            if !sides.into_iter().all(|s| keeps_side(&mut seen, s)) {
+                return false;
             }
         }
         true
@@ -169,11 +164,8 @@ impl Topology {
                 DVec3::ZERO,
                 inward.normalize_or_zero() * (pa - pb).length(),
             );
-            if s != 0 {
-                if seen != 0 && s != seen {
-                    return false;
-                }
-                seen = s;
+            if !keeps_side(&mut seen, s) {
+                return false;
             }
         }
         true
@@ -196,4 +188,16 @@ impl Topology {
                     || self.side(n, origin, self.points[c.next]) == 0
             })
     }
+}
+
+/// Folds one more side (-1, 0, 1) into the side seen so far; false once two sides differ.
+fn keeps_side(seen: &mut i8, side: i8) -> bool {
+    if side == 0 {
+        return true;
+    }
+    if *seen != 0 && side != *seen {
+        return false;
+    }
+    *seen = side;
+    true
 }
