@@ -230,13 +230,23 @@ fn snap_t_junctions(
         s.0 = s.0.map(|p| welder.weld(p));
     }
     segments.retain(|s| s.0[0] != s.0[1]);
+    // One orientation per segment, so that a segment and its reverse sort together and only one
+    // is inserted: inserting a constraint twice upsets spade's splitting of later crossings.
+    for s in &mut segments {
+        let [a, b] = s.0;
+        if (b.x, b.y) < (a.x, a.y) {
+            s.0 = [b, a];
+        }
+    }
     segments.sort_by(|x, y| {
         let key = |s: &([DVec2; 2], bool)| [s.0[0].x, s.0[0].y, s.0[1].x, s.0[1].y];
         key(x)
             .partial_cmp(&key(y))
             .unwrap_or(std::cmp::Ordering::Equal)
+            .then(y.1.cmp(&x.1))
     });
-    segments.dedup_by(|x, y| x.0 == y.0 || x.0 == [y.0[1], y.0[0]]);
+    // Keep the splitting copy of a duplicate (sorted first).
+    segments.dedup_by(|x, y| x.0 == y.0);
     let splits = splits
         .into_iter()
         .map(|mut v| {

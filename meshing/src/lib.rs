@@ -14,6 +14,7 @@
 
 pub mod constrained;
 pub mod error;
+pub mod fuzzing;
 pub mod mesh;
 pub mod planar;
 pub mod scene_mesh;

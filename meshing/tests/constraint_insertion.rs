@@ -96,3 +96,31 @@ fn many_crossing_segments() {
     let mesh = constrained.into_mesh(&surface, 20_000);
     mesh.sanity_check().expect("sane");
 }
+
+/// Inputs the fuzz target found, original and reduced, kept as tests:
+/// `reversed_duplicate_loses_crossing`: a segment given twice, once reversed, was inserted twice,
+/// and a later segment crossing it lost its far half.
+#[test]
+fn fuzz_regressions() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/regressions");
+    let square = square(1.0);
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .expect("regressions folder")
+        .flatten()
+        .map(|e| e.path())
+        .collect();
+    files.sort();
+    assert!(!files.is_empty());
+    for path in files {
+        let data = std::fs::read(&path).expect("readable input");
+        let Some((target, segments)) = penumbra_meshing::fuzzing::constraints_from_bytes(&data)
+        else {
+            continue;
+        };
+        let constrained = ConstrainedSurface::new(0, &square, &segments)
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let mesh = constrained.into_mesh(&square, target);
+        mesh.sanity_check()
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    }
+}
