@@ -6,7 +6,7 @@ use glam::DVec3;
 
 use crate::builtin;
 use crate::error::SceneError;
-use crate::model::{Scene, Surface};
+use crate::model::Scene;
 use crate::obj;
 use crate::validate::validate;
 
@@ -116,13 +116,4 @@ pub fn drop_repeated_vertices(polygon: &mut Vec<DVec3>) {
 /// Writes a scene in the JSON format (pretty-printed).
 pub fn to_json(scene: &Scene) -> String {
     serde_json::to_string_pretty(scene).unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"))
-}
-
-impl Surface {
-    /// True when every number of the surface is finite.
-    pub fn is_finite(&self) -> bool {
-        self.polygon.iter().all(|p| p.is_finite())
-            && self.emission.is_finite()
-            && self.reflectance.is_finite()
-    }
 }

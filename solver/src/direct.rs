@@ -327,16 +327,11 @@ fn contact_shadow(
             through.push((k, n.cross(d).normalize_or_zero()));
         }
     }
-    let inside = through.is_empty() && {
-        let frame = PlaneFrame {
-            origin: occ.polygon[0],
-            u: (occ.polygon[1] - occ.polygon[0]).normalize_or_zero(),
-            v: n.cross((occ.polygon[1] - occ.polygon[0]).normalize_or_zero()),
-            normal: n,
-        };
-        let flat: Vec<DVec2> = occ.polygon.iter().map(|&p| frame.to_2d(p)).collect();
-        crate::clip::inside_convex(frame.to_2d(x.point), &flat)
-    };
+    let inside = through.is_empty()
+        && PlaneFrame::of_polygon(&occ.polygon).is_some_and(|frame| {
+            let flat: Vec<DVec2> = occ.polygon.iter().map(|&p| frame.to_2d(p)).collect();
+            crate::clip::inside_convex(frame.to_2d(x.point), &flat)
+        });
     if through.is_empty() && !inside {
         return Vec::new();
     }

@@ -7,6 +7,16 @@ use penumbra_scenes::{Visibility, builtin};
 use penumbra_solver::coupling::PatchCoupling;
 use penumbra_solver::{Discretization, NoProgress, SolverOptions, StopReason, solve_progressive};
 
+/// Vertex-to-patch coupling for a scene with nothing to occlude (few rays suffice).
+fn unoccluded_coupling<'a>(disc: &'a Discretization, vis: &'a Visibility) -> PatchCoupling<'a> {
+    PatchCoupling {
+        disc,
+        visibility: vis,
+        rays: 4,
+        seed: 1,
+    }
+}
+
 /// Patch-to-patch form factors F_ij: the area average over patch i of the vertex form factors
 /// (linear interpolation over each element, the solver's own quadrature).
 fn patch_matrix(disc: &Discretization, coupling: &PatchCoupling) -> Vec<Vec<f64>> {
@@ -42,12 +52,7 @@ fn closed_cube_patch_rows_sum_to_one() {
     let mesh = mesh_scene_uniform(&scene, 3000).expect("cube meshes");
     // Patches of about 30 elements: many patch pairs, adjacent and opposite, share edges.
     let disc = Discretization::new(&scene, &mesh, 30);
-    let coupling = PatchCoupling {
-        disc: &disc,
-        visibility: &vis,
-        rays: 4,
-        seed: 1,
-    };
+    let coupling = unoccluded_coupling(&disc, &vis);
     let f = patch_matrix(&disc, &coupling);
     let worst_row = f
         .iter()
@@ -71,12 +76,7 @@ fn box_face_factors_match_closed_forms_sum_to_one_and_are_reciprocal() {
     let mesh = mesh_scene_uniform(&scene, 8000).expect("box meshes");
     let disc = Discretization::new(&scene, &mesh, 1_000_000);
     assert_eq!(disc.patches.len(), 6, "one patch per face");
-    let coupling = PatchCoupling {
-        disc: &disc,
-        visibility: &vis,
-        rays: 4,
-        seed: 1,
-    };
+    let coupling = unoccluded_coupling(&disc, &vis);
     let f = patch_matrix(&disc, &coupling);
     // Closed forms by face size (dimensions of the emitting face, then of the receiving face).
     let dims = |s: usize| {
@@ -146,12 +146,7 @@ fn face_to_face_factors_match_the_closed_forms() {
     // One patch per face.
     let disc = Discretization::new(&scene, &mesh, 100_000);
     assert_eq!(disc.patches.len(), 6);
-    let coupling = PatchCoupling {
-        disc: &disc,
-        visibility: &vis,
-        rays: 4,
-        seed: 1,
-    };
+    let coupling = unoccluded_coupling(&disc, &vis);
     let f = patch_matrix(&disc, &coupling);
     const F_OPP: f64 = 0.199_824_895_698_387_4;
     const F_ADJ: f64 = 0.200_043_776_075_403_15;

@@ -26,8 +26,7 @@ use topology::Topology;
 pub use wedge::{Event, Wedge};
 
 /// What a discontinuity line bounds.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Boundary {
     /// One side sees none of the emitter.
     Umbra,

@@ -8,19 +8,15 @@ use glam::DVec3;
 use penumbra_scenes::SurfaceId;
 
 /// Whether the emitter or the blocker contributes the edge of a visual event.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Event {
     /// Emitter edge, blocker vertex.
-    #[serde(rename = "EV")]
     Ev,
     /// Emitter vertex, blocker edge.
-    #[serde(rename = "VE")]
     Ve,
     /// Emitter edge and two blocker edges (a ruled quadric).
-    #[serde(rename = "EEE")]
     Eee,
     /// A blocker touching the receiver.
-    #[serde(rename = "contact")]
     Contact,
 }
 
