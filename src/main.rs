@@ -11,6 +11,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 use penumbra::outputs::write_outputs;
 use penumbra::progress_bar::Bars;
 use penumbra::{DEFAULT_MAX_ELEMENTS, MeshMethod, RunOptions};
+use penumbra_meshing::grading::DEFAULT_PENUMBRA_DENSITY;
 use penumbra_scenes::{builtin, load_scene};
 use penumbra_solver::SolverOptions;
 use penumbra_solver::progressive::DEFAULT_EPSILON;
@@ -57,6 +58,10 @@ struct RunArgs {
     /// Cap on triangles for the whole scene, spread over the surfaces by area.
     #[arg(long, default_value_t = DEFAULT_MAX_ELEMENTS)]
     max_elements: usize,
+    /// Discontinuity meshes: how many times smaller in area triangles are in partial shadow than
+    /// in full light or full shadow (1: no grading).
+    #[arg(long, default_value_t = DEFAULT_PENUMBRA_DENSITY)]
+    penumbra_density: f64,
     /// Stop shooting when the unshot power is below this fraction of the emitted power.
     #[arg(long, default_value_t = DEFAULT_EPSILON)]
     epsilon: f64,
@@ -168,6 +173,12 @@ fn run(args: &RunArgs) -> Result<(), Failure> {
             .build_global()
             .context("cannot start the worker threads")?;
     }
+    if !(args.penumbra_density >= 1.0 && args.penumbra_density <= 1e6) {
+        return Err(usage(anyhow::anyhow!(
+            "--penumbra-density must be between 1 and 1e6, not {}",
+            args.penumbra_density
+        )));
+    }
     if args.width == 0 || args.height == 0 {
         return Err(usage(anyhow::anyhow!(
             "--width and --height must be at least 1"
@@ -186,6 +197,7 @@ fn run(args: &RunArgs) -> Result<(), Failure> {
             Some(MeshArg::Discontinuity) => MeshMethod::Discontinuity,
         },
         max_elements: args.max_elements,
+        penumbra_density: args.penumbra_density,
         solver: SolverOptions {
             epsilon: args.epsilon,
             max_shots: args.max_shots,

@@ -4,6 +4,7 @@
 use std::time::Instant;
 
 use penumbra_meshing::discontinuity::{DiscontinuityOptions, find_discontinuities};
+use penumbra_meshing::grading::DEFAULT_PENUMBRA_DENSITY;
 use penumbra_meshing::{MeshError, SceneMesh, mesh_scene_discontinuity, mesh_scene_uniform};
 use penumbra_scenes::{LoadedScene, Rgb, Visibility};
 use penumbra_solver::{Progress, Solution, SolveError, SolverOptions, solve_progressive};
@@ -29,6 +30,8 @@ pub const DEFAULT_MAX_ELEMENTS: usize = 10_000;
 pub struct RunOptions {
     pub mesh: MeshMethod,
     pub max_elements: usize,
+    /// How many times smaller in area discontinuity-mesh triangles are in penumbrae (1: none).
+    pub penumbra_density: f64,
     pub solver: SolverOptions,
     pub render: RenderOptions,
 }
@@ -38,6 +41,7 @@ impl Default for RunOptions {
         RunOptions {
             mesh: MeshMethod::Auto,
             max_elements: DEFAULT_MAX_ELEMENTS,
+            penumbra_density: DEFAULT_PENUMBRA_DENSITY,
             solver: SolverOptions::default(),
             render: RenderOptions::default(),
         }
@@ -119,7 +123,13 @@ pub fn run(
     progress.start("meshing", 1);
     let mesh = match found {
         Some(found) if options.mesh == MeshMethod::Discontinuity || found.stats.segments > 0 => {
-            mesh_scene_discontinuity(scene, found, options.max_elements)?
+            mesh_scene_discontinuity(
+                scene,
+                &visibility,
+                found,
+                options.max_elements,
+                options.penumbra_density,
+            )?
         }
         _ => mesh_scene_uniform(scene, options.max_elements)?,
     };

@@ -12,10 +12,11 @@
 
 use std::collections::HashMap;
 
-use glam::DVec2;
+use glam::{DVec2, DVec3};
 use penumbra_scenes::{Surface, SurfaceId};
 
 use crate::error::MeshError;
+use crate::grading::Density;
 use crate::mesh::{ON_SEGMENT_TOLERANCE, SurfaceMesh};
 use crate::planar::clip_segment;
 use crate::uniform::{Cdt, MeshCoordinates, SurfaceTriangulation, insert_segment, snap};
@@ -160,6 +161,29 @@ impl ConstrainedSurface {
         let refined = self
             .triangulation
             .refined(target, CONSTRAINED_MIN_ANGLE_DEG);
+        self.finish(refined, surface)
+    }
+
+    /// Like [`Self::into_mesh`], with triangles `penumbra_density` times smaller in area where
+    /// `varies` says the light varies (see [`crate::grading`]).
+    pub fn into_graded_mesh(
+        self,
+        surface: &Surface,
+        target: usize,
+        penumbra_density: f64,
+        varies: &dyn Fn(&[DVec3]) -> bool,
+    ) -> SurfaceMesh {
+        if self.segments.is_empty() || penumbra_density <= 1.0 {
+            return self.into_mesh(surface, target);
+        }
+        let density = Density::probe(&self.triangulation, target, penumbra_density, varies);
+        let refined =
+            self.triangulation
+                .refined_graded(target, CONSTRAINED_MIN_ANGLE_DEG, &density);
+        self.finish(refined, surface)
+    }
+
+    fn finish(&self, refined: SurfaceTriangulation, surface: &Surface) -> SurfaceMesh {
         let mut mesh = refined.into_mesh(self.id, surface);
         mesh.constraints = self.segments.iter().map(|s| s.0).collect();
         let jumps: Vec<[DVec2; 2]> = self.segments.iter().filter(|s| s.1).map(|s| s.0).collect();

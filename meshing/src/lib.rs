@@ -15,6 +15,7 @@
 pub mod constrained;
 pub mod error;
 pub mod fuzzing;
+pub mod grading;
 pub mod mesh;
 pub mod planar;
 pub mod scene_mesh;

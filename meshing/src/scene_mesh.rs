@@ -1,9 +1,14 @@
 //! Meshes for a whole scene, with the element budget spread over the surfaces by area.
 
-use penumbra_scenes::{PlaneFrame, Scene};
+use std::collections::BTreeSet;
+
+use glam::DVec3;
+use penumbra_scenes::{PlaneFrame, Scene, SurfaceId, Visibility};
 
 use crate::constrained::{ConstrainedSurface, Constraint};
-use crate::discontinuity::{Discontinuities, DiscontinuitySegment, DiscontinuityStats, Event};
+use crate::discontinuity::{
+    Discontinuities, DiscontinuitySegment, DiscontinuityStats, EmitterProbe, Event,
+};
 use crate::error::MeshError;
 use crate::mesh::{MeshQuality, SurfaceMesh, quality_of};
 use crate::uniform::mesh_surface_uniform;
@@ -99,11 +104,15 @@ pub fn mesh_scene_uniform(scene: &Scene, max_elements: usize) -> Result<SceneMes
 }
 
 /// Discontinuity meshes: each surface's discontinuity segments become constraint edges, then the
-/// surfaces are refined to about `max_elements` triangles in all, spread by area.
+/// surfaces are refined to about `max_elements` triangles in all, spread by area, with triangles
+/// `penumbra_density` times smaller in area where the light varies (1: no grading; see
+/// [`crate::grading`]).
 pub fn mesh_scene_discontinuity(
     scene: &Scene,
+    visibility: &Visibility,
     found: Discontinuities,
     max_elements: usize,
+    penumbra_density: f64,
 ) -> Result<SceneMesh, MeshError> {
     let constrained = scene
         .surfaces
@@ -138,8 +147,34 @@ pub fn mesh_scene_discontinuity(
     let surfaces = constrained
         .into_iter()
         .zip(targets)
-        .zip(&scene.surfaces)
-        .map(|((c, target), s)| c.into_mesh(s, target))
+        .enumerate()
+        .map(|(id, (c, target))| {
+            let surface = &scene.surfaces[id];
+            let Some(frame) = PlaneFrame::of_polygon(&surface.polygon) else {
+                return c.into_mesh(surface, target);
+            };
+            let emitters: BTreeSet<SurfaceId> = found
+                .segments
+                .get(id)
+                .into_iter()
+                .flatten()
+                .map(|g| g.emitter)
+                .collect();
+            let probes: Vec<EmitterProbe> = emitters
+                .into_iter()
+                .map(|e| EmitterProbe::new(scene, e))
+                .collect();
+            let varies = |points: &[DVec3]| {
+                probes.iter().any(|probe| {
+                    let (lo, hi) = points.iter().fold((1.0f64, 0.0f64), |(lo, hi), &x| {
+                        let f = probe.visible_fraction(visibility, x, frame.normal, id);
+                        (lo.min(f), hi.max(f))
+                    });
+                    hi > 0.0 && lo < 1.0
+                })
+            };
+            c.into_graded_mesh(surface, target, penumbra_density, &varies)
+        })
         .collect();
     let mut discontinuities = found.segments;
     discontinuities.resize(scene.surfaces.len(), Vec::new());

@@ -14,12 +14,16 @@ use spade::{
 };
 
 use crate::error::MeshError;
+use crate::grading::Density;
 use crate::mesh::SurfaceMesh;
 
 /// Grid of mesh coordinates: 2^-36 of a polygon's extent (about 1.5e-11).
 pub const SNAP_BITS: i32 = 36;
 /// Smallest angle the refinement aims for.
 pub const MIN_ANGLE_DEG: f64 = 25.0;
+/// Rounds of graded refinement: each halves the triangles still too large, so a density of
+/// 2^8 is reached.
+const GRADING_ROUNDS: usize = 8;
 
 /// The triangulation type. It keeps spade's default hint generator: with
 /// `HierarchyHintGenerator`, `add_constraint_and_split` panics on random crossing segments
@@ -175,6 +179,88 @@ impl SurfaceTriangulation {
     /// A refinement with about `target` triangles (never more, unless the triangulation already
     /// has more) and angles of at least `min_angle_deg` where the budget allows.
     pub fn refined(&self, target: usize, min_angle_deg: f64) -> SurfaceTriangulation {
+        self.calibrated(target, |max_area| {
+            let mut cdt = self.cdt.clone();
+            self.refine_cdt(&mut cdt, min_angle_deg, Some(max_area), max_area, target);
+            cdt
+        })
+    }
+
+    /// Like [`Self::refined`], with triangles `density.at(p)` times smaller in area where the
+    /// density asks for it: uniform refinement to a base size, then rounds that split the
+    /// triangles still too large for their place (at the midpoint of their longest edge, or at
+    /// their centroid when that edge is fixed), each followed by quality refinement.
+    pub fn refined_graded(
+        &self,
+        target: usize,
+        min_angle_deg: f64,
+        density: &Density,
+    ) -> SurfaceTriangulation {
+        self.calibrated(target, |max_area| {
+            let mut cdt = self.cdt.clone();
+            let smallest = max_area / density.max_factor();
+            self.refine_cdt(&mut cdt, min_angle_deg, Some(max_area), max_area, target);
+            for _ in 0..GRADING_ROUNDS {
+                let mut split_edges = std::collections::HashSet::new();
+                let mut points = Vec::new();
+                for face in cdt.inner_faces() {
+                    let [a, b, c] = face.positions().map(|p| DVec2::new(p.x, p.y));
+                    let centroid = (a + b + c) / 3.0;
+                    if face.area() <= max_area / density.at(centroid)
+                        || !crate::planar::inside_polygon(centroid, &self.coords.boundary)
+                    {
+                        continue;
+                    }
+                    let longest = face
+                        .adjacent_edges()
+                        .into_iter()
+                        .max_by(|e, f| e.length_2().total_cmp(&f.length_2()))
+                        .expect("a face has three edges");
+                    let undirected = longest.as_undirected();
+                    if undirected.is_constraint_edge() || undirected.is_part_of_convex_hull() {
+                        points.push(centroid);
+                    } else if split_edges.insert(undirected.fix()) {
+                        let [p, q] = undirected.positions();
+                        points.push(DVec2::new(0.5 * (p.x + q.x), 0.5 * (p.y + q.y)));
+                    }
+                }
+                if points.is_empty() || cdt.num_vertices() > 2 * target + 64 {
+                    break;
+                }
+                for p in points {
+                    // Only positions spade cannot represent fail; skipping one costs a split.
+                    let _ = cdt.insert(Point2::new(p.x, p.y));
+                }
+                self.refine_cdt(&mut cdt, min_angle_deg, None, smallest, target);
+            }
+            cdt
+        })
+    }
+
+    /// Runs spade's refinement: angles of at least `min_angle_deg`, triangles no larger than
+    /// `max_area` (when given), none refined below a thousandth of `base_area`.
+    fn refine_cdt(
+        &self,
+        cdt: &mut Cdt,
+        min_angle_deg: f64,
+        max_area: Option<f64>,
+        base_area: f64,
+        target: usize,
+    ) {
+        let mut parameters = RefinementParameters::<f64>::new()
+            .exclude_outer_faces(self.boundary_only)
+            .with_angle_limit(AngleLimit::from_deg(min_angle_deg))
+            .with_min_required_area(1e-3 * base_area)
+            .with_max_additional_vertices(target + 64);
+        if let Some(max_area) = max_area {
+            parameters = parameters.with_max_allowed_area(max_area);
+        }
+        cdt.refine(parameters);
+    }
+
+    /// The best of a few refinements made by `refine(max_area)` with the area bound calibrated so
+    /// that the count comes to 90-100 % of `target`.
+    fn calibrated(&self, target: usize, refine: impl Fn(f64) -> Cdt) -> SurfaceTriangulation {
         let mut best = self.clone();
         let base_count = self.count();
         if target <= base_count {
@@ -186,30 +272,18 @@ impl SurfaceTriangulation {
         // bound from the counts of a few trial runs.
         let mut max_area = 1.6 * polygon_area / target as f64;
         for _ in 0..8 {
-            let mut cdt = self.cdt.clone();
-            let result = cdt.refine(
-                RefinementParameters::<f64>::new()
-                    .exclude_outer_faces(self.boundary_only)
-                    .with_angle_limit(AngleLimit::from_deg(min_angle_deg))
-                    .with_max_allowed_area(max_area)
-                    .with_min_required_area(1e-3 * max_area)
-                    .with_max_additional_vertices(target + 64),
-            );
-            let outside = if self.boundary_only {
-                result.excluded_faces
-            } else {
-                faces_outside_polygon(&cdt, &self.coords.boundary)
+            let mut refined = SurfaceTriangulation {
+                coords: self.coords.clone(),
+                cdt: refine(max_area),
+                outside: Vec::new(),
+                boundary_only: self.boundary_only,
             };
-            let count = cdt.num_inner_faces() - outside.len();
+            refined.find_outside();
+            let count = refined.count();
             let ratio = count as f64 / target as f64;
             if count <= target && count > best_count {
                 best_count = count;
-                best = SurfaceTriangulation {
-                    coords: self.coords.clone(),
-                    cdt,
-                    outside,
-                    boundary_only: self.boundary_only,
-                };
+                best = refined;
             }
             if (0.9..=1.0).contains(&ratio) {
                 break;

@@ -420,34 +420,19 @@ fn merge_on_receiver(
 }
 
 /// Classifies a segment by probing both sides of its midpoint: how much of the emitter each side
-/// sees, by rays to points spread over the emitter.
+/// sees.
 fn classify(
     scene: &Scene,
     visibility: &Visibility,
     frame: &PlaneFrame,
     s: &DiscontinuitySegment,
 ) -> Boundary {
-    let emitter = &scene.surfaces[s.emitter];
     let mid = 0.5 * (s.from + s.to);
     let along = (s.to - s.from).normalize_or_zero();
     let across = frame.normal.cross(along);
     let step = 1e3 * visibility.contact_distance();
-    let samples = emitter_samples(&emitter.polygon);
-    let en = emitter.normal();
-    let fraction = |x: DVec3| {
-        let usable: Vec<&DVec3> = samples
-            .iter()
-            .filter(|&&y| en.dot(x - y) > 0.0 && frame.normal.dot(y - x) > 0.0)
-            .collect();
-        if usable.is_empty() {
-            return 0.0;
-        }
-        let open = usable
-            .iter()
-            .filter(|&&&y| !visibility.occluded(x, y, [s.surface, s.emitter]))
-            .count();
-        open as f64 / usable.len() as f64
-    };
+    let probe = EmitterProbe::new(scene, s.emitter);
+    let fraction = |x: DVec3| probe.visible_fraction(visibility, x, frame.normal, s.surface);
     let (a, b) = (fraction(mid + across * step), fraction(mid - across * step));
     if a.min(b) == 0.0 {
         Boundary::Umbra
@@ -455,6 +440,49 @@ fn classify(
         Boundary::Penumbra
     } else {
         Boundary::Inner
+    }
+}
+
+/// Estimates how much of an emitter a point sees, by rays to points spread over the emitter.
+#[derive(Clone, Debug)]
+pub struct EmitterProbe {
+    emitter: SurfaceId,
+    normal: DVec3,
+    samples: Vec<DVec3>,
+}
+
+impl EmitterProbe {
+    pub fn new(scene: &Scene, emitter: SurfaceId) -> EmitterProbe {
+        let polygon = &scene.surfaces[emitter].polygon;
+        EmitterProbe {
+            emitter,
+            normal: scene.surfaces[emitter].normal(),
+            samples: emitter_samples(polygon),
+        }
+    }
+
+    /// The fraction of the samples in front of the point `x` (on `receiver`, facing `normal`)
+    /// that it sees: 0 in umbra (and when none is in front), 1 in full light.
+    pub fn visible_fraction(
+        &self,
+        visibility: &Visibility,
+        x: DVec3,
+        normal: DVec3,
+        receiver: SurfaceId,
+    ) -> f64 {
+        let usable: Vec<&DVec3> = self
+            .samples
+            .iter()
+            .filter(|&&y| self.normal.dot(x - y) > 0.0 && normal.dot(y - x) > 0.0)
+            .collect();
+        if usable.is_empty() {
+            return 0.0;
+        }
+        let open = usable
+            .iter()
+            .filter(|&&&y| !visibility.occluded(x, y, [receiver, self.emitter]))
+            .count();
+        open as f64 / usable.len() as f64
     }
 }
 
