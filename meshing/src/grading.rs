@@ -10,7 +10,9 @@
 //! when some emitter is partly visible from its centroid or from its corners (pulled slightly
 //! inward), or when those points disagree. Triangles never cross discontinuity lines, so the
 //! varying ones cover the penumbrae closely. Varying triangles ask for `factor` times smaller
-//! triangles.
+//! triangles. (Asking for more where the pilot's triangles are crowded by constraints, as in the
+//! thin penumbra at the foot of a blocker, cost more triangles than it saved error on the Cornell
+//! box's floor.)
 
 use glam::{DVec2, DVec3};
 use spade::{PositionInTriangulation, Triangulation as _};
@@ -55,9 +57,14 @@ impl Density {
         varies: &dyn Fn(&[DVec3]) -> bool,
     ) -> Density {
         let pilot_target = ((target as f64 * PILOT_SHARE) as usize).max(1);
-        let pilot = triangulation
-            .refined(pilot_target, crate::constrained::CONSTRAINED_MIN_ANGLE_DEG)
-            .cdt;
+        let pilot_area = triangulation.area_for(pilot_target);
+        // Refined once to its share's size: quality refinement around the constraints may take
+        // it over that share, which is fine for a probe.
+        let pilot = triangulation.refined_to_area(
+            pilot_area,
+            crate::constrained::CONSTRAINED_MIN_ANGLE_DEG,
+            pilot_target,
+        );
         let coords = &triangulation.coords;
         let mut factors = vec![1.0; pilot.num_all_faces()];
         let factor = factor.max(1.0);

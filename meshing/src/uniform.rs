@@ -180,9 +180,7 @@ impl SurfaceTriangulation {
     /// has more) and angles of at least `min_angle_deg` where the budget allows.
     pub fn refined(&self, target: usize, min_angle_deg: f64) -> SurfaceTriangulation {
         self.calibrated(target, |max_area| {
-            let mut cdt = self.cdt.clone();
-            self.refine_cdt(&mut cdt, min_angle_deg, Some(max_area), max_area, target);
-            cdt
+            self.refined_to_area(max_area, min_angle_deg, target)
         })
     }
 
@@ -237,6 +235,20 @@ impl SurfaceTriangulation {
         })
     }
 
+    /// The area bound that leaves about `target` triangles in a refinement of the polygon.
+    pub(crate) fn area_for(&self, target: usize) -> f64 {
+        // Area-bounded refinement leaves triangles of about 0.6 of the bound.
+        1.6 * signed_area_2d(&self.coords.boundary) / target.max(1) as f64
+    }
+
+    /// One refinement with triangles no larger than `max_area` (and at most about `target`
+    /// more vertices than there are).
+    pub(crate) fn refined_to_area(&self, max_area: f64, min_angle_deg: f64, target: usize) -> Cdt {
+        let mut cdt = self.cdt.clone();
+        self.refine_cdt(&mut cdt, min_angle_deg, Some(max_area), max_area, target);
+        cdt
+    }
+
     /// Runs spade's refinement: angles of at least `min_angle_deg`, triangles no larger than
     /// `max_area` (when given), none refined below a thousandth of `base_area`.
     fn refine_cdt(
@@ -267,10 +279,8 @@ impl SurfaceTriangulation {
             return best;
         }
         let mut best_count = base_count;
-        let polygon_area = signed_area_2d(&self.coords.boundary);
-        // Area-bounded refinement leaves triangles of about 0.6 of the bound; calibrate the
-        // bound from the counts of a few trial runs.
-        let mut max_area = 1.6 * polygon_area / target as f64;
+        // Calibrate the area bound from the counts of a few trial runs.
+        let mut max_area = self.area_for(target);
         for _ in 0..8 {
             let mut refined = SurfaceTriangulation {
                 coords: self.coords.clone(),

@@ -25,7 +25,11 @@ fn segments(scene: &Scene) -> Vec<Vec<(DVec3, DVec3, String)>> {
 
 #[test]
 fn moved_rotated_and_scaled_scenes_have_the_same_segments() {
-    for scene in [builtin::textbook(), builtin::cornell()] {
+    for scene in [
+        builtin::textbook(),
+        builtin::cornell(),
+        builtin::crossed_bars(),
+    ] {
         let reference = segments(&scene);
         let size = scene.diagonal();
         let turn = DQuat::from_euler(EulerRot::XYZ, 0.7, -0.4, 2.1);

@@ -7,7 +7,7 @@ use crate::model::{Camera, Scene, Surface};
 use crate::polygon;
 
 /// Names and one-line descriptions of the built-in scenes.
-pub const NAMES: [(&str, &str); 4] = [
+pub const NAMES: [(&str, &str); 5] = [
     (
         "cornell",
         "the measured Cornell box (mm): red and green walls, two white blocks, ceiling light",
@@ -24,6 +24,10 @@ pub const NAMES: [(&str, &str); 4] = [
         "boxworld",
         "100 boxes of random size and turn standing on a floor under a square light (seed 1)",
     ),
+    (
+        "bars",
+        "two thin bars crossing at two heights under a square light, turned against its edges: EEE events",
+    ),
 ];
 
 /// The built-in scene called `name`.
@@ -33,6 +37,7 @@ pub fn builtin(name: &str) -> Option<Scene> {
         "textbook" => Some(textbook()),
         "furnace" => Some(furnace(1.0, 0.5)),
         "boxworld" => Some(boxworld(100, 1)),
+        "bars" => Some(crossed_bars()),
         _ => None,
     }
 }
@@ -199,6 +204,43 @@ pub fn textbook() -> Scene {
             Surface::new("light", light, Rgb::ZERO).with_emission(Rgb::splat(1.0)),
             Surface::new("blocker", square(1.0, 0.5), Rgb::splat(0.5)),
             Surface::new("floor", square(0.0, 3.0), Rgb::splat(0.7)),
+        ],
+    }
+}
+
+/// A unit square light at height 4 over two thin bars (4 x 0.2) at heights 2 and 1, crossing at
+/// right angles and turned 20 degrees against the light's edges, over a floor. Where the bars'
+/// shadows cross, the corner of their crossing slides over the light's edges: EEE events, whose
+/// critical surfaces are ruled quadrics meeting the floor in conic arcs.
+pub fn crossed_bars() -> Scene {
+    let square = |h: f64, s: f64| vec![v(-s, -s, h), v(s, -s, h), v(s, s, h), v(-s, s, h)];
+    let bar = |h: f64, turn_deg: f64| {
+        let (sin, cos) = turn_deg.to_radians().sin_cos();
+        [
+            v(-2.0, -0.1, h),
+            v(2.0, -0.1, h),
+            v(2.0, 0.1, h),
+            v(-2.0, 0.1, h),
+        ]
+        .iter()
+        .map(|p| v(cos * p.x - sin * p.y, sin * p.x + cos * p.y, h))
+        .collect::<Vec<_>>()
+    };
+    let mut light = square(4.0, 0.5);
+    light.reverse(); // facing down
+    Scene {
+        name: "bars".into(),
+        camera: Some(Camera {
+            eye: v(0.0, -7.5, 5.5),
+            target: v(0.0, 0.0, 0.6),
+            up: v(0.0, 0.0, 1.0),
+            fov_deg: 45.0,
+        }),
+        surfaces: vec![
+            Surface::new("light", light, Rgb::ZERO).with_emission(Rgb::splat(1.0)),
+            Surface::new("upper", bar(2.0, 20.0), Rgb::splat(0.5)),
+            Surface::new("lower", bar(1.0, 110.0), Rgb::splat(0.5)),
+            Surface::new("floor", square(0.0, 4.0), Rgb::splat(0.7)),
         ],
     }
 }

@@ -12,12 +12,15 @@ pub struct FlatSegment<T> {
 }
 
 /// Merges segments that lie on one line (every endpoint of each within `tol` of the other's line)
-/// and overlap or touch (within `tol`) into their union. Tags of merged pieces combine with
-/// `combine`. The result is in a deterministic order.
+/// and overlap or touch (within `tol`) into their union. Where segments overlap their tags
+/// combine with `combine`; neighbouring pieces of the union join when `joins` says their tags
+/// may (their tags combining too), and stay apart otherwise. The result is in a deterministic
+/// order.
 pub fn merge_collinear<T: Copy>(
     segments: &[FlatSegment<T>],
     tol: f64,
     combine: impl Fn(T, T) -> T,
+    joins: impl Fn(&T, &T) -> bool,
 ) -> Vec<FlatSegment<T>> {
     let segments: Vec<&FlatSegment<T>> = segments
         .iter()
@@ -96,7 +99,7 @@ pub fn merge_collinear<T: Copy>(
         let reference = segments[root];
         let origin = reference.from;
         let dir = (reference.to - reference.from).normalize();
-        let mut intervals: Vec<(f64, f64, T)> = members
+        let intervals: Vec<(f64, f64, T)> = members
             .iter()
             .map(|&m| {
                 let s = segments[m];
@@ -104,7 +107,6 @@ pub fn merge_collinear<T: Copy>(
                 (a.min(b), a.max(b), s.tag)
             })
             .collect();
-        intervals.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.total_cmp(&y.1)));
         let emit = |(lo, hi, tag): (f64, f64, T), out: &mut Vec<FlatSegment<T>>| {
             out.push(FlatSegment {
                 from: origin + dir * lo,
@@ -112,17 +114,29 @@ pub fn merge_collinear<T: Copy>(
                 tag,
             });
         };
+        // The line cut at every end: each piece takes the combined tag of the segments over it,
+        // and neighbouring pieces with one tag join again.
+        let mut cuts: Vec<f64> = intervals.iter().flat_map(|&(lo, hi, _)| [lo, hi]).collect();
+        cuts.sort_by(f64::total_cmp);
+        cuts.dedup_by(|b, a| *b - *a <= tol);
         let mut current: Option<(f64, f64, T)> = None;
-        for (lo, hi, tag) in intervals {
-            current = match current {
-                Some((clo, chi, ctag)) if lo <= chi + tol => {
-                    Some((clo, chi.max(hi), combine(ctag, tag)))
+        for w in cuts.windows(2) {
+            let (a, b) = (w[0], w[1]);
+            let tag = intervals
+                .iter()
+                .filter(|&&(lo, hi, _)| lo <= a + tol && hi >= b - tol)
+                .map(|&(_, _, t)| t)
+                .reduce(&combine);
+            current = match (current, tag) {
+                (Some((clo, chi, ctag)), Some(tag)) if joins(&ctag, &tag) && a <= chi + tol => {
+                    Some((clo, b, combine(ctag, tag)))
                 }
-                Some(done) => {
-                    emit(done, &mut out);
-                    Some((lo, hi, tag))
+                (done, tag) => {
+                    if let Some(done) = done {
+                        emit(done, &mut out);
+                    }
+                    tag.map(|tag| (a, b, tag))
                 }
-                None => Some((lo, hi, tag)),
             };
         }
         if let Some(done) = current {
@@ -155,25 +169,38 @@ mod tests {
             seg((0.0, 1.5), (0.0, 3.0), 1),  // continues the vertical line, reversed sign of x
             seg((-1e-17, 3.0), (1e-17, 3.5), 2),
         ];
-        let out = merge_collinear(&input, 1e-9, u8::min);
-        assert_eq!(out.len(), 3, "{out:?}");
-        let vertical = out
+        let out = merge_collinear(&input, 1e-9, u8::min, |a, b| a == b);
+        assert_eq!(out.len(), 6, "{out:?}");
+        // The vertical line: [0, 1.5] tagged 2, [1.5, 3] 1 (the lower tag where they overlap),
+        // then [3, 3.5] tagged 2 again.
+        let mut vertical: Vec<(f64, f64, u8)> = out
             .iter()
-            .find(|s| s.from.x.abs() < 1e-9 && s.to.x.abs() < 1e-9)
-            .expect("vertical");
-        let (lo, hi) = (
-            vertical.from.y.min(vertical.to.y),
-            vertical.from.y.max(vertical.to.y),
-        );
-        assert!(lo.abs() < 1e-12 && (hi - 3.5).abs() < 1e-12, "{vertical:?}");
-        let long = out
+            .filter(|s| s.from.x.abs() < 1e-9 && s.to.x.abs() < 1e-9)
+            .map(|s| (s.from.y.min(s.to.y), s.from.y.max(s.to.y), s.tag))
+            .collect();
+        vertical.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let expected = [(0.0, 1.5, 2), (1.5, 3.0, 1), (3.0, 3.5, 2)];
+        assert_eq!(vertical.len(), 3, "{vertical:?}");
+        for (got, want) in vertical.iter().zip(expected) {
+            assert!(
+                (got.0 - want.0).abs() < 1e-12 && (got.1 - want.1).abs() < 1e-12 && got.2 == want.2,
+                "{vertical:?}"
+            );
+        }
+        // The line y = 1: [-1, 0] tagged 1, [0, 1] tagged 2, and [3, 4] apart.
+        let mut horizontal: Vec<(f64, f64, u8)> = out
             .iter()
-            .find(|s| (s.from.y - 1.0).abs() < 1e-12 && s.tag == 1)
-            .expect("merged line");
-        let (lo, hi) = (long.from.x.min(long.to.x), long.from.x.max(long.to.x));
-        assert!(
-            (lo + 1.0).abs() < 1e-12 && (hi - 1.0).abs() < 1e-12,
-            "{long:?}"
-        );
+            .filter(|s| (s.from.y - 1.0).abs() < 1e-12)
+            .map(|s| (s.from.x.min(s.to.x), s.from.x.max(s.to.x), s.tag))
+            .collect();
+        horizontal.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let expected = [(-1.0, 0.0, 1), (0.0, 1.0, 2), (3.0, 4.0, 2)];
+        assert_eq!(horizontal.len(), 3, "{horizontal:?}");
+        for (got, want) in horizontal.iter().zip(expected) {
+            assert!(
+                (got.0 - want.0).abs() < 1e-12 && (got.1 - want.1).abs() < 1e-12 && got.2 == want.2,
+                "{horizontal:?}"
+            );
+        }
     }
 }

@@ -9,6 +9,7 @@
 //! segment is classified by what lies on either side: umbra, penumbra or lit.
 
 pub mod contact;
+pub mod eee;
 pub mod merge;
 pub mod topology;
 pub mod trim;
@@ -66,6 +67,10 @@ pub struct DiscontinuityOptions {
     pub trim_samples: usize,
     /// Trim points are located to this fraction of the receiver's diameter.
     pub trim_tolerance: f64,
+    /// Whether to find EEE events (emitter edge with two blocker edges).
+    pub eee: bool,
+    /// EEE curves become polylines within this fraction of the receiver's diameter.
+    pub eee_tolerance: f64,
 }
 
 impl Default for DiscontinuityOptions {
@@ -73,6 +78,8 @@ impl Default for DiscontinuityOptions {
         DiscontinuityOptions {
             trim_samples: 16,
             trim_tolerance: 1e-9,
+            eee: true,
+            eee_tolerance: 1e-4,
         }
     }
 }
@@ -98,7 +105,9 @@ pub struct DiscontinuityStats {
     /// Contact lines where blockers touch receivers (those along a receiver's own edge are
     /// found too, then dropped: they are mesh edges already).
     pub contact_segments: usize,
-    /// EEE events (ruled quadric critical surfaces); not computed.
+    /// Emitter edge–blocker edge–blocker edge triples examined for EEE events (after silhouette
+    /// and spatial culling), and those that left a curve on their receiver.
+    pub eee_considered: usize,
     pub eee_events: usize,
     /// Segments after merging coincident ones.
     pub segments: usize,
@@ -251,6 +260,46 @@ pub fn find_discontinuities(
                     });
                 }
             }
+            if options.eee {
+                let search = eee::EeeSearch {
+                    topology: &topology,
+                    visibility,
+                    emitter: e,
+                    receiver: r,
+                    emitter_frame: ef,
+                    receiver_frame: rf,
+                    tol,
+                    reach,
+                    chord_tolerance: options.eee_tolerance
+                        * penumbra_scenes::polygon::diameter(&receiver.polygon),
+                    receiver_polygon: &receiver.polygon,
+                    trim_samples: options.trim_samples,
+                    trim_tolerance: options.trim_tolerance
+                        * penumbra_scenes::polygon::diameter(&receiver.polygon),
+                };
+                let emitter_edges: Vec<(usize, usize)> = (0..e_loop.len())
+                    .map(|k| (e_loop[k], e_loop[(k + 1) % e_loop.len()]))
+                    .filter(|(a, b)| a != b)
+                    .collect();
+                let (curves, count) = search.curves(&emitter_edges, &edges);
+                stats.eee_considered += count.considered;
+                stats.eee_events += count.events;
+                for curve in curves {
+                    for w in curve.points.windows(2) {
+                        for [a, b] in clip_to_polygon(&rf, &receiver.polygon, w[0], w[1]) {
+                            raw[r].push(DiscontinuitySegment {
+                                surface: r,
+                                emitter: e,
+                                from: a,
+                                to: b,
+                                event: Event::Eee,
+                                boundary: Boundary::Inner,
+                                order: curve.order,
+                            });
+                        }
+                    }
+                }
+            }
             for wedge in wedges {
                 let Some([p, q]) = wedge.meet_plane(rf.origin, rf.normal, reach) else {
                     continue;
@@ -316,7 +365,7 @@ pub fn find_discontinuities(
             segments.push(Vec::new());
             continue;
         };
-        let merged = merge_on_receiver(&rf, list, tol);
+        let merged = merge_on_receiver(&rf, r, list, tol);
         let boundary: Vec<DVec2> = scene.surfaces[r]
             .polygon
             .iter()
@@ -381,38 +430,35 @@ pub(crate) fn clip_to_polygon(
         .collect()
 }
 
-/// Merges a receiver's coincident segments (per emitter) in its plane frame.
+/// Merges a receiver's coincident segments (per emitter) in its plane frame. Where segments of
+/// different kinds overlap, the most significant description wins: the lowest order, then the
+/// first event kind; pieces of one order join.
 fn merge_on_receiver(
     frame: &PlaneFrame,
+    receiver: SurfaceId,
     list: Vec<DiscontinuitySegment>,
     tol: f64,
 ) -> Vec<DiscontinuitySegment> {
-    let mut by_emitter: std::collections::BTreeMap<
-        SurfaceId,
-        Vec<FlatSegment<DiscontinuitySegment>>,
-    > = Default::default();
+    let mut by_emitter: std::collections::BTreeMap<SurfaceId, Vec<FlatSegment<(u8, Event)>>> =
+        Default::default();
     for s in list {
         by_emitter.entry(s.emitter).or_default().push(FlatSegment {
             from: frame.to_2d(s.from),
             to: frame.to_2d(s.to),
-            tag: s,
+            tag: (s.order, s.event),
         });
     }
     let mut out = Vec::new();
-    for (_, flat) in by_emitter {
-        // The most significant description wins: the lowest order, then the first event kind.
-        let combine = |a: DiscontinuitySegment, b: DiscontinuitySegment| {
-            if (b.order, b.event) < (a.order, a.event) {
-                b
-            } else {
-                a
-            }
-        };
-        for m in merge_collinear(&flat, tol, combine) {
+    for (emitter, flat) in by_emitter {
+        for m in merge_collinear(&flat, tol, std::cmp::min, |a, b| a.0 == b.0) {
             out.push(DiscontinuitySegment {
+                surface: receiver,
+                emitter,
                 from: frame.to_3d(m.from),
                 to: frame.to_3d(m.to),
-                ..m.tag
+                event: m.tag.1,
+                boundary: Boundary::Inner,
+                order: m.tag.0,
             });
         }
     }

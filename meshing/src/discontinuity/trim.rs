@@ -31,9 +31,23 @@ pub fn visible_runs(
     samples: usize,
     tol: f64,
 ) -> Vec<[DVec3; 2]> {
+    runs_where(from, to, samples, tol, |x| {
+        generator_visible(visibility, wedge, x, receiver)
+    })
+}
+
+/// The runs of `from -> to` where `holds`, with ends located to `tol` (a length) by bisection.
+/// `samples` points along the segment find the runs.
+pub fn runs_where(
+    from: DVec3,
+    to: DVec3,
+    samples: usize,
+    tol: f64,
+    holds: impl Fn(DVec3) -> bool,
+) -> Vec<[DVec3; 2]> {
     let samples = samples.max(2);
     let at = |t: f64| from.lerp(to, t);
-    let visible = |t: f64| generator_visible(visibility, wedge, at(t), receiver);
+    let visible = |t: f64| holds(at(t));
     let length = from.distance(to);
     // Where the visibility changes between two parameters, to within `tol`.
     let bisect = |mut lo: f64, mut hi: f64, lo_visible: bool| {

@@ -1,0 +1,606 @@
+//! EEE visual events: the lines that meet an emitter edge and two blocker edges.
+//!
+//! Seen from a receiver point, two blocker edges that cross in projection make a corner of the
+//! visible part of the emitter; where that corner slides over an emitter edge the light changes
+//! its analytic form. The lines through three edges form a ruled quadric; it meets the receiver's
+//! plane in a conic arc. When the two blocker edges share a vertex they lie in one plane, and the
+//! lines of that plane through the point where it cuts the emitter edge form a planar pencil: a
+//! straight line on the receiver, of order 1 (a face of a box seen edge-on at its foot).
+//!
+//! The lines are parametrised by their point on the first blocker edge (the one nearer the
+//! emitter). A line is an event where it meets all three segments in the order emitter, first
+//! edge, second edge, receiver, grazes both blocker edges (their faces on one side), and is
+//! unobstructed. Samples along the edge find the runs where this holds, bisection places their
+//! ends, and each run's arc is split until every chord is within the tolerance.
+
+use std::collections::{BTreeMap, BTreeSet};
+
+use glam::DVec3;
+use penumbra_scenes::{Bounds, PlaneFrame, SurfaceId, Visibility};
+
+use super::topology::Topology;
+
+/// Samples along the first blocker edge.
+const SAMPLES: usize = 48;
+/// Bisection steps placing the ends of a run (to 2^-40 of the edge).
+const BISECTIONS: usize = 40;
+/// Deepest subdivision of an arc into chords.
+const MAX_DEPTH: u32 = 14;
+
+/// A polyline on a receiver where an EEE event meets it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EeeCurve {
+    pub points: Vec<DVec3>,
+    /// The emitter edge, the blocker edge nearer the emitter, and the one nearer the receiver.
+    pub edges: [[DVec3; 2]; 3],
+    /// 1 for a planar pencil (the blocker edges share a plane), else 2.
+    pub order: u8,
+}
+
+/// What the search over edge triples did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct EeeCount {
+    /// Edge triples examined (after silhouette and spatial culling).
+    pub considered: usize,
+    /// Triples that left a curve.
+    pub events: usize,
+}
+
+/// One emitter–receiver pair: the geometry every triple of it shares.
+pub(crate) struct EeeSearch<'a> {
+    pub topology: &'a Topology,
+    pub visibility: &'a Visibility,
+    pub emitter: SurfaceId,
+    pub receiver: SurfaceId,
+    pub emitter_frame: PlaneFrame,
+    pub receiver_frame: PlaneFrame,
+    /// Heights under this are on a plane.
+    pub tol: f64,
+    /// How far a line may run (a few scene diagonals).
+    pub reach: f64,
+    /// Greatest distance of a chord from its arc.
+    pub chord_tolerance: f64,
+    pub receiver_polygon: &'a [DVec3],
+    /// Samples along a pencil's line when trimming it, and the length its trim points are
+    /// located to.
+    pub trim_samples: usize,
+    pub trim_tolerance: f64,
+}
+
+/// A line through the three edges: its points on the emitter edge, the first and second blocker
+/// edges, and the receiver's plane.
+#[derive(Clone, Copy, Debug)]
+struct Transversal {
+    source: DVec3,
+    first: DVec3,
+    second: DVec3,
+    receiver: DVec3,
+}
+
+impl EeeSearch<'_> {
+    /// The EEE curves of emitter edges `emitter_edges` with the blocker edges `edges` (welded
+    /// vertex pairs), and what it took.
+    pub fn curves(
+        &self,
+        emitter_edges: &[(usize, usize)],
+        edges: &BTreeSet<(usize, usize)>,
+    ) -> (Vec<EeeCurve>, EeeCount) {
+        let mut count = EeeCount::default();
+        let mut curves = Vec::new();
+        // Blocker edges at each vertex, for the pairs that share one.
+        let mut at_vertex: BTreeMap<usize, Vec<(usize, usize)>> = BTreeMap::new();
+        for &(u, w) in edges {
+            at_vertex.entry(u).or_default().push((u, w));
+            at_vertex.entry(w).or_default().push((u, w));
+        }
+        let t = self.topology;
+        for &(ia, ib) in emitter_edges {
+            let source = [t.points[ia], t.points[ib]];
+            // Edges lying on the receiver are contact lines, not blockers of its light.
+            let usable: BTreeSet<(usize, usize)> = edges
+                .iter()
+                .copied()
+                .filter(|&(u, w)| {
+                    [u, w]
+                        .iter()
+                        .any(|&v| self.receiver_frame.height(t.points[v]) > self.tol)
+                        && self.can_be_silhouette(u, w, source)
+                })
+                .collect();
+            for &first in &usable {
+                let mut partners: BTreeSet<(usize, usize)> = BTreeSet::new();
+                for v in [first.0, first.1] {
+                    partners.extend(at_vertex.get(&v).into_iter().flatten().copied());
+                }
+                let region = self.beyond(source, [t.points[first.0], t.points[first.1]]);
+                let mut near = BTreeSet::new();
+                self.visibility.triangles_overlapping(region, |k| {
+                    near.insert(self.visibility.triangles()[k].surface);
+                });
+                for s in near {
+                    let l = &t.loops[s];
+                    for k in 0..l.len() {
+                        let (u, w) = (l[k], l[(k + 1) % l.len()]);
+                        partners.insert((u.min(w), u.max(w)));
+                    }
+                }
+                partners.remove(&first);
+                for second in partners {
+                    if !usable.contains(&second) {
+                        continue;
+                    }
+                    count.considered += 1;
+                    let found = self.triple(source, first, second);
+                    if !found.is_empty() {
+                        count.events += 1;
+                        curves.extend(found);
+                    }
+                }
+            }
+        }
+        (curves, count)
+    }
+
+    /// Whether blocker edge `(u, w)` is on the silhouette of its faces as seen from some point of
+    /// the emitter edge `source`: one face turned towards that point and another away, or a face
+    /// seen edge-on (each face's side is linear along the edge, so the ends and the roots tell).
+    fn can_be_silhouette(&self, u: usize, w: usize, source: [DVec3; 2]) -> bool {
+        let t = self.topology;
+        let Some(faces) = t.edges.get(&(u, w)) else {
+            return true;
+        };
+        let faces: Vec<SurfaceId> = faces
+            .iter()
+            .map(|&(s, _)| s)
+            .filter(|&s| s != self.emitter && s != self.receiver)
+            .collect();
+        if faces.len() < 2 {
+            return true;
+        }
+        let a = t.points[u];
+        let side = |s: SurfaceId, p: DVec3| t.normals[s].dot(p - a);
+        let straddles = |p: DVec3| {
+            let (lo, hi) = faces
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &s| {
+                    let h = side(s, p);
+                    (lo.min(h), hi.max(h))
+                });
+            lo <= 0.0 && hi >= 0.0
+        };
+        straddles(source[0])
+            || straddles(source[1])
+            || faces
+                .iter()
+                .any(|&s| (side(s, source[0]) > 0.0) != (side(s, source[1]) > 0.0))
+    }
+
+    /// A box holding every point beyond the blocker edge `first` on a line from `source` towards
+    /// the receiver's plane: the edge and its shadow from the emitter edge on that plane.
+    fn beyond(&self, source: [DVec3; 2], first: [DVec3; 2]) -> Bounds {
+        let rf = &self.receiver_frame;
+        let mut bounds = Bounds::from_points(first.iter());
+        for p in source {
+            for q in first {
+                let d = q - p;
+                let (hq, hd) = (rf.height(q), rf.normal.dot(d));
+                let far = if hd < 0.0 && hq > 0.0 {
+                    q + d * (hq / -hd).min(self.reach / d.length().max(f64::MIN_POSITIVE))
+                } else {
+                    q + d.normalize_or_zero() * self.reach
+                };
+                bounds = bounds.including(far);
+            }
+        }
+        bounds
+    }
+
+    /// The curves of one triple.
+    fn triple(
+        &self,
+        source: [DVec3; 2],
+        first: (usize, usize),
+        second: (usize, usize),
+    ) -> Vec<EeeCurve> {
+        let t = self.topology;
+        let b1 = [t.points[first.0], t.points[first.1]];
+        let b2 = [t.points[second.0], t.points[second.1]];
+        let shares_vertex = first.0 == second.0
+            || first.0 == second.1
+            || first.1 == second.0
+            || first.1 == second.1;
+        let coplanar = shares_vertex
+            || plane_normal(b1, b2)
+                .is_some_and(|n| b2.iter().all(|&p| n.dot(p - b1[0]).abs() <= self.tol));
+        if coplanar {
+            return self.pencil(source, b1, b2, first, second);
+        }
+        // With the emitter edge parallel to a blocker edge, every line through the three lies in
+        // the plane of those two: an edge–edge event, found as EV and VE wedges already.
+        let e = source[1] - source[0];
+        let parallel = |d: DVec3| e.cross(d).length() <= 1e-9 * e.length() * d.length();
+        if parallel(b1[1] - b1[0]) || parallel(b2[1] - b2[0]) {
+            return Vec::new();
+        }
+        let line = |u: f64| self.transversal(source, b1, b2, u);
+        let event =
+            |u: f64| line(u).filter(|x| self.grazes(x, first, second) && self.unobstructed(x));
+        let params: Vec<f64> = (0..SAMPLES)
+            .map(|k| (k as f64 + 0.5) / SAMPLES as f64)
+            .collect();
+        let states: Vec<bool> = params.iter().map(|&u| event(u).is_some()).collect();
+        if !states.iter().any(|&s| s) {
+            return Vec::new();
+        }
+        // Where the event starts or stops between a parameter where it holds and one where it
+        // does not.
+        let edge_of = |mut inside: f64, mut outside: f64| {
+            for _ in 0..BISECTIONS {
+                let mid = 0.5 * (inside + outside);
+                if event(mid).is_some() {
+                    inside = mid;
+                } else {
+                    outside = mid;
+                }
+            }
+            inside
+        };
+        let mut runs = Vec::new();
+        let mut start = None;
+        for k in 0..SAMPLES {
+            match (states[k], start) {
+                (true, None) => {
+                    start = Some(if k == 0 {
+                        if event(0.0).is_some() {
+                            0.0
+                        } else {
+                            edge_of(params[0], 0.0)
+                        }
+                    } else {
+                        edge_of(params[k], params[k - 1])
+                    });
+                }
+                (false, Some(s)) => {
+                    runs.push((s, edge_of(params[k - 1], params[k])));
+                    start = None;
+                }
+                _ => {}
+            }
+        }
+        if let Some(s) = start {
+            let end = if event(1.0).is_some() {
+                1.0
+            } else {
+                edge_of(params[SAMPLES - 1], 1.0)
+            };
+            runs.push((s, end));
+        }
+        runs.into_iter()
+            .filter_map(|(u0, u1)| {
+                let (a, b) = (line(u0)?.receiver, line(u1)?.receiver);
+                let mut points = vec![a];
+                self.subdivide(&line, (u0, a), (u1, b), 0, &mut points);
+                (points.len() >= 2).then_some(EeeCurve {
+                    points,
+                    edges: [source, b1, b2],
+                    order: 2,
+                })
+            })
+            .collect()
+    }
+
+    /// The curves of two coplanar blocker edges: the lines of their plane through the point where
+    /// it cuts the emitter edge, a straight line on the receiver. Its ends are the shadows of the
+    /// edges' vertices from that point, so they are placed exactly; trimming then finds where the
+    /// lines are unobstructed.
+    fn pencil(
+        &self,
+        source: [DVec3; 2],
+        b1: [DVec3; 2],
+        b2: [DVec3; 2],
+        first: (usize, usize),
+        second: (usize, usize),
+    ) -> Vec<EeeCurve> {
+        let Some(n) = plane_normal(b1, b2) else {
+            return Vec::new();
+        };
+        let e = source[1] - source[0];
+        let den = n.dot(e);
+        if den.abs() <= 1e-12 * e.length() {
+            return Vec::new();
+        }
+        let s = n.dot(b1[0] - source[0]) / den;
+        if !(0.0..=1.0).contains(&s) {
+            return Vec::new();
+        }
+        let apex = source[0] + e * s;
+        let rf = &self.receiver_frame;
+        let h_apex = rf.height(apex);
+        if h_apex <= self.tol || self.emitter_frame.height(apex).abs() > self.tol {
+            return Vec::new();
+        }
+        // The receiver's line: where the edges' plane meets the receiver's plane.
+        let Some(dir) = n.cross(rf.normal).try_normalize() else {
+            return Vec::new();
+        };
+        let foot = apex - rf.normal * h_apex;
+        let across = rf.normal.cross(dir);
+        let den = n.dot(across);
+        if den.abs() <= 1e-12 {
+            return Vec::new();
+        }
+        let base = foot + across * (n.dot(b1[0] - foot) / den);
+        let at = |c: f64| base + dir * c;
+        // Cuts: the shadows of the four vertices from the apex, and the far ends.
+        let mut cuts = vec![-self.reach, self.reach];
+        for v in [b1[0], b1[1], b2[0], b2[1]] {
+            let hv = rf.height(v);
+            if hv < h_apex {
+                let x = apex + (v - apex) * (h_apex / (h_apex - hv));
+                cuts.push(dir.dot(x - base).clamp(-self.reach, self.reach));
+            }
+        }
+        cuts.sort_by(f64::total_cmp);
+        cuts.dedup();
+        let holds = |x: DVec3| {
+            self.emitter_frame.height(x) > self.tol
+                && self
+                    .pencil_line(apex, x, b1, b2)
+                    .is_some_and(|l| self.grazes(&l, first, second))
+        };
+        let mut runs: Vec<(f64, f64)> = Vec::new();
+        for w in cuts.windows(2) {
+            if w[1] - w[0] <= self.tol || !holds(at(0.5 * (w[0] + w[1]))) {
+                continue;
+            }
+            match runs.last_mut() {
+                Some(last) if last.1 == w[0] => last.1 = w[1],
+                _ => runs.push((w[0], w[1])),
+            }
+        }
+        let mut curves = Vec::new();
+        for (c0, c1) in runs {
+            for [a, b] in super::clip_to_polygon(rf, self.receiver_polygon, at(c0), at(c1)) {
+                let visible =
+                    super::trim::runs_where(a, b, self.trim_samples, self.trim_tolerance, |x| {
+                        self.pencil_line(apex, x, b1, b2)
+                            .is_some_and(|l| self.unobstructed(&l))
+                    });
+                curves.extend(visible.into_iter().map(|[p, q]| EeeCurve {
+                    points: vec![p, q],
+                    edges: [source, b1, b2],
+                    order: 1,
+                }));
+            }
+        }
+        curves
+    }
+
+    /// The line from `apex` to the receiver point `x`, if it crosses `b1` and then `b2` (all in
+    /// one plane) on its way.
+    fn pencil_line(
+        &self,
+        apex: DVec3,
+        x: DVec3,
+        b1: [DVec3; 2],
+        b2: [DVec3; 2],
+    ) -> Option<Transversal> {
+        let (l1, m1) = crossing(apex, x, b1)?;
+        let (l2, m2) = crossing(apex, x, b2)?;
+        let inside = |m: f64| (0.0..=1.0).contains(&m);
+        if !(inside(m1) && inside(m2) && 0.0 < l1 && l1 < l2 && l2 < 1.0) {
+            return None;
+        }
+        let second = b2[0].lerp(b2[1], m2);
+        // The line must reach the receiver beyond the blocker, not touch it there.
+        (self.receiver_frame.height(second) > self.tol).then(|| Transversal {
+            source: apex,
+            first: b1[0].lerp(b1[1], m1),
+            second,
+            receiver: x,
+        })
+    }
+
+    /// Appends the points after `a` of the polyline from `a` to `b` whose chords are within the
+    /// tolerance of the arc.
+    fn subdivide(
+        &self,
+        line: &dyn Fn(f64) -> Option<Transversal>,
+        a: (f64, DVec3),
+        b: (f64, DVec3),
+        depth: u32,
+        points: &mut Vec<DVec3>,
+    ) {
+        let um = 0.5 * (a.0 + b.0);
+        if let Some(m) = line(um).map(|x| x.receiver) {
+            let chord = b.1 - a.1;
+            let off = if chord.length_squared() > 0.0 {
+                let s = ((m - a.1).dot(chord) / chord.length_squared()).clamp(0.0, 1.0);
+                m.distance(a.1 + chord * s)
+            } else {
+                m.distance(a.1)
+            };
+            if (off > self.chord_tolerance || depth < 1) && depth < MAX_DEPTH {
+                self.subdivide(line, a, (um, m), depth + 1, points);
+                self.subdivide(line, (um, m), b, depth + 1, points);
+                return;
+            }
+        }
+        if b.1 != *points.last().unwrap_or(&a.1) {
+            points.push(b.1);
+        }
+    }
+
+    /// The line through the point at `u` along `b1` that meets the lines of `source` and `b2`,
+    /// if it meets the three segments in the order emitter, `b1`, `b2`, and then the receiver's
+    /// plane in front of the emitter.
+    fn transversal(
+        &self,
+        source: [DVec3; 2],
+        b1: [DVec3; 2],
+        b2: [DVec3; 2],
+        u: f64,
+    ) -> Option<Transversal> {
+        let first = b1[0].lerp(b1[1], u);
+        let e = source[1] - source[0];
+        // The plane through `first` and the emitter edge's line cuts `b2`'s line at `second`.
+        let n = e.cross(first - source[0]);
+        let n = n.try_normalize()?;
+        let d2 = b2[1] - b2[0];
+        let den = n.dot(d2);
+        if den.abs() <= f64::EPSILON * d2.length() {
+            return None;
+        }
+        let s = n.dot(source[0] - b2[0]) / den;
+        if !(0.0..=1.0).contains(&s) {
+            return None;
+        }
+        let second = b2[0] + d2 * s;
+        let d = second - first;
+        if d.length() <= self.tol {
+            return None;
+        }
+        // In that plane the line meets the emitter edge's line.
+        let m = d.cross(n);
+        let den = m.dot(e);
+        if den.abs() <= f64::EPSILON * m.length() * e.length() {
+            return None;
+        }
+        let v = m.dot(first - source[0]) / den;
+        if !(0.0..=1.0).contains(&v) {
+            return None;
+        }
+        let from = source[0] + e * v;
+        // The emitter, then `first`, then `second`, along the line.
+        if d.dot(first - from) <= 0.0 {
+            return None;
+        }
+        let rf = &self.receiver_frame;
+        let (h, hd) = (rf.height(second), rf.normal.dot(d));
+        if !(h > self.tol && hd < 0.0) {
+            return None;
+        }
+        let receiver = second + d * (h / -hd);
+        let in_front = self.emitter_frame.height(receiver) > self.tol
+            && self.emitter_frame.height(first) > self.tol
+            && rf.height(from) > self.tol
+            && receiver.distance(from) <= self.reach;
+        in_front.then_some(Transversal {
+            source: from,
+            first,
+            second,
+            receiver,
+        })
+    }
+
+    /// Whether the line grazes both blocker edges: their faces stay on one side of the plane
+    /// through each edge and the line.
+    fn grazes(&self, x: &Transversal, first: (usize, usize), second: (usize, usize)) -> bool {
+        let t = self.topology;
+        let not_pair = |s: SurfaceId| s != self.emitter && s != self.receiver;
+        let d = x.receiver - x.source;
+        [first, second].into_iter().all(|(a, b)| {
+            let along = t.points[b] - t.points[a];
+            along
+                .cross(d)
+                .try_normalize()
+                .is_some_and(|n| t.edge_is_tangent(a, b, n, not_pair))
+        })
+    }
+
+    /// Whether nothing else crosses the line between the emitter and the receiver.
+    fn unobstructed(&self, x: &Transversal) -> bool {
+        let v = self.visibility;
+        let (e, r) = (self.emitter, self.receiver);
+        !v.occluded(x.receiver, x.second, [r, r])
+            && !v.occluded(x.second, x.first, [r, e])
+            && !v.occluded(x.first, x.source, [e, e])
+    }
+}
+
+/// The unit normal of the plane through segment `a` and a point of segment `b`, from the best
+/// conditioned of the cross products (for parallel segments the first is rounding noise).
+fn plane_normal(a: [DVec3; 2], b: [DVec3; 2]) -> Option<DVec3> {
+    let d = a[1] - a[0];
+    [b[1] - b[0], b[0] - a[0], b[1] - a[0]]
+        .into_iter()
+        .map(|w| {
+            let c = d.cross(w);
+            (
+                c.length() / (d.length() * w.length()).max(f64::MIN_POSITIVE),
+                c,
+            )
+        })
+        .max_by(|x, y| x.0.total_cmp(&y.0))
+        .and_then(|(_, c)| c.try_normalize())
+}
+
+/// Where the line `a -> b` and the line of segment `c` come closest (for coplanar lines, where
+/// they cross): the parameters along `a -> b` and along `c`.
+fn crossing(a: DVec3, b: DVec3, c: [DVec3; 2]) -> Option<(f64, f64)> {
+    let (u, v, w) = (b - a, c[1] - c[0], c[0] - a);
+    let (uu, uv, vv, uw, vw) = (u.dot(u), u.dot(v), v.dot(v), u.dot(w), v.dot(w));
+    let den = uu * vv - uv * uv;
+    if den <= 1e-24 * uu * vv {
+        return None;
+    }
+    Some(((uw * vv - uv * vw) / den, (uv * uw - uu * vw) / den))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn transversals_meet_all_three_edges() {
+        let scene = penumbra_scenes::builtin::crossed_bars();
+        let vis = Visibility::build(&scene);
+        let tol = vis.contact_distance();
+        let topology = Topology::new(&scene, tol);
+        let frame = |s: usize| PlaneFrame::of_polygon(&scene.surfaces[s].polygon).expect("flat");
+        let search = EeeSearch {
+            topology: &topology,
+            visibility: &vis,
+            emitter: 0,
+            receiver: 3,
+            emitter_frame: frame(0),
+            receiver_frame: frame(3),
+            tol,
+            reach: 4.0 * scene.diagonal(),
+            chord_tolerance: 1e-6 * scene.diagonal(),
+            receiver_polygon: &scene.surfaces[3].polygon,
+            trim_samples: 16,
+            trim_tolerance: 1e-9 * scene.diagonal(),
+        };
+        let l = &topology.loops[0];
+        let emitter_edges: Vec<(usize, usize)> =
+            (0..l.len()).map(|k| (l[k], l[(k + 1) % l.len()])).collect();
+        let mut edges = BTreeSet::new();
+        for s in [1, 2] {
+            let l = &topology.loops[s];
+            for k in 0..l.len() {
+                let (u, w) = (l[k], l[(k + 1) % l.len()]);
+                edges.insert((u.min(w), u.max(w)));
+            }
+        }
+        let (curves, count) = search.curves(&emitter_edges, &edges);
+        assert!(count.events > 0 && !curves.is_empty(), "{count:?}");
+        for c in &curves {
+            let [e, b1, b2] = c.edges;
+            for &x in &c.points {
+                assert!(x.z.abs() < 1e-12, "{x} is off the floor");
+                // From x: the plane through x and b2's line meets b1's line at q; the line x-q
+                // must then meet e's line.
+                let n = (b2[1] - b2[0]).cross(x - b2[0]);
+                let dir = b1[1] - b1[0];
+                let q = b1[0] + dir * (n.dot(b2[0] - b1[0]) / n.dot(dir));
+                let c = (q - x).cross(e[1] - e[0]).normalize();
+                let gap = (e[0] - x).dot(c).abs();
+                assert!(
+                    gap < 1e-9,
+                    "{x}: the line through the blocker edges misses the emitter edge by {gap:e}"
+                );
+            }
+        }
+    }
+}
