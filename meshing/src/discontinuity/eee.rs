@@ -13,7 +13,7 @@
 //! unobstructed. Samples along the edge find the runs where this holds, bisection places their
 //! ends, and each run's arc is split until every chord is within the tolerance.
 
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::{BTreeSet, HashMap};
 
 use glam::DVec3;
 use penumbra_scenes::{Bounds, PlaneFrame, SurfaceId, Visibility};
@@ -87,46 +87,94 @@ impl EeeSearch<'_> {
     ) -> (Vec<EeeCurve>, EeeCount) {
         let mut count = EeeCount::default();
         let mut curves = Vec::new();
-        // Blocker edges at each vertex, for the pairs that share one.
-        let mut at_vertex: BTreeMap<usize, Vec<(usize, usize)>> = BTreeMap::new();
-        for &(u, w) in edges {
-            at_vertex.entry(u).or_default().push((u, w));
-            at_vertex.entry(w).or_default().push((u, w));
-        }
         let t = self.topology;
+        // Blocker edges by index, at each vertex (for the pairs that share one) and along each
+        // surface (for the pairs found by region).
+        let list: Vec<(usize, usize)> = edges.iter().copied().collect();
+        let index: HashMap<(usize, usize), usize> =
+            list.iter().enumerate().map(|(i, &e)| (e, i)).collect();
+        let mut at_vertex: HashMap<usize, Vec<usize>> = HashMap::new();
+        for (i, &(u, w)) in list.iter().enumerate() {
+            at_vertex.entry(u).or_default().push(i);
+            at_vertex.entry(w).or_default().push(i);
+        }
+        let along_surface: Vec<Vec<usize>> = t
+            .loops
+            .iter()
+            .map(|l| {
+                (0..l.len())
+                    .filter_map(|k| {
+                        let (u, w) = (l[k], l[(k + 1) % l.len()]);
+                        index.get(&(u.min(w), u.max(w))).copied()
+                    })
+                    .collect()
+            })
+            .collect();
+        // Surfaces and edges already taken for the current first edge, stamped to skip repeats.
+        let mut surface_stamp = vec![usize::MAX; t.loops.len()];
+        let mut edge_stamp = vec![usize::MAX; list.len()];
+        let mut partners: Vec<usize> = Vec::new();
+        let mut round = 0usize;
         for &(ia, ib) in emitter_edges {
             let source = [t.points[ia], t.points[ib]];
-            // Edges lying on the receiver are contact lines, not blockers of its light.
-            let usable: BTreeSet<(usize, usize)> = edges
+            // Edges lying on the receiver are contact lines, not blockers of its light; edges
+            // whose shadow from the emitter edge misses the receiver cannot cast an event on it.
+            let usable: Vec<bool> = list
                 .iter()
-                .copied()
-                .filter(|&(u, w)| {
-                    [u, w]
-                        .iter()
-                        .any(|&v| self.receiver_frame.height(t.points[v]) > self.tol)
+                .map(|&(u, w)| {
+                    let b = [t.points[u], t.points[w]];
+                    b.iter().any(|&p| self.receiver_frame.height(p) > self.tol)
                         && self.can_be_silhouette(u, w, source)
+                        && self.shadow_meets_receiver(&self.beyond(source, b)[2..])
                 })
                 .collect();
-            for &first in &usable {
-                let mut partners: BTreeSet<(usize, usize)> = BTreeSet::new();
-                for v in [first.0, first.1] {
-                    partners.extend(at_vertex.get(&v).into_iter().flatten().copied());
+            for (i1, &first) in list.iter().enumerate() {
+                if !usable[i1] {
+                    continue;
                 }
-                let region = self.beyond(source, [t.points[first.0], t.points[first.1]]);
-                let mut near = BTreeSet::new();
-                self.visibility.triangles_overlapping(region, |k| {
-                    near.insert(self.visibility.triangles()[k].surface);
-                });
-                for s in near {
-                    let l = &t.loops[s];
-                    for k in 0..l.len() {
-                        let (u, w) = (l[k], l[(k + 1) % l.len()]);
-                        partners.insert((u.min(w), u.max(w)));
+                round += 1;
+                let b1 = [t.points[first.0], t.points[first.1]];
+                let corners = self.beyond(source, b1);
+                let hull = super::hull::hull_planes(&corners, self.tol);
+                let outside =
+                    |points: &[DVec3]| super::hull::beyond_a_face(&hull, points, self.tol);
+                let mut polygon: Vec<DVec3> = Vec::new();
+                partners.clear();
+                let mut take = |i: usize, partners: &mut Vec<usize>| {
+                    if edge_stamp[i] != round && i != i1 && usable[i] {
+                        edge_stamp[i] = round;
+                        partners.push(i);
+                    }
+                };
+                for v in [first.0, first.1] {
+                    for &i in at_vertex.get(&v).into_iter().flatten() {
+                        take(i, &mut partners);
                     }
                 }
-                partners.remove(&first);
-                for second in partners {
-                    if !usable.contains(&second) {
+                self.visibility
+                    .triangles_overlapping(Bounds::from_points(corners.iter()), |k| {
+                        let s = self.visibility.triangles()[k].surface;
+                        if surface_stamp[s] == round {
+                            return;
+                        }
+                        surface_stamp[s] = round;
+                        polygon.clear();
+                        polygon.extend(t.loops[s].iter().map(|&v| t.points[v]));
+                        if outside(&polygon) {
+                            return;
+                        }
+                        for &i in &along_surface[s] {
+                            take(i, &mut partners);
+                        }
+                    });
+                partners.sort_unstable();
+                for &i2 in &partners {
+                    let second = list[i2];
+                    let b2 = [t.points[second.0], t.points[second.1]];
+                    if outside(&b2)
+                        || !sweeps_across(source, b1, b2)
+                        || !sweeps_across(source, b2, b1)
+                    {
                         continue;
                     }
                     count.considered += 1;
@@ -175,24 +223,46 @@ impl EeeSearch<'_> {
                 .any(|&s| (side(s, source[0]) > 0.0) != (side(s, source[1]) > 0.0))
     }
 
-    /// A box holding every point beyond the blocker edge `first` on a line from `source` towards
-    /// the receiver's plane: the edge and its shadow from the emitter edge on that plane.
-    fn beyond(&self, source: [DVec3; 2], first: [DVec3; 2]) -> Bounds {
+    /// Whether the box, in the receiver's plane, of the shadow corners `shadow` overlaps the
+    /// receiver polygon's.
+    fn shadow_meets_receiver(&self, shadow: &[DVec3]) -> bool {
         let rf = &self.receiver_frame;
-        let mut bounds = Bounds::from_points(first.iter());
-        for p in source {
-            for q in first {
+        let box_of = |points: &mut dyn Iterator<Item = DVec3>| {
+            points.fold(
+                (glam::DVec2::INFINITY, glam::DVec2::NEG_INFINITY),
+                |(lo, hi), p| {
+                    let q = rf.to_2d(p);
+                    (lo.min(q), hi.max(q))
+                },
+            )
+        };
+        let (slo, shi) = box_of(&mut shadow.iter().copied());
+        let (rlo, rhi) = box_of(&mut self.receiver_polygon.iter().copied());
+        let tol = glam::DVec2::splat(self.tol);
+        slo.cmple(rhi + tol).all() && rlo.cmple(shi + tol).all()
+    }
+
+    /// Points whose convex hull holds every point beyond the blocker edge `first` on a line from
+    /// `source` towards the receiver's plane: the edge and its shadow from the emitter edge on
+    /// that plane (the shadow of a segment from a segment is the hull of its corners' shadows).
+    fn beyond(&self, source: [DVec3; 2], first: [DVec3; 2]) -> [DVec3; 6] {
+        let rf = &self.receiver_frame;
+        let mut out = [first[0], first[1], first[0], first[1], first[0], first[1]];
+        for (i, p) in source.into_iter().enumerate() {
+            for (j, q) in first.into_iter().enumerate() {
                 let d = q - p;
                 let (hq, hd) = (rf.height(q), rf.normal.dot(d));
-                let far = if hd < 0.0 && hq > 0.0 {
+                out[2 + 2 * i + j] = if hq <= self.tol {
+                    // On the receiver's plane already: its own shadow.
+                    q - rf.normal * hq
+                } else if hd < 0.0 {
                     q + d * (hq / -hd).min(self.reach / d.length().max(f64::MIN_POSITIVE))
                 } else {
                     q + d.normalize_or_zero() * self.reach
                 };
-                bounds = bounds.including(far);
             }
         }
-        bounds
+        out
     }
 
     /// The curves of one triple.
@@ -516,6 +586,25 @@ impl EeeSearch<'_> {
             && !v.occluded(x.second, x.first, [r, e])
             && !v.occluded(x.first, x.source, [e, e])
     }
+}
+
+/// Whether, for some point `p` of the emitter edge `source`, segment `b` crosses the plane through
+/// `p` and segment `a`: every line from `p` through `a` lies in that plane, so without a crossing no
+/// line meets all three. The plane's side of each end of `b` is linear along `source`, so the ends
+/// and the roots tell.
+fn sweeps_across(source: [DVec3; 2], a: [DVec3; 2], b: [DVec3; 2]) -> bool {
+    let d = a[1] - a[0];
+    let (n0, n1) = (d.cross(source[0] - a[0]), d.cross(source[1] - source[0]));
+    let side = |w: DVec3, s: f64| (n0 + n1 * s).dot(w);
+    let (w0, w1) = (b[0] - a[0], b[1] - a[0]);
+    let root_inside = |w: DVec3| {
+        let (c0, c1) = (n0.dot(w), n1.dot(w));
+        c1 != 0.0 && (0.0..=1.0).contains(&(-c0 / c1))
+    };
+    side(w0, 0.0) * side(w1, 0.0) <= 0.0
+        || side(w0, 1.0) * side(w1, 1.0) <= 0.0
+        || root_inside(w0)
+        || root_inside(w1)
 }
 
 /// The unit normal of the plane through segment `a` and a point of segment `b`, from the best

@@ -1,8 +1,8 @@
 //! Discontinuity meshing, first half: where on each receiver the direct light from each emitter
 //! changes its analytic form (Heckbert 1992; Lischinski, Tampieri & Greenberg 1992).
 //!
-//! For every emitter and receiver, the blockers inside the shaft between them (BVH box query)
-//! contribute their silhouette features: EV wedges (emitter edge, blocker vertex) and VE wedges
+//! For every emitter and receiver, the blockers inside the shaft between them (a BVH box query,
+//! then the planes of the convex hull of the two polygons) contribute their silhouette features: EV wedges (emitter edge, blocker vertex) and VE wedges
 //! (emitter vertex, blocker edge). Each wedge meets the receiver's plane in a line, clipped to the
 //! receiver polygon and trimmed to where its generating rays are unobstructed. Coincident lines
 //! (the parallel case) are merged. Blockers touching the receiver add contact (D0) lines. Every
@@ -10,6 +10,7 @@
 
 pub mod contact;
 pub mod eee;
+pub mod hull;
 pub mod merge;
 pub mod topology;
 pub mod trim;
@@ -154,16 +155,22 @@ pub fn find_discontinuities(
                 continue;
             }
             stats.pairs += 1;
+            // The shaft: the convex hull of emitter and receiver. A blocker must have a vertex in
+            // front of both and must not lie wholly beyond one of the hull's faces.
+            let mut ends = emitter.polygon.clone();
+            ends.extend(&receiver.polygon);
+            let shaft = hull::hull_planes(&ends, tol);
             let blockers = shaft_blockers(
                 visibility,
                 emitter.bounds().union(receiver.bounds()),
                 e,
                 r,
                 |s| {
-                    scene.surfaces[s]
-                        .polygon
+                    let polygon = &scene.surfaces[s].polygon;
+                    polygon
                         .iter()
                         .any(|&p| ef.height(p) > tol && rf.height(p) > tol)
+                        && !hull::beyond_a_face(&shaft, polygon, tol)
                 },
             );
             if blockers.is_empty() {
