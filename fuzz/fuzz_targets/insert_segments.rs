@@ -1,6 +1,6 @@
 //! Segment insertion into a surface's constrained triangulation: any set of segments (crossing,
 //! overlapping, sharing ends, a rounding error apart, sticking out of the polygon) must give a
-//! sane mesh, never a panic or an error.
+//! sane mesh, never a panic or an error, refined uniformly or graded.
 #![no_main]
 
 use glam::DVec3;
@@ -22,8 +22,14 @@ fuzz_target!(|data: &[u8]| {
         Ok(c) => c,
         Err(e) => panic!("insertion failed: {e}"),
     };
-    let mesh = constrained.into_mesh(&square, target);
+    let mesh = constrained.clone().into_mesh(&square, target);
     if let Err(e) = mesh.sanity_check() {
         panic!("{e}");
+    }
+    // Graded refinement inserts its own points: the light "varies" on the left half.
+    let varies = |points: &[DVec3]| points.iter().any(|p| p.x < 0.5);
+    let graded = constrained.into_graded_mesh(&square, target, 8.0, &varies);
+    if let Err(e) = graded.sanity_check() {
+        panic!("graded: {e}");
     }
 });

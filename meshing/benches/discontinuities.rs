@@ -1,5 +1,5 @@
 //! Discontinuity finding on floors of 10, 100 and 1000 boxes: how its time grows with the number
-//! of blockers, and how many wedges it tests per second.
+//! of blockers, and how many wedges and EEE triples it tests.
 
 use std::hint::black_box;
 use std::time::Instant;
@@ -21,12 +21,16 @@ fn discontinuities(c: &mut Criterion) {
         let seconds = started.elapsed().as_secs_f64();
         let s = &found.stats;
         eprintln!(
-            "{boxes} boxes: {:.3} s, {} wedges considered ({:.2e}/s), {} culled, {} kept, {} segments",
+            "{boxes} boxes: {:.3} s, {} blockers in shafts, {} wedges considered ({:.2e}/s), {} culled, \
+             {} kept, {} EEE triples considered, {} EEE events, {} segments",
             seconds,
+            s.blockers_in_shafts,
             s.wedges_considered,
             s.wedges_considered as f64 / seconds,
             s.wedges_culled,
             s.wedges_kept,
+            s.eee_considered,
+            s.eee_events,
             s.segments
         );
         group.bench_with_input(BenchmarkId::from_parameter(boxes), &scene, |b, scene| {

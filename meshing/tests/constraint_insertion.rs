@@ -70,15 +70,61 @@ fn random_segments_in_any_order_give_sane_meshes() {
             let constrained = ConstrainedSurface::new(0, &surface, &segments)
                 .unwrap_or_else(|e| panic!("case {case}: {e}"));
             let target = 200 + (rng.next_f64() * 800.0) as usize;
-            let mesh = constrained.into_mesh(&surface, target);
+            // Half the cases graded: the light "varies" left of the middle.
+            let mesh = if case % 2 == 0 {
+                constrained.into_mesh(&surface, target)
+            } else {
+                let varies = |points: &[DVec3]| points.iter().any(|p| p.x < 0.5 * size);
+                constrained.into_graded_mesh(&surface, target, 8.0, &varies)
+            };
             mesh.sanity_check()
                 .unwrap_or_else(|e| panic!("case {case}, order {order}: {e}"));
+            assert!(
+                mesh.triangle_count() <= target.max(constrained_minimum(&surface, &segments)),
+                "case {case}: {} triangles for {target}",
+                mesh.triangle_count()
+            );
             assert!(
                 !mesh.constraints.is_empty()
                     || segments.iter().all(|s| s.from.distance(s.to) < 1e-9 * size)
             );
         }
     }
+}
+
+/// The fewest triangles the constrained triangulation can have.
+fn constrained_minimum(surface: &Surface, segments: &[Constraint]) -> usize {
+    ConstrainedSurface::new(0, surface, segments)
+        .map(|c| c.minimum_triangles())
+        .unwrap_or(0)
+}
+
+/// Graded meshes put more triangles where the light varies: on the left half of a square with a
+/// few segments, at least three times as many per area as on the right.
+#[test]
+fn graded_meshes_are_finer_where_the_light_varies() {
+    let surface = square(1.0);
+    let segments = [Constraint {
+        from: DVec2::new(0.5, 0.0),
+        to: DVec2::new(0.5, 1.0),
+        splits: false,
+    }];
+    let varies = |points: &[DVec3]| points.iter().any(|p| p.x < 0.5);
+    let mesh = ConstrainedSurface::new(0, &surface, &segments)
+        .expect("inserts")
+        .into_graded_mesh(&surface, 4000, 8.0, &varies);
+    mesh.sanity_check().expect("sane");
+    let (mut left, mut right) = (0usize, 0usize);
+    for t in &mesh.triangles {
+        let cx: f64 = t.iter().map(|&i| mesh.points3[i as usize].x).sum::<f64>() / 3.0;
+        if cx < 0.5 { left += 1 } else { right += 1 }
+    }
+    assert!(
+        mesh.triangle_count() <= 4000 && mesh.triangle_count() >= 3000,
+        "{}",
+        mesh.triangle_count()
+    );
+    assert!(left >= 3 * right, "{left} left, {right} right");
 }
 
 #[test]

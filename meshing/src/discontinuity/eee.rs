@@ -79,11 +79,12 @@ struct Transversal {
 
 impl EeeSearch<'_> {
     /// The EEE curves of emitter edges `emitter_edges` with the blocker edges `edges` (welded
-    /// vertex pairs), and what it took.
+    /// vertex pairs) of the surfaces `blockers`, and what it took.
     pub fn curves(
         &self,
         emitter_edges: &[(usize, usize)],
         edges: &BTreeSet<(usize, usize)>,
+        blockers: &[SurfaceId],
     ) -> (Vec<EeeCurve>, EeeCount) {
         let mut count = EeeCount::default();
         let mut curves = Vec::new();
@@ -98,16 +99,17 @@ impl EeeSearch<'_> {
             at_vertex.entry(u).or_default().push(i);
             at_vertex.entry(w).or_default().push(i);
         }
-        let along_surface: Vec<Vec<usize>> = t
-            .loops
+        let along_surface: HashMap<SurfaceId, Vec<usize>> = blockers
             .iter()
-            .map(|l| {
-                (0..l.len())
+            .map(|&s| {
+                let l = &t.loops[s];
+                let ids = (0..l.len())
                     .filter_map(|k| {
                         let (u, w) = (l[k], l[(k + 1) % l.len()]);
                         index.get(&(u.min(w), u.max(w))).copied()
                     })
-                    .collect()
+                    .collect();
+                (s, ids)
             })
             .collect();
         // Surfaces and edges already taken for the current first edge, stamped to skip repeats.
@@ -158,12 +160,15 @@ impl EeeSearch<'_> {
                             return;
                         }
                         surface_stamp[s] = round;
+                        let Some(ids) = along_surface.get(&s) else {
+                            return;
+                        };
                         polygon.clear();
                         polygon.extend(t.loops[s].iter().map(|&v| t.points[v]));
                         if outside(&polygon) {
                             return;
                         }
-                        for &i in &along_surface[s] {
+                        for &i in ids {
                             take(i, &mut partners);
                         }
                     });
@@ -672,7 +677,7 @@ mod tests {
                 edges.insert((u.min(w), u.max(w)));
             }
         }
-        let (curves, count) = search.curves(&emitter_edges, &edges);
+        let (curves, count) = search.curves(&emitter_edges, &edges, &[1, 2]);
         assert!(count.events > 0 && !curves.is_empty(), "{count:?}");
         for c in &curves {
             let [e, b1, b2] = c.edges;

@@ -288,7 +288,7 @@ pub fn find_discontinuities(
                     .map(|k| (e_loop[k], e_loop[(k + 1) % e_loop.len()]))
                     .filter(|(a, b)| a != b)
                     .collect();
-                let (curves, count) = search.curves(&emitter_edges, &edges);
+                let (curves, count) = search.curves(&emitter_edges, &edges, &blockers);
                 stats.eee_considered += count.considered;
                 stats.eee_events += count.events;
                 for curve in curves {
