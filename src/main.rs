@@ -62,6 +62,9 @@ struct RunArgs {
     /// in full light or full shadow (1: no grading).
     #[arg(long, default_value_t = DEFAULT_PENUMBRA_DENSITY)]
     penumbra_density: f64,
+    /// Discontinuity meshes: leave out EEE events (emitter edge with two blocker edges).
+    #[arg(long)]
+    no_eee: bool,
     /// Stop shooting when the unshot power is below this fraction of the emitted power.
     #[arg(long, default_value_t = DEFAULT_EPSILON)]
     epsilon: f64,
@@ -198,6 +201,10 @@ fn run(args: &RunArgs) -> Result<(), Failure> {
         },
         max_elements: args.max_elements,
         penumbra_density: args.penumbra_density,
+        discontinuity: penumbra_meshing::discontinuity::DiscontinuityOptions {
+            eee: !args.no_eee,
+            ..Default::default()
+        },
         solver: SolverOptions {
             epsilon: args.epsilon,
             max_shots: args.max_shots,

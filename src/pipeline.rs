@@ -32,6 +32,8 @@ pub struct RunOptions {
     pub max_elements: usize,
     /// How many times smaller in area discontinuity-mesh triangles are in penumbrae (1: none).
     pub penumbra_density: f64,
+    /// How discontinuities are found (EEE events on or off, tolerances).
+    pub discontinuity: DiscontinuityOptions,
     pub solver: SolverOptions,
     pub render: RenderOptions,
 }
@@ -42,6 +44,7 @@ impl Default for RunOptions {
             mesh: MeshMethod::Auto,
             max_elements: DEFAULT_MAX_ELEMENTS,
             penumbra_density: DEFAULT_PENUMBRA_DENSITY,
+            discontinuity: DiscontinuityOptions::default(),
             solver: SolverOptions::default(),
             render: RenderOptions::default(),
         }
@@ -114,7 +117,7 @@ pub fn run(
         MeshMethod::Discontinuity | MeshMethod::Auto => Some(find_discontinuities(
             scene,
             &visibility,
-            &DiscontinuityOptions::default(),
+            &options.discontinuity,
         )),
     };
     times.discontinuities = t.elapsed().as_secs_f64();

@@ -163,6 +163,52 @@ fn bad_input_exits_2_names_the_problem_and_writes_nothing() {
             .code(),
         Some(2)
     );
+    assert_eq!(
+        penumbra(&["run", "textbook", "--penumbra-density", "0.5"])
+            .status
+            .code(),
+        Some(2)
+    );
+}
+
+/// EEE events are on by default where a scene has them, counted in the report, listed in the
+/// solution, and `--no-eee` leaves them out.
+#[test]
+fn eee_events_are_reported_and_can_be_left_out() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut counts = Vec::new();
+    for (name, extra) in [("with", None), ("without", Some("--no-eee"))] {
+        let out = dir.path().join(name);
+        let mut args = vec![
+            "run",
+            "bars",
+            "--out",
+            out.to_str().expect("utf-8"),
+            "--direct-only",
+            "--max-elements",
+            "3000",
+            "--quiet",
+        ];
+        args.extend(extra);
+        let o = penumbra(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let report = json(&out.join("report.json"));
+        let events = report["discontinuities"]["eee_events"]
+            .as_u64()
+            .expect("count");
+        assert_eq!(report["method"]["eee"].as_bool(), Some(extra.is_none()));
+        let solution = json(&out.join("solution.json"));
+        let listed = solution["surfaces"]
+            .as_array()
+            .expect("surfaces")
+            .iter()
+            .flat_map(|s| s["discontinuities"].as_array().into_iter().flatten())
+            .filter(|d| d["event"] == "EEE")
+            .count();
+        counts.push((events, listed));
+    }
+    assert!(counts[0].0 > 0 && counts[0].1 > 0, "{counts:?}");
+    assert_eq!(counts[1], (0, 0));
 }
 
 #[test]
