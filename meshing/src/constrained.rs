@@ -158,10 +158,7 @@ impl ConstrainedSurface {
     /// Refines to about `target` triangles and makes the mesh, with separate vertices on the two
     /// sides of every value discontinuity.
     pub fn into_mesh(self, surface: &Surface, target: usize) -> SurfaceMesh {
-        let refined = self
-            .triangulation
-            .refined(target, CONSTRAINED_MIN_ANGLE_DEG);
-        self.finish(refined, surface)
+        self.into_refinable(target, 1.0, &|_| false).mesh(surface)
     }
 
     /// Like [`Self::into_mesh`], with triangles `penumbra_density` times smaller in area where
@@ -173,18 +170,74 @@ impl ConstrainedSurface {
         penumbra_density: f64,
         varies: &dyn Fn(&[DVec3]) -> bool,
     ) -> SurfaceMesh {
-        if self.segments.is_empty() || penumbra_density <= 1.0 {
-            return self.into_mesh(surface, target);
-        }
-        let density = Density::probe(&self.triangulation, target, penumbra_density, varies);
-        let refined =
-            self.triangulation
-                .refined_graded(target, CONSTRAINED_MIN_ANGLE_DEG, &density);
-        self.finish(refined, surface)
+        self.into_refinable(target, penumbra_density, varies)
+            .mesh(surface)
     }
 
-    fn finish(&self, refined: SurfaceTriangulation, surface: &Surface) -> SurfaceMesh {
-        let mut mesh = refined.into_mesh(self.id, surface);
+    /// The refined triangulation, graded as in [`Self::into_graded_mesh`], kept so that
+    /// triangles can be split later.
+    pub fn into_refinable(
+        self,
+        target: usize,
+        penumbra_density: f64,
+        varies: &dyn Fn(&[DVec3]) -> bool,
+    ) -> RefinableSurface {
+        let triangulation = if self.segments.is_empty() || penumbra_density <= 1.0 {
+            self.triangulation
+                .refined(target, CONSTRAINED_MIN_ANGLE_DEG)
+        } else {
+            let density = Density::probe(&self.triangulation, target, penumbra_density, varies);
+            self.triangulation
+                .refined_graded(target, CONSTRAINED_MIN_ANGLE_DEG, &density)
+        };
+        RefinableSurface {
+            id: self.id,
+            triangulation,
+            segments: self.segments,
+            min_angle_deg: CONSTRAINED_MIN_ANGLE_DEG,
+        }
+    }
+}
+
+/// A surface's refined triangulation with its constraints, kept so that triangles can be split
+/// later (adaptive refinement) without losing a constraint or the quality of the rest.
+#[derive(Clone)]
+pub struct RefinableSurface {
+    id: SurfaceId,
+    triangulation: SurfaceTriangulation,
+    segments: Vec<([DVec2; 2], bool)>,
+    min_angle_deg: f64,
+}
+
+impl std::fmt::Debug for RefinableSurface {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("RefinableSurface")
+            .field("id", &self.id)
+            .field("vertices", &self.triangulation.cdt.num_vertices())
+            .field("segments", &self.segments.len())
+            .finish()
+    }
+}
+
+impl RefinableSurface {
+    /// A uniform mesh of the surface, about `target` triangles, that can be refined later.
+    pub fn uniform(
+        id: SurfaceId,
+        surface: &Surface,
+        target: usize,
+    ) -> Result<RefinableSurface, MeshError> {
+        Ok(RefinableSurface {
+            id,
+            triangulation: SurfaceTriangulation::of_surface(id, surface)?
+                .refined(target, crate::uniform::MIN_ANGLE_DEG),
+            segments: Vec::new(),
+            min_angle_deg: crate::uniform::MIN_ANGLE_DEG,
+        })
+    }
+
+    /// The mesh, with separate vertices on the two sides of every value discontinuity.
+    pub fn mesh(&self, surface: &Surface) -> SurfaceMesh {
+        let mut mesh = self.triangulation.clone().into_mesh(self.id, surface);
         mesh.constraints = self.segments.iter().map(|s| s.0).collect();
         let jumps: Vec<[DVec2; 2]> = self.segments.iter().filter(|s| s.1).map(|s| s.0).collect();
         if !jumps.is_empty() {
@@ -192,6 +245,19 @@ impl ConstrainedSurface {
             split_along(&mut mesh, &jumps, &lines);
         }
         mesh
+    }
+
+    /// Splits the triangles holding the points `at` (mesh coordinates, such as the centroids of
+    /// a mesh's triangles), never across a constraint, and restores quality around them.
+    /// Returns how many vertices were added.
+    pub fn split_at(&mut self, at: &[DVec2]) -> usize {
+        self.triangulation
+            .split_triangles_at(at, self.min_angle_deg)
+    }
+
+    /// Triangles inside the polygon.
+    pub fn triangle_count(&self) -> usize {
+        self.triangulation.count()
     }
 }
 

@@ -5,19 +5,20 @@ use std::collections::BTreeSet;
 use glam::DVec3;
 use penumbra_scenes::{PlaneFrame, Scene, SurfaceId, Visibility};
 
-use crate::constrained::{ConstrainedSurface, Constraint};
+use crate::constrained::{ConstrainedSurface, Constraint, RefinableSurface};
 use crate::discontinuity::{
     Discontinuities, DiscontinuitySegment, DiscontinuityStats, EmitterProbe, Event,
 };
 use crate::error::MeshError;
 use crate::mesh::{MeshQuality, SurfaceMesh, quality_of};
-use crate::uniform::mesh_surface_uniform;
 
 /// One mesh per surface, in the scene's surface order, and the discontinuities the meshes follow
 /// (none for uniform meshes).
 #[derive(Clone, Debug)]
 pub struct SceneMesh {
     pub surfaces: Vec<SurfaceMesh>,
+    /// Each surface's triangulation, kept for adaptive refinement.
+    pub refinable: Vec<RefinableSurface>,
     /// Each surface's discontinuity segments (empty lists for uniform meshes).
     pub discontinuities: Vec<Vec<DiscontinuitySegment>>,
     pub discontinuity_stats: Option<DiscontinuityStats>,
@@ -42,6 +43,33 @@ impl SceneMesh {
 
     pub fn segment_count(&self) -> usize {
         self.discontinuities.iter().map(Vec::len).sum()
+    }
+
+    /// Splits the listed triangles of surface `surface` (indices into its current mesh), never
+    /// across a constraint, restores quality around them and rebuilds that surface's mesh.
+    /// Returns how many vertices the triangulation gained.
+    pub fn split_triangles(
+        &mut self,
+        scene: &Scene,
+        surface: SurfaceId,
+        triangles: &[usize],
+    ) -> usize {
+        let mesh = &self.surfaces[surface];
+        let at: Vec<glam::DVec2> = triangles
+            .iter()
+            .filter_map(|&t| mesh.triangles.get(t))
+            .map(|tri| {
+                tri.iter()
+                    .map(|&i| mesh.local[i as usize])
+                    .sum::<glam::DVec2>()
+                    / 3.0
+            })
+            .collect();
+        let added = self.refinable[surface].split_at(&at);
+        if added > 0 {
+            self.surfaces[surface] = self.refinable[surface].mesh(&scene.surfaces[surface]);
+        }
+        added
     }
 }
 
@@ -89,16 +117,22 @@ pub fn mesh_scene_uniform(scene: &Scene, max_elements: usize) -> Result<SceneMes
         .map(|s| s.polygon.len().saturating_sub(2).max(1))
         .collect();
     let targets = spread_by_area(&areas, &minimum, max_elements)?;
-    let surfaces = scene
+    let refinable = scene
         .surfaces
         .iter()
         .zip(targets)
         .enumerate()
-        .map(|(id, (s, target))| mesh_surface_uniform(id, s, target))
+        .map(|(id, (s, target))| RefinableSurface::uniform(id, s, target))
         .collect::<Result<Vec<_>, _>>()?;
+    let surfaces = refinable
+        .iter()
+        .zip(&scene.surfaces)
+        .map(|(r, s)| r.mesh(s))
+        .collect();
     Ok(SceneMesh {
-        discontinuities: vec![Vec::new(); surfaces.len()],
+        discontinuities: vec![Vec::new(); scene.surfaces.len()],
         surfaces,
+        refinable,
         discontinuity_stats: None,
     })
 }
@@ -144,14 +178,14 @@ pub fn mesh_scene_discontinuity(
         .map(ConstrainedSurface::minimum_triangles)
         .collect();
     let targets = spread_by_area(&areas, &minimum, max_elements)?;
-    let surfaces = constrained
+    let refinable: Vec<RefinableSurface> = constrained
         .into_iter()
         .zip(targets)
         .enumerate()
         .map(|(id, (c, target))| {
             let surface = &scene.surfaces[id];
             let Some(frame) = PlaneFrame::of_polygon(&surface.polygon) else {
-                return c.into_mesh(surface, target);
+                return c.into_refinable(target, 1.0, &|_| false);
             };
             let emitters: BTreeSet<SurfaceId> = found
                 .segments
@@ -173,13 +207,19 @@ pub fn mesh_scene_discontinuity(
                     hi > 0.0 && lo < 1.0
                 })
             };
-            c.into_graded_mesh(surface, target, penumbra_density, &varies)
+            c.into_refinable(target, penumbra_density, &varies)
         })
+        .collect();
+    let surfaces = refinable
+        .iter()
+        .zip(&scene.surfaces)
+        .map(|(r, s)| r.mesh(s))
         .collect();
     let mut discontinuities = found.segments;
     discontinuities.resize(scene.surfaces.len(), Vec::new());
     Ok(SceneMesh {
         surfaces,
+        refinable,
         discontinuities,
         discontinuity_stats: Some(found.stats),
     })

@@ -199,29 +199,11 @@ impl SurfaceTriangulation {
             let smallest = max_area / density.max_factor();
             self.refine_cdt(&mut cdt, min_angle_deg, Some(max_area), max_area, target);
             for _ in 0..GRADING_ROUNDS {
-                let mut split_edges = std::collections::HashSet::new();
-                let mut points = Vec::new();
-                for face in cdt.inner_faces() {
-                    let [a, b, c] = face.positions().map(|p| DVec2::new(p.x, p.y));
-                    let centroid = (a + b + c) / 3.0;
-                    if face.area() <= max_area / density.at(centroid)
-                        || !crate::planar::inside_polygon(centroid, &self.coords.boundary)
-                    {
-                        continue;
-                    }
-                    let longest = face
-                        .adjacent_edges()
-                        .into_iter()
-                        .max_by(|e, f| e.length_2().total_cmp(&f.length_2()))
-                        .expect("a face has three edges");
-                    let undirected = longest.as_undirected();
-                    if undirected.is_constraint_edge() || undirected.is_part_of_convex_hull() {
-                        points.push(centroid);
-                    } else if split_edges.insert(undirected.fix()) {
-                        let [p, q] = undirected.positions();
-                        points.push(DVec2::new(0.5 * (p.x + q.x), 0.5 * (p.y + q.y)));
-                    }
-                }
+                let points = split_points(&cdt, |face| {
+                    let centroid = face_centroid(face);
+                    face.area() > max_area / density.at(centroid)
+                        && crate::planar::inside_polygon(centroid, &self.coords.boundary)
+                });
                 if points.is_empty() || cdt.num_vertices() > 2 * target + 64 {
                     break;
                 }
@@ -233,6 +215,39 @@ impl SurfaceTriangulation {
             }
             cdt
         })
+    }
+
+    /// Splits the triangles that hold one of `points` (each once), then refines for quality
+    /// (angles of at least `min_angle_deg`, nothing refined below a thousandth of the smallest
+    /// split triangle). Returns how many vertices were added.
+    pub fn split_triangles_at(&mut self, points: &[DVec2], min_angle_deg: f64) -> usize {
+        let before = self.cdt.num_vertices();
+        let mut faces = std::collections::HashSet::new();
+        for p in points {
+            if let spade::PositionInTriangulation::OnFace(f) =
+                self.cdt.locate(Point2::new(p.x, p.y))
+            {
+                faces.insert(f);
+            }
+        }
+        if faces.is_empty() {
+            return 0;
+        }
+        let smallest = faces
+            .iter()
+            .map(|&f| self.cdt.face(f).area())
+            .fold(f64::INFINITY, f64::min);
+        let splits = split_points(&self.cdt, |face| faces.contains(&face.fix()));
+        for p in splits {
+            // Only positions spade cannot represent fail; skipping one costs a split.
+            let _ = self.cdt.insert(Point2::new(p.x, p.y));
+        }
+        let mut cdt = std::mem::take(&mut self.cdt);
+        let budget = cdt.num_vertices();
+        self.refine_cdt(&mut cdt, min_angle_deg, None, smallest, budget);
+        self.cdt = cdt;
+        self.find_outside();
+        self.cdt.num_vertices() - before
     }
 
     /// The area bound that leaves about `target` triangles in a refinement of the polygon.
@@ -310,6 +325,39 @@ impl SurfaceTriangulation {
     pub fn into_mesh(self, id: SurfaceId, surface: &Surface) -> SurfaceMesh {
         extract(id, surface, self.coords, &self.cdt, &self.outside)
     }
+}
+
+type Face<'a> = spade::handles::FaceHandle<'a, InnerTag, Point2<f64>, (), spade::CdtEdge<()>, ()>;
+
+fn face_centroid(face: Face<'_>) -> DVec2 {
+    let [a, b, c] = face.positions().map(|p| DVec2::new(p.x, p.y));
+    (a + b + c) / 3.0
+}
+
+/// Where to split each face for which `wants` holds: the midpoint of its longest edge (shared
+/// with the neighbour across it, once), or its centroid when that edge is a constraint or on the
+/// hull. Longest-edge bisection keeps the triangles' shapes.
+fn split_points(cdt: &Cdt, wants: impl Fn(Face<'_>) -> bool) -> Vec<DVec2> {
+    let mut split_edges = std::collections::HashSet::new();
+    let mut points = Vec::new();
+    for face in cdt.inner_faces() {
+        if !wants(face) {
+            continue;
+        }
+        let longest = face
+            .adjacent_edges()
+            .into_iter()
+            .max_by(|e, f| e.length_2().total_cmp(&f.length_2()))
+            .expect("a face has three edges");
+        let undirected = longest.as_undirected();
+        if undirected.is_constraint_edge() || undirected.is_part_of_convex_hull() {
+            points.push(face_centroid(face));
+        } else if split_edges.insert(undirected.fix()) {
+            let [p, q] = undirected.positions();
+            points.push(DVec2::new(0.5 * (p.x + q.x), 0.5 * (p.y + q.y)));
+        }
+    }
+    points
 }
 
 /// Faces whose centroid lies outside the polygon (exact even-odd test). Faces never straddle the
