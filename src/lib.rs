@@ -4,6 +4,7 @@
 //! light, progressive refinement, render — and the files it writes. The `penumbra` binary is a
 //! thin command line around it.
 
+pub mod adaptive;
 pub mod outputs;
 pub mod pipeline;
 pub mod progress_bar;

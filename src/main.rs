@@ -62,6 +62,17 @@ struct RunArgs {
     /// in full light or full shadow (1: no grading).
     #[arg(long, default_value_t = DEFAULT_PENUMBRA_DENSITY)]
     penumbra_density: f64,
+    /// Adaptive refinement: start from a coarser mesh and split, round after round, the triangles
+    /// whose interpolation misses the exact direct light by more than this fraction of the
+    /// scene's mean radiosity, up to --max-elements.
+    #[arg(long)]
+    refine_tol: Option<f64>,
+    /// With --refine-tol: triangles of the starting mesh (default: a quarter of --max-elements).
+    #[arg(long)]
+    initial_elements: Option<usize>,
+    /// With --refine-tol: rounds of refinement at most.
+    #[arg(long, default_value_t = 16)]
+    refine_rounds: usize,
     /// Discontinuity meshes: leave out EEE events (emitter edge with two blocker edges).
     #[arg(long)]
     no_eee: bool,
@@ -182,6 +193,13 @@ fn run(args: &RunArgs) -> Result<(), Failure> {
             args.penumbra_density
         )));
     }
+    if let Some(tol) = args.refine_tol
+        && !(tol > 0.0 && tol.is_finite())
+    {
+        return Err(usage(anyhow::anyhow!(
+            "--refine-tol must be a positive number, not {tol}"
+        )));
+    }
     if args.width == 0 || args.height == 0 {
         return Err(usage(anyhow::anyhow!(
             "--width and --height must be at least 1"
@@ -201,6 +219,13 @@ fn run(args: &RunArgs) -> Result<(), Failure> {
         },
         max_elements: args.max_elements,
         penumbra_density: args.penumbra_density,
+        refine: args
+            .refine_tol
+            .map(|tolerance| penumbra::adaptive::RefineOptions {
+                tolerance,
+                initial_elements: args.initial_elements.unwrap_or(args.max_elements / 4),
+                max_rounds: args.refine_rounds,
+            }),
         discontinuity: penumbra_meshing::discontinuity::DiscontinuityOptions {
             eee: !args.no_eee,
             ..Default::default()

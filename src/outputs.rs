@@ -81,6 +81,9 @@ struct Report<'a> {
     method: Method,
     counts: Counts,
     discontinuities: Option<&'a penumbra_meshing::discontinuity::DiscontinuityStats>,
+    /// Adaptive refinement: rounds, residuals and why it stopped (absent when not asked for).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    refinement: Option<&'a crate::adaptive::RefineReport>,
     times_seconds: &'a StageTimes,
     solver: &'a SolveStats,
     energy: Energy,
@@ -190,6 +193,7 @@ pub fn report_json(result: &RunResult) -> String {
             discontinuity_segments: result.mesh.segment_count(),
         },
         discontinuities: result.mesh.discontinuity_stats.as_ref(),
+        refinement: result.refinement.as_ref(),
         times_seconds: &result.times,
         solver: stats,
         energy: Energy {

@@ -3,6 +3,7 @@
 
 use std::time::Instant;
 
+use crate::adaptive::{RefineOptions, RefineReport, refine_adaptively};
 use penumbra_meshing::discontinuity::{DiscontinuityOptions, find_discontinuities};
 use penumbra_meshing::grading::DEFAULT_PENUMBRA_DENSITY;
 use penumbra_meshing::{MeshError, SceneMesh, mesh_scene_discontinuity, mesh_scene_uniform};
@@ -34,6 +35,8 @@ pub struct RunOptions {
     pub penumbra_density: f64,
     /// How discontinuities are found (EEE events on or off, tolerances).
     pub discontinuity: DiscontinuityOptions,
+    /// Adaptive refinement from a coarser mesh up to `max_elements`, if asked for.
+    pub refine: Option<RefineOptions>,
     pub solver: SolverOptions,
     pub render: RenderOptions,
 }
@@ -45,6 +48,7 @@ impl Default for RunOptions {
             max_elements: DEFAULT_MAX_ELEMENTS,
             penumbra_density: DEFAULT_PENUMBRA_DENSITY,
             discontinuity: DiscontinuityOptions::default(),
+            refine: None,
             solver: SolverOptions::default(),
             render: RenderOptions::default(),
         }
@@ -57,6 +61,8 @@ pub struct StageTimes {
     pub visibility: f64,
     pub discontinuities: f64,
     pub mesh: f64,
+    /// Adaptive refinement, its direct solves included.
+    pub refine: f64,
     pub direct: f64,
     pub shooting: f64,
     pub render: f64,
@@ -69,6 +75,7 @@ pub struct RunResult {
     pub loaded: LoadedScene,
     pub options: RunOptions,
     pub mesh: SceneMesh,
+    pub refinement: Option<RefineReport>,
     pub solution: Solution,
     pub render: Render,
     pub times: StageTimes,
@@ -124,20 +131,36 @@ pub fn run(
 
     let t = Instant::now();
     progress.start("meshing", 1);
-    let mesh = match found {
+    let initial = options.refine.as_ref().map_or(options.max_elements, |r| {
+        r.initial_elements.min(options.max_elements)
+    });
+    let mut mesh = match found {
         Some(found) if options.mesh == MeshMethod::Discontinuity || found.stats.segments > 0 => {
-            mesh_scene_discontinuity(
-                scene,
-                &visibility,
-                found,
-                options.max_elements,
-                options.penumbra_density,
-            )?
+            mesh_scene_discontinuity(scene, &visibility, found, initial, options.penumbra_density)?
         }
-        _ => mesh_scene_uniform(scene, options.max_elements)?,
+        _ => mesh_scene_uniform(scene, initial)?,
     };
     progress.finish();
     times.mesh = t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
+    let refinement = match &options.refine {
+        Some(refine) => {
+            progress.start("adaptive refinement", 1);
+            let report = refine_adaptively(
+                scene,
+                &visibility,
+                &mut mesh,
+                options.max_elements,
+                refine,
+                &options.solver,
+            )?;
+            progress.finish();
+            Some(report)
+        }
+        None => None,
+    };
+    times.refine = t.elapsed().as_secs_f64();
 
     let solution = solve_progressive(scene, &mesh, &visibility, &options.solver, progress)?;
     times.direct = solution.stats.direct_seconds;
@@ -165,6 +188,7 @@ pub fn run(
         loaded,
         options: options.clone(),
         mesh,
+        refinement,
         solution,
         render,
         times,

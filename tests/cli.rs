@@ -250,3 +250,42 @@ fn solutions_are_byte_identical_whatever_the_thread_count() {
     }
     assert!(solutions.windows(2).all(|w| w[0] == w[1]));
 }
+
+/// `--refine-tol` refines adaptively from a quarter of the budget and says how in `report.json`;
+/// a tolerance that is not positive is a usage error.
+#[test]
+fn adaptive_refinement_is_reported() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("out");
+    let o = penumbra(&[
+        "run",
+        "textbook",
+        "--out",
+        out.to_str().expect("utf-8"),
+        "--direct-only",
+        "--max-elements",
+        "8000",
+        "--refine-tol",
+        "0.001",
+        "--quiet",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let report = json(&out.join("report.json"));
+    let refinement = &report["refinement"];
+    let rounds = refinement["rounds"].as_array().expect("rounds");
+    assert!(rounds.len() >= 2, "{refinement}");
+    let first = rounds[0]["triangles"].as_u64().expect("count");
+    let last = report["counts"]["triangles"].as_u64().expect("count");
+    assert!(
+        first <= 2000 && last > first && last <= 8000,
+        "{first} -> {last}"
+    );
+    assert!(refinement["stop"].is_string());
+    assert!(refinement["residual"]["max"].as_f64().expect("max") > 0.0);
+    assert_eq!(
+        penumbra(&["run", "textbook", "--refine-tol", "0"])
+            .status
+            .code(),
+        Some(2)
+    );
+}

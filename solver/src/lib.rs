@@ -22,6 +22,7 @@ pub mod coupling;
 pub mod direct;
 pub mod elements;
 pub mod error;
+pub mod estimate;
 pub mod lambert;
 pub mod measure;
 pub mod progress;

@@ -1,0 +1,112 @@
+//! Adaptive refinement: every round leaves a sane mesh with every discontinuity still a chain of
+//! edges, the budget holds, and the error against the exact direct light falls.
+
+use penumbra::adaptive::{RefineOptions, RefineStop, refine_adaptively};
+use penumbra_meshing::discontinuity::{DiscontinuityOptions, find_discontinuities};
+use penumbra_meshing::{SceneMesh, mesh_scene_discontinuity, mesh_scene_uniform};
+use penumbra_scenes::{Scene, Visibility, builtin};
+use penumbra_solver::measure::direct_interpolation_error;
+use penumbra_solver::{DirectLight, NoProgress, SolverOptions, solve_progressive};
+
+fn floor_rms(scene: &Scene, vis: &Visibility, mesh: &SceneMesh) -> f64 {
+    let options = SolverOptions {
+        direct_only: true,
+        ..SolverOptions::default()
+    };
+    let solution = solve_progressive(scene, mesh, vis, &options, &NoProgress).expect("solves");
+    let direct = DirectLight::new(scene, vis);
+    let r = scene.surface_id("floor").expect("floor");
+    let e = direct_interpolation_error(
+        scene,
+        &direct,
+        &mesh.surfaces[r],
+        &solution.radiosity[r],
+        10_000,
+        7,
+    );
+    e.rms / e.mean_exact
+}
+
+/// Round by round (one round per call), on discontinuity and uniform meshes of the Cornell box
+/// and the textbook scene: sane meshes with all constraints, within budget, error falling.
+#[test]
+fn rounds_keep_meshes_sane_and_cut_the_error() {
+    for scene in [builtin::textbook(), builtin::cornell()] {
+        let vis = Visibility::build(&scene);
+        for discontinuity in [true, false] {
+            let mut mesh = if discontinuity {
+                let found = find_discontinuities(&scene, &vis, &DiscontinuityOptions::default());
+                mesh_scene_discontinuity(&scene, &vis, found, 2_000, 8.0).expect("meshes")
+            } else {
+                mesh_scene_uniform(&scene, 2_000).expect("meshes")
+            };
+            let constraints: usize = mesh.surfaces.iter().map(|m| m.constraints.len()).sum();
+            let before = floor_rms(&scene, &vis, &mesh);
+            let budget = 8_000;
+            for round in 0..4 {
+                let report = refine_adaptively(
+                    &scene,
+                    &vis,
+                    &mut mesh,
+                    budget,
+                    &RefineOptions {
+                        tolerance: 1e-4,
+                        initial_elements: 2_000,
+                        max_rounds: 1,
+                    },
+                    &SolverOptions::default(),
+                )
+                .expect("refines");
+                mesh.sanity_check()
+                    .unwrap_or_else(|e| panic!("{} round {round}: {e}", scene.name));
+                assert!(mesh.triangle_count() <= budget);
+                // Constraints are split, never lost: the sanity check covers each one.
+                let now: usize = mesh.surfaces.iter().map(|m| m.constraints.len()).sum();
+                assert_eq!(now, constraints);
+                if report.stop == RefineStop::Budget {
+                    break;
+                }
+            }
+            let after = floor_rms(&scene, &vis, &mesh);
+            eprintln!(
+                "{} discontinuity={discontinuity}: floor RMS {:.3} % -> {:.3} % at {} triangles",
+                scene.name,
+                100.0 * before,
+                100.0 * after,
+                mesh.triangle_count()
+            );
+            assert!(
+                after < 0.7 * before,
+                "{}: floor RMS {before:e} -> {after:e}",
+                scene.name
+            );
+        }
+    }
+}
+
+/// With a loose tolerance refinement stops on its own, below the budget, with every residual
+/// under the tolerance.
+#[test]
+fn a_met_tolerance_stops_refinement() {
+    let scene = builtin::textbook();
+    let vis = Visibility::build(&scene);
+    let found = find_discontinuities(&scene, &vis, &DiscontinuityOptions::default());
+    let mut mesh = mesh_scene_discontinuity(&scene, &vis, found, 3_000, 8.0).expect("meshes");
+    let report = refine_adaptively(
+        &scene,
+        &vis,
+        &mut mesh,
+        30_000,
+        &RefineOptions {
+            tolerance: 2e-3,
+            initial_elements: 3_000,
+            max_rounds: 20,
+        },
+        &SolverOptions::default(),
+    )
+    .expect("refines");
+    assert_eq!(report.stop, RefineStop::Tolerance, "{report:#?}");
+    assert!(mesh.triangle_count() < 30_000);
+    assert!(report.residual.max <= 2e-3 * report.residual.mean_radiosity);
+    assert!(report.rounds.len() >= 2, "{report:#?}");
+}
