@@ -10,6 +10,21 @@ fn penumbra(args: &[&str]) -> Output {
         .expect("the penumbra binary runs")
 }
 
+/// `penumbra run SCENE --out OUT --quiet` with `extra` options; fails the test unless it succeeds.
+fn run_quietly(scene: &str, out: &Path, extra: &[&str]) -> Output {
+    let mut args = vec![
+        "run",
+        scene,
+        "--out",
+        out.to_str().expect("utf-8"),
+        "--quiet",
+    ];
+    args.extend(extra);
+    let o = penumbra(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    o
+}
+
 fn json(path: &Path) -> serde_json::Value {
     let text = std::fs::read_to_string(path).expect("output file exists");
     serde_json::from_str(&text).expect("output is valid JSON")
@@ -40,16 +55,7 @@ fn check_radiosity(solution: &serde_json::Value) -> usize {
 fn run_writes_every_output() {
     let dir = tempfile::tempdir().expect("temp dir");
     let out = dir.path().join("out");
-    let o = penumbra(&[
-        "run",
-        "textbook",
-        "--out",
-        out.to_str().expect("utf-8"),
-        "--max-elements",
-        "1500",
-        "--quiet",
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = run_quietly("textbook", &out, &["--max-elements", "1500"]);
     assert!(o.stdout.is_empty(), "--quiet prints nothing");
 
     let solution = json(&out.join("solution.json"));
@@ -179,19 +185,9 @@ fn eee_events_are_reported_and_can_be_left_out() {
     let mut counts = Vec::new();
     for (name, extra) in [("with", None), ("without", Some("--no-eee"))] {
         let out = dir.path().join(name);
-        let mut args = vec![
-            "run",
-            "bars",
-            "--out",
-            out.to_str().expect("utf-8"),
-            "--direct-only",
-            "--max-elements",
-            "3000",
-            "--quiet",
-        ];
+        let mut args = vec!["--direct-only", "--max-elements", "3000"];
         args.extend(extra);
-        let o = penumbra(&args);
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        run_quietly("bars", &out, &args);
         let report = json(&out.join("report.json"));
         let events = report["discontinuities"]["eee_events"]
             .as_u64()
@@ -257,19 +253,17 @@ fn solutions_are_byte_identical_whatever_the_thread_count() {
 fn adaptive_refinement_is_reported() {
     let dir = tempfile::tempdir().expect("temp dir");
     let out = dir.path().join("out");
-    let o = penumbra(&[
-        "run",
+    run_quietly(
         "textbook",
-        "--out",
-        out.to_str().expect("utf-8"),
-        "--direct-only",
-        "--max-elements",
-        "8000",
-        "--refine-tol",
-        "0.001",
-        "--quiet",
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        &out,
+        &[
+            "--direct-only",
+            "--max-elements",
+            "8000",
+            "--refine-tol",
+            "0.001",
+        ],
+    );
     let report = json(&out.join("report.json"));
     let refinement = &report["refinement"];
     let rounds = refinement["rounds"].as_array().expect("rounds");
