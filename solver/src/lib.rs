@@ -25,6 +25,7 @@ pub mod error;
 pub mod estimate;
 pub mod lambert;
 pub mod measure;
+pub mod path_trace;
 pub mod progress;
 pub mod progressive;
 

@@ -1,0 +1,172 @@
+//! A Monte Carlo reference for full (multi-bounce) solutions: radiosity at any surface point by
+//! path tracing, with the exact direct light at every bounce and Russian roulette.
+//!
+//! B(x) = E(x) + ρ(x) H(x), and the irradiance H splits into the direct part, exact from the
+//! emitters' visible outlines ([`DirectLight`]), and light reflected by other surfaces. A path
+//! leaves x in a cosine-distributed direction and finds the surface y it sees; ρ(y) H(y) is what
+//! y sends back, so the estimate of H(x) collects the exact direct irradiance at every vertex of
+//! the path, weighted by the product of the reflectances on the way. Paths end on leaving the
+//! scene, on reaching a surface's back (surfaces are one-sided), or by Russian roulette.
+//! Every point has its own seeded random stream, so results do not depend on thread count.
+
+use glam::DVec3;
+use penumbra_scenes::rng::SplitMix64;
+use penumbra_scenes::{PlaneFrame, Rgb, Scene, SurfaceId, Visibility};
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::direct::DirectLight;
+use crate::lambert::ReceivingPoint;
+
+/// Paths whose throughput falls below this play Russian roulette with it as survival chance.
+const ROULETTE_BELOW: f64 = 0.5;
+/// Bounces at most (a path this long carries ρ^64 of its light: nothing).
+const MAX_BOUNCES: usize = 64;
+
+/// How the reference is computed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PathTraceOptions {
+    /// Paths per point.
+    pub paths: usize,
+    pub seed: u64,
+}
+
+impl Default for PathTraceOptions {
+    fn default() -> Self {
+        PathTraceOptions {
+            paths: 4096,
+            seed: 1,
+        }
+    }
+}
+
+/// A point's radiosity and the standard error of its estimate (channel means).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct ReferenceValue {
+    pub radiosity: Rgb,
+    pub standard_error: f64,
+}
+
+/// Path-traced radiosity at surface points.
+pub struct PathTracer<'a> {
+    scene: &'a Scene,
+    visibility: &'a Visibility,
+    direct: DirectLight<'a>,
+    frames: Vec<Option<PlaneFrame>>,
+    /// Rays start this far off their surface, and hits this close to the start are ignored.
+    offset: f64,
+}
+
+impl std::fmt::Debug for PathTracer<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("PathTracer")
+            .field("scene", &self.scene.name)
+            .field("offset", &self.offset)
+            .finish()
+    }
+}
+
+impl<'a> PathTracer<'a> {
+    pub fn new(scene: &'a Scene, visibility: &'a Visibility) -> PathTracer<'a> {
+        PathTracer {
+            scene,
+            visibility,
+            direct: DirectLight::new(scene, visibility),
+            frames: scene
+                .surfaces
+                .iter()
+                .map(|s| PlaneFrame::of_polygon(&s.polygon))
+                .collect(),
+            offset: visibility.contact_distance(),
+        }
+    }
+
+    /// Radiosity at each of `points` (point, surface), each from `options.paths` paths with its
+    /// own random stream keyed by the seed and the point's index.
+    pub fn radiosity(
+        &self,
+        points: &[(DVec3, SurfaceId)],
+        options: &PathTraceOptions,
+    ) -> Vec<ReferenceValue> {
+        points
+            .par_iter()
+            .enumerate()
+            .map(|(k, &(x, s))| {
+                let mut rng = SplitMix64::keyed(options.seed, &[k as u64]);
+                self.radiosity_at(x, s, options.paths.max(2), &mut rng)
+            })
+            .collect()
+    }
+
+    fn radiosity_at(
+        &self,
+        x: DVec3,
+        s: SurfaceId,
+        paths: usize,
+        rng: &mut SplitMix64,
+    ) -> ReferenceValue {
+        let surface = &self.scene.surfaces[s];
+        let (mut sum, mut sum2) = (Rgb::ZERO, 0.0);
+        for _ in 0..paths {
+            let h = self.irradiance_sample(x, s, rng);
+            let b = surface.emission + surface.reflectance.mul_rgb(h);
+            sum += b;
+            sum2 += b.mean() * b.mean();
+        }
+        let n = paths as f64;
+        let mean = sum * (1.0 / n);
+        let variance = ((sum2 / n - mean.mean() * mean.mean()) * n / (n - 1.0)).max(0.0);
+        ReferenceValue {
+            radiosity: mean,
+            standard_error: (variance / n).sqrt(),
+        }
+    }
+
+    /// One path's estimate of the irradiance at `x` on surface `s`.
+    fn irradiance_sample(&self, mut x: DVec3, mut s: SurfaceId, rng: &mut SplitMix64) -> Rgb {
+        let mut h = Rgb::ZERO;
+        let mut throughput = Rgb::splat(1.0);
+        for _ in 0..MAX_BOUNCES {
+            let Some(frame) = self.frames[s] else { break };
+            h += throughput.mul_rgb(
+                self.direct
+                    .irradiance(&ReceivingPoint::interior(x, frame.normal), s),
+            );
+            // Cosine-distributed direction about the normal.
+            let (r1, r2) = (rng.next_f64(), rng.next_f64());
+            let (sin_phi, cos_phi) = (2.0 * std::f64::consts::PI * r1).sin_cos();
+            let radius = r2.sqrt();
+            let d = frame.u * (radius * cos_phi)
+                + frame.v * (radius * sin_phi)
+                + frame.normal * (1.0 - r2).max(0.0).sqrt();
+            let start = x + frame.normal * self.offset;
+            let Some(hit) =
+                self.visibility
+                    .closest_hit(start, d, self.offset, f64::INFINITY, Some(s))
+            else {
+                break;
+            };
+            let Some(hit_frame) = self.frames[hit.surface] else {
+                break;
+            };
+            // Arriving at a surface's back: nothing comes back from there.
+            if d.dot(hit_frame.normal) >= 0.0 {
+                break;
+            }
+            throughput = throughput.mul_rgb(self.scene.surfaces[hit.surface].reflectance);
+            let strongest = throughput.r.max(throughput.g).max(throughput.b);
+            if strongest <= 0.0 {
+                break;
+            }
+            if strongest < ROULETTE_BELOW {
+                if rng.next_f64() >= strongest {
+                    break;
+                }
+                throughput *= 1.0 / strongest;
+            }
+            x = hit.point;
+            s = hit.surface;
+        }
+        h
+    }
+}
