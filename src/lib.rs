@@ -8,5 +8,6 @@ pub mod adaptive;
 pub mod outputs;
 pub mod pipeline;
 pub mod progress_bar;
+pub mod sweep;
 
 pub use pipeline::{DEFAULT_MAX_ELEMENTS, MeshMethod, RunError, RunOptions, RunResult, run};

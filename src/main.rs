@@ -27,6 +27,10 @@ struct Cli {
 enum Command {
     /// Mesh, solve and render a scene; write solution.json, report.json, render.png and SVGs.
     Run(RunArgs),
+    /// Run uniform, uniform + adaptive, discontinuity and discontinuity + adaptive meshes over a
+    /// ladder of element budgets and score each against a reference; write sweep.csv and
+    /// sweep.json.
+    Sweep(SweepArgs),
     /// List the built-in scenes.
     Scenes,
     /// Load and validate a scene, reporting every problem at once.
@@ -108,6 +112,35 @@ struct RunArgs {
     quiet: bool,
 }
 
+#[derive(clap::Args, Debug)]
+struct SweepArgs {
+    /// A .json or .obj file, or the name of a built-in scene.
+    scene: String,
+    /// Output directory.
+    #[arg(long, default_value = "sweep")]
+    out: PathBuf,
+    /// Element budgets, comma-separated.
+    #[arg(long, value_delimiter = ',', default_values_t = [2500, 5000, 10000, 20000, 30000])]
+    budgets: Vec<usize>,
+    /// Tolerance of the adaptive runs at the first budget, relative to the scene's mean
+    /// radiosity; it shrinks in proportion as the budget grows.
+    #[arg(long, default_value_t = 1e-3)]
+    refine_tol: f64,
+    /// Sample points the runs are scored at.
+    #[arg(long, default_value_t = 4000)]
+    samples: usize,
+    /// Seed of the sample points.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Direct light only, scored against the exact evaluator (required: full solutions need the
+    /// path-traced reference, which sweeps do not compute yet).
+    #[arg(long)]
+    direct_only: bool,
+    /// No progress bar and no table.
+    #[arg(long)]
+    quiet: bool,
+}
+
 /// A failure, and whether it was the user's input (exit 2) or the run (exit 1).
 struct Failure {
     error: anyhow::Error,
@@ -151,7 +184,77 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
         }
         Command::Check { scene } => check(&scene),
         Command::Run(args) => run(&args),
+        Command::Sweep(args) => sweep(&args),
     }
+}
+
+fn sweep(args: &SweepArgs) -> Result<(), Failure> {
+    if !args.direct_only {
+        return Err(usage(anyhow::anyhow!(
+            "sweeps of full solutions need the path-traced reference, which is not computed yet: \
+             pass --direct-only"
+        )));
+    }
+    if args.budgets.is_empty() || args.samples == 0 {
+        return Err(usage(anyhow::anyhow!(
+            "--budgets and --samples must not be empty"
+        )));
+    }
+    if !(args.refine_tol > 0.0 && args.refine_tol.is_finite()) {
+        return Err(usage(anyhow::anyhow!(
+            "--refine-tol must be a positive number, not {}",
+            args.refine_tol
+        )));
+    }
+    let loaded = load(&args.scene)?;
+    let options = penumbra::sweep::SweepOptions {
+        budgets: args.budgets.clone(),
+        refine_tol: args.refine_tol,
+        samples: args.samples,
+        seed: args.seed,
+        solver: SolverOptions {
+            direct_only: true,
+            ..SolverOptions::default()
+        },
+    };
+    let bars = Bars::new(args.quiet);
+    let result = penumbra::sweep::sweep(&loaded, &options, &bars).map_err(|e| {
+        if e.is_usage() {
+            usage(e)
+        } else {
+            Failure::from(e)
+        }
+    })?;
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    let csv = penumbra::sweep::sweep_csv(&result);
+    penumbra::outputs::write_atomic(&args.out.join("sweep.csv"), csv.as_bytes())?;
+    let json = serde_json::to_string_pretty(&result)?;
+    penumbra::outputs::write_atomic(&args.out.join("sweep.json"), json.as_bytes())?;
+    if !args.quiet {
+        println!(
+            "{}: {} samples ({} in penumbrae), reference mean {:.4e}",
+            result.scene, result.samples, result.penumbra_samples, result.reference_mean
+        );
+        println!(
+            "{:<24} {:>8} {:>9} {:>9} {:>10} {:>10} {:>12}",
+            "method", "budget", "triangles", "seconds", "rms", "max", "penumbra rms"
+        );
+        for r in &result.rows {
+            println!(
+                "{:<24} {:>8} {:>9} {:>9.3} {:>9.4}% {:>9.3}% {:>11.4}%",
+                r.method,
+                r.max_elements,
+                r.triangles,
+                r.seconds,
+                100.0 * r.rms,
+                100.0 * r.max,
+                100.0 * r.penumbra_rms
+            );
+        }
+        println!("wrote sweep.csv and sweep.json to {}", args.out.display());
+    }
+    Ok(())
 }
 
 fn load(spec: &str) -> Result<penumbra_scenes::LoadedScene, Failure> {

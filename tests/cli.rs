@@ -283,3 +283,47 @@ fn adaptive_refinement_is_reported() {
         Some(2)
     );
 }
+
+/// `penumbra sweep` runs the four methods per budget and writes a row for each, in CSV and JSON;
+/// without `--direct-only` it says what is missing and exits 2.
+#[test]
+fn sweep_writes_a_row_per_method_and_budget() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("sweep");
+    let o = penumbra(&[
+        "sweep",
+        "textbook",
+        "--direct-only",
+        "--budgets",
+        "800,1600",
+        "--samples",
+        "400",
+        "--out",
+        out.to_str().expect("utf-8"),
+        "--quiet",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let csv = std::fs::read_to_string(out.join("sweep.csv")).expect("sweep.csv");
+    assert_eq!(csv.lines().count(), 1 + 2 * 4, "{csv}");
+    let sweep = json(&out.join("sweep.json"));
+    let rows = sweep["rows"].as_array().expect("rows");
+    assert_eq!(rows.len(), 8);
+    for r in rows {
+        let rms = r["rms"].as_f64().expect("rms");
+        assert!(rms.is_finite() && rms >= 0.0 && rms <= r["max"].as_f64().expect("max"));
+        assert!(
+            r["triangles"].as_u64().expect("count") <= r["max_elements"].as_u64().expect("budget")
+        );
+    }
+    // At the larger budget, the discontinuity mesh beats the uniform one.
+    let rms_of = |method: &str| {
+        rows.iter()
+            .find(|r| r["method"] == method && r["max_elements"] == 1600)
+            .and_then(|r| r["rms"].as_f64())
+            .expect("row")
+    };
+    assert!(rms_of("discontinuity") < rms_of("uniform"));
+    let o = penumbra(&["sweep", "textbook", "--out", out.to_str().expect("utf-8")]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--direct-only"));
+}

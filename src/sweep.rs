@@ -1,0 +1,305 @@
+//! The speed/accuracy trade, measured: the same scene meshed four ways (uniform, uniform +
+//! adaptive, discontinuity, discontinuity + adaptive) over a ladder of element budgets, each run
+//! timed and scored against a reference at fixed sample points.
+//!
+//! The samples are seeded random points spread over the scene's surfaces by area. For direct-only
+//! runs the reference is the exact evaluator. Samples where some emitter is partly hidden form
+//! the penumbra subset, scored on its own.
+
+use glam::{DVec2, DVec3};
+use penumbra_meshing::SurfaceMesh;
+use penumbra_meshing::discontinuity::EmitterProbe;
+use penumbra_scenes::rng::SplitMix64;
+use penumbra_scenes::{LoadedScene, Rgb, Scene, SurfaceId, Visibility};
+use penumbra_solver::{DirectLight, Progress, ReceivingPoint, SolverOptions};
+use serde::Serialize;
+
+use crate::adaptive::RefineOptions;
+use crate::pipeline::{MeshMethod, RunError, RunOptions, run};
+
+/// What a sweep runs.
+#[derive(Clone, Debug)]
+pub struct SweepOptions {
+    /// Element budgets (`--max-elements` of each run).
+    pub budgets: Vec<usize>,
+    /// Tolerance of the adaptive runs at the first budget; it shrinks in proportion as the
+    /// budget grows, so that larger budgets are spent.
+    pub refine_tol: f64,
+    /// Sample points and their seed.
+    pub samples: usize,
+    pub seed: u64,
+    pub solver: SolverOptions,
+}
+
+/// One run of a sweep: its size, its time and its error. Errors are relative to the mean of the
+/// reference over the samples.
+#[derive(Clone, Debug, Serialize)]
+pub struct SweepRow {
+    pub method: &'static str,
+    pub max_elements: usize,
+    /// The adaptive runs' tolerance.
+    pub refine_tol: Option<f64>,
+    pub triangles: usize,
+    pub vertices: usize,
+    pub seconds: f64,
+    pub rms: f64,
+    pub max: f64,
+    pub penumbra_rms: f64,
+}
+
+/// A sweep's samples, reference and rows.
+#[derive(Clone, Debug, Serialize)]
+pub struct Sweep {
+    pub format: &'static str,
+    pub scene: String,
+    pub reference: &'static str,
+    pub samples: usize,
+    pub penumbra_samples: usize,
+    pub reference_mean: f64,
+    pub rows: Vec<SweepRow>,
+}
+
+/// A sample point on a surface.
+#[derive(Clone, Copy, Debug)]
+struct Sample {
+    point: DVec3,
+    surface: SurfaceId,
+    reference: f64,
+    penumbra: bool,
+}
+
+/// Runs the sweep. Only direct-only sweeps are scored so far; a full solution needs the
+/// path-traced reference at the samples.
+pub fn sweep(
+    loaded: &LoadedScene,
+    options: &SweepOptions,
+    progress: &dyn Progress,
+) -> Result<Sweep, RunError> {
+    let scene = &loaded.scene;
+    let visibility = Visibility::build(scene);
+    let samples = reference_samples(scene, &visibility, options.samples, options.seed);
+    let n = samples.len().max(1) as f64;
+    let mean = samples.iter().map(|s| s.reference).sum::<f64>() / n;
+    let methods = [
+        ("uniform", MeshMethod::Uniform, false),
+        ("uniform+adaptive", MeshMethod::Uniform, true),
+        ("discontinuity", MeshMethod::Discontinuity, false),
+        ("discontinuity+adaptive", MeshMethod::Discontinuity, true),
+    ];
+    let first = options.budgets.first().copied().unwrap_or(1);
+    let mut rows = Vec::new();
+    progress.start("sweep", (options.budgets.len() * methods.len()) as u64);
+    for &budget in &options.budgets {
+        for (name, mesh, adaptive) in methods {
+            let run_options = RunOptions {
+                mesh,
+                max_elements: budget,
+                refine: adaptive.then(|| RefineOptions {
+                    tolerance: options.refine_tol * first as f64 / budget.max(1) as f64,
+                    initial_elements: budget / 4,
+                    max_rounds: 16,
+                }),
+                solver: options.solver.clone(),
+                render: penumbra_viz::RenderOptions {
+                    width: 1,
+                    height: 1,
+                    ..Default::default()
+                },
+                ..RunOptions::default()
+            };
+            let result = run(loaded.clone(), &run_options, &penumbra_solver::NoProgress)?;
+            let (mut sum2, mut max, mut pen2, mut pen_n) = (0.0, 0.0f64, 0.0, 0usize);
+            let locators: Vec<Locator> = result.mesh.surfaces.iter().map(Locator::new).collect();
+            for s in &samples {
+                let value = locators[s.surface]
+                    .interpolate(
+                        &result.mesh.surfaces[s.surface],
+                        &result.solution.radiosity[s.surface],
+                        s.point,
+                    )
+                    .mean();
+                let e = value - s.reference;
+                sum2 += e * e;
+                max = max.max(e.abs());
+                if s.penumbra {
+                    pen2 += e * e;
+                    pen_n += 1;
+                }
+            }
+            let scale = mean.max(f64::MIN_POSITIVE);
+            rows.push(SweepRow {
+                method: name,
+                max_elements: budget,
+                refine_tol: run_options.refine.as_ref().map(|r| r.tolerance),
+                triangles: result.mesh.triangle_count(),
+                vertices: result.mesh.vertex_count(),
+                seconds: result.times.total - result.times.render,
+                rms: (sum2 / n).sqrt() / scale,
+                max: max / scale,
+                penumbra_rms: (pen2 / pen_n.max(1) as f64).sqrt() / scale,
+            });
+            progress.set(rows.len() as u64);
+        }
+    }
+    progress.finish();
+    Ok(Sweep {
+        format: "penumbra-sweep/1",
+        scene: scene.name.clone(),
+        reference: "exact direct light",
+        samples: samples.len(),
+        penumbra_samples: samples.iter().filter(|s| s.penumbra).count(),
+        reference_mean: mean,
+        rows,
+    })
+}
+
+/// Seeded points spread over the scene's surfaces by area (emitters left out), with the exact
+/// direct radiosity there and whether some emitter is partly hidden.
+fn reference_samples(
+    scene: &Scene,
+    visibility: &Visibility,
+    count: usize,
+    seed: u64,
+) -> Vec<Sample> {
+    let triangles: Vec<_> = visibility
+        .triangles()
+        .iter()
+        .filter(|t| !scene.surfaces[t.surface].is_emitter())
+        .collect();
+    let areas: Vec<f64> = triangles
+        .iter()
+        .map(|t| {
+            0.5 * (t.vertices[1] - t.vertices[0])
+                .cross(t.vertices[2] - t.vertices[0])
+                .length()
+        })
+        .collect();
+    let mut cumulative = Vec::with_capacity(areas.len());
+    let mut acc = 0.0;
+    for a in &areas {
+        acc += a;
+        cumulative.push(acc);
+    }
+    let direct = DirectLight::new(scene, visibility);
+    let probes: Vec<EmitterProbe> = scene
+        .emitters()
+        .map(|(e, _)| EmitterProbe::new(scene, e))
+        .collect();
+    let mut rng = SplitMix64::keyed(seed, &[]);
+    (0..count)
+        .filter_map(|_| {
+            let u = rng.next_f64() * acc;
+            let k = cumulative
+                .partition_point(|&c| c < u)
+                .min(areas.len().checked_sub(1)?);
+            let t = triangles[k];
+            let (r1, r2) = (rng.next_f64().sqrt(), rng.next_f64());
+            let w = [1.0 - r1, r1 * (1.0 - r2), r1 * r2];
+            let point: DVec3 = (0..3).map(|j| t.vertices[j] * w[j]).sum();
+            let surface = &scene.surfaces[t.surface];
+            let normal = surface.normal();
+            let h = direct.irradiance(&ReceivingPoint::interior(point, normal), t.surface);
+            let reference = (surface.emission + surface.reflectance.mul_rgb(h)).mean();
+            let penumbra = probes.iter().any(|p| {
+                let f = p.visible_fraction(visibility, point, normal, t.surface);
+                f > 0.0 && f < 1.0
+            });
+            Some(Sample {
+                point,
+                surface: t.surface,
+                reference,
+                penumbra,
+            })
+        })
+        .collect()
+}
+
+/// Finds the triangle of a mesh that holds a point: triangles bucketed by their boxes on a grid
+/// over the mesh coordinates.
+struct Locator {
+    lo: DVec2,
+    cell: f64,
+    side: usize,
+    buckets: Vec<Vec<u32>>,
+}
+
+impl Locator {
+    fn new(mesh: &SurfaceMesh) -> Locator {
+        let (lo, hi) = mesh
+            .local
+            .iter()
+            .fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), &p| {
+                (lo.min(p), hi.max(p))
+            });
+        let side = ((mesh.triangles.len() as f64).sqrt().ceil() as usize).clamp(1, 512);
+        let cell = ((hi - lo).max_element() / side as f64).max(f64::MIN_POSITIVE);
+        let mut buckets = vec![Vec::new(); side * side];
+        let index = |x: f64| ((x / cell).floor().max(0.0) as usize).min(side - 1);
+        for (t, tri) in mesh.triangles.iter().enumerate() {
+            let p = tri.map(|i| mesh.local[i as usize] - lo);
+            let (a, b) = (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]));
+            for i in index(a.x)..=index(b.x) {
+                for j in index(a.y)..=index(b.y) {
+                    buckets[j * side + i].push(t as u32);
+                }
+            }
+        }
+        Locator {
+            lo,
+            cell,
+            side,
+            buckets,
+        }
+    }
+
+    /// The linear interpolation of `values` at `point` (3D, on the mesh's surface): in the
+    /// triangle that holds it, or the one it is least outside of.
+    fn interpolate(&self, mesh: &SurfaceMesh, values: &[Rgb], point: DVec3) -> Rgb {
+        let q = mesh.frame.to_2d(point) / mesh.scale;
+        let index = |x: f64| ((x / self.cell).floor().max(0.0) as usize).min(self.side - 1);
+        let bucket = &self.buckets[index(q.y - self.lo.y) * self.side + index(q.x - self.lo.x)];
+        let mut best: Option<(f64, [f64; 3], [u32; 3])> = None;
+        for &t in bucket {
+            let tri = mesh.triangles[t as usize];
+            let [a, b, c] = tri.map(|i| mesh.local[i as usize]);
+            let area = (b - a).perp_dot(c - a);
+            if area == 0.0 {
+                continue;
+            }
+            let w = [
+                (b - q).perp_dot(c - q) / area,
+                (c - q).perp_dot(a - q) / area,
+                (a - q).perp_dot(b - q) / area,
+            ];
+            let outside = -w.iter().copied().fold(f64::INFINITY, f64::min);
+            if best.is_none_or(|(o, _, _)| outside < o) {
+                best = Some((outside, w, tri));
+            }
+        }
+        best.map_or(Rgb::ZERO, |(_, w, tri)| {
+            (0..3).map(|k| values[tri[k] as usize] * w[k]).sum()
+        })
+    }
+}
+
+/// The sweep as CSV, a row per run.
+pub fn sweep_csv(sweep: &Sweep) -> String {
+    let mut out = String::from(
+        "method,max_elements,refine_tol,triangles,vertices,seconds,rms_relative,max_relative,penumbra_rms_relative\n",
+    );
+    for r in &sweep.rows {
+        out += &format!(
+            "{},{},{},{},{},{:.6},{:.6e},{:.6e},{:.6e}\n",
+            r.method,
+            r.max_elements,
+            r.refine_tol.map_or(String::new(), |t| format!("{t:e}")),
+            r.triangles,
+            r.vertices,
+            r.seconds,
+            r.rms,
+            r.max,
+            r.penumbra_rms
+        );
+    }
+    out
+}
