@@ -126,16 +126,19 @@ struct SweepArgs {
     /// radiosity; it shrinks in proportion as the budget grows.
     #[arg(long, default_value_t = 1e-3)]
     refine_tol: f64,
-    /// Sample points the runs are scored at.
-    #[arg(long, default_value_t = 4000)]
-    samples: usize,
+    /// Sample points the runs are scored at (default: 4000 with --direct-only, else 1000).
+    #[arg(long)]
+    samples: Option<usize>,
     /// Seed of the sample points.
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// Direct light only, scored against the exact evaluator (required: full solutions need the
-    /// path-traced reference, which sweeps do not compute yet).
+    /// Direct light only, scored against the exact evaluator. Without it, full solutions are
+    /// scored against path tracing at the samples, cached in the output directory.
     #[arg(long)]
     direct_only: bool,
+    /// Paths per sample of the path-traced reference.
+    #[arg(long, default_value_t = 16_000)]
+    reference_paths: usize,
     /// No progress bar and no table.
     #[arg(long)]
     quiet: bool,
@@ -189,13 +192,10 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
 }
 
 fn sweep(args: &SweepArgs) -> Result<(), Failure> {
-    if !args.direct_only {
-        return Err(usage(anyhow::anyhow!(
-            "sweeps of full solutions need the path-traced reference, which is not computed yet: \
-             pass --direct-only"
-        )));
-    }
-    if args.budgets.is_empty() || args.samples == 0 {
+    let sample_count = args
+        .samples
+        .unwrap_or(if args.direct_only { 4000 } else { 1000 });
+    if args.budgets.is_empty() || sample_count == 0 {
         return Err(usage(anyhow::anyhow!(
             "--budgets and --samples must not be empty"
         )));
@@ -210,21 +210,32 @@ fn sweep(args: &SweepArgs) -> Result<(), Failure> {
     let options = penumbra::sweep::SweepOptions {
         budgets: args.budgets.clone(),
         refine_tol: args.refine_tol,
-        samples: args.samples,
+        samples: sample_count,
         seed: args.seed,
         solver: SolverOptions {
-            direct_only: true,
+            direct_only: args.direct_only,
             ..SolverOptions::default()
         },
     };
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    let scene = &loaded.scene;
+    let visibility = penumbra_scenes::Visibility::build(scene);
+    let samples = penumbra::sweep::sample_points(scene, &visibility, sample_count, args.seed);
+    let reference = if args.direct_only {
+        penumbra::sweep::Reference::ExactDirect
+    } else {
+        penumbra::sweep::Reference::PathTraced(traced_reference(args, &loaded, &samples)?)
+    };
     let bars = Bars::new(args.quiet);
-    let result = penumbra::sweep::sweep(&loaded, &options, &bars).map_err(|e| {
-        if e.is_usage() {
-            usage(e)
-        } else {
-            Failure::from(e)
-        }
-    })?;
+    let result =
+        penumbra::sweep::sweep(&loaded, &options, &samples, &reference, &bars).map_err(|e| {
+            if e.is_usage() {
+                usage(e)
+            } else {
+                Failure::from(e)
+            }
+        })?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
     let csv = penumbra::sweep::sweep_csv(&result);
@@ -233,8 +244,13 @@ fn sweep(args: &SweepArgs) -> Result<(), Failure> {
     penumbra::outputs::write_atomic(&args.out.join("sweep.json"), json.as_bytes())?;
     if !args.quiet {
         println!(
-            "{}: {} samples ({} in penumbrae), reference mean {:.4e}",
-            result.scene, result.samples, result.penumbra_samples, result.reference_mean
+            "{}: {} samples ({} in penumbrae), reference ({}) mean {:.4e}, standard error {:.3}%",
+            result.scene,
+            result.samples,
+            result.penumbra_samples,
+            result.reference,
+            result.reference_mean,
+            100.0 * result.reference_standard_error
         );
         println!(
             "{:<24} {:>8} {:>9} {:>9} {:>10} {:>10} {:>12}",
@@ -255,6 +271,72 @@ fn sweep(args: &SweepArgs) -> Result<(), Failure> {
         println!("wrote sweep.csv and sweep.json to {}", args.out.display());
     }
     Ok(())
+}
+
+/// The path-traced reference at the sweep's samples: read from `reference.json` in the output
+/// directory when it was traced for the same scene, samples, seed and paths, else traced and
+/// written there.
+fn traced_reference(
+    args: &SweepArgs,
+    loaded: &penumbra_scenes::LoadedScene,
+    samples: &[penumbra::sweep::Sample],
+) -> Result<Vec<penumbra_solver::path_trace::ReferenceValue>, Failure> {
+    #[derive(serde::Serialize, serde::Deserialize)]
+    struct Cached {
+        format: String,
+        scene: String,
+        source: String,
+        samples: usize,
+        seed: u64,
+        paths: usize,
+        values: Vec<penumbra_solver::path_trace::ReferenceValue>,
+    }
+    let path = args.out.join("reference.json");
+    let wanted = |c: &Cached| {
+        c.format == "penumbra-reference/1"
+            && c.scene == loaded.scene.name
+            && c.source == loaded.source
+            && c.samples == samples.len()
+            && c.seed == args.seed
+            && c.paths == args.reference_paths
+            && c.values.len() == samples.len()
+    };
+    if let Some(cached) = std::fs::read_to_string(&path)
+        .ok()
+        .and_then(|text| serde_json::from_str::<Cached>(&text).ok())
+        .filter(|c| wanted(c))
+    {
+        return Ok(cached.values);
+    }
+    if !args.quiet {
+        eprintln!(
+            "tracing the reference: {} samples x {} paths (cached in {})",
+            samples.len(),
+            args.reference_paths,
+            path.display()
+        );
+    }
+    let visibility = penumbra_scenes::Visibility::build(&loaded.scene);
+    let tracer = penumbra_solver::path_trace::PathTracer::new(&loaded.scene, &visibility);
+    let points: Vec<_> = samples.iter().map(|s| (s.point, s.surface)).collect();
+    let values = tracer.radiosity(
+        &points,
+        &penumbra_solver::path_trace::PathTraceOptions {
+            paths: args.reference_paths,
+            seed: args.seed,
+        },
+    );
+    let cached = Cached {
+        format: "penumbra-reference/1".into(),
+        scene: loaded.scene.name.clone(),
+        source: loaded.source.clone(),
+        samples: samples.len(),
+        seed: args.seed,
+        paths: args.reference_paths,
+        values,
+    };
+    penumbra::outputs::write_atomic(&path, serde_json::to_string(&cached)?.as_bytes())?;
+    Ok(cached.values)
 }
 
 fn load(spec: &str) -> Result<penumbra_scenes::LoadedScene, Failure> {

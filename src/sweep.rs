@@ -3,14 +3,16 @@
 //! timed and scored against a reference at fixed sample points.
 //!
 //! The samples are seeded random points spread over the scene's surfaces by area. For direct-only
-//! runs the reference is the exact evaluator. Samples where some emitter is partly hidden form
-//! the penumbra subset, scored on its own.
+//! runs the reference is the exact evaluator; for full solutions, path tracing at the samples
+//! ([`penumbra_solver::path_trace`]). Samples where some emitter is partly hidden form the
+//! penumbra subset, scored on its own.
 
 use glam::{DVec2, DVec3};
 use penumbra_meshing::SurfaceMesh;
 use penumbra_meshing::discontinuity::EmitterProbe;
 use penumbra_scenes::rng::SplitMix64;
 use penumbra_scenes::{LoadedScene, Rgb, Scene, SurfaceId, Visibility};
+use penumbra_solver::path_trace::ReferenceValue;
 use penumbra_solver::{DirectLight, Progress, ReceivingPoint, SolverOptions};
 use serde::Serialize;
 
@@ -29,6 +31,15 @@ pub struct SweepOptions {
     pub samples: usize,
     pub seed: u64,
     pub solver: SolverOptions,
+}
+
+/// What the runs are scored against.
+#[derive(Clone, Debug)]
+pub enum Reference {
+    /// The exact direct light (for direct-only runs).
+    ExactDirect,
+    /// Path-traced radiosity at the samples (for full solutions), in the samples' order.
+    PathTraced(Vec<ReferenceValue>),
 }
 
 /// One run of a sweep: its size, its time and its error. Errors are relative to the mean of the
@@ -53,33 +64,51 @@ pub struct Sweep {
     pub format: &'static str,
     pub scene: String,
     pub reference: &'static str,
+    /// Root mean square of the reference's standard errors relative to the mean (zero for the
+    /// exact direct light).
+    pub reference_standard_error: f64,
     pub samples: usize,
     pub penumbra_samples: usize,
     pub reference_mean: f64,
     pub rows: Vec<SweepRow>,
 }
 
-/// A sample point on a surface.
+/// A sample point on a surface, with the exact direct radiosity there (channel mean) and whether
+/// some emitter is partly hidden from it.
 #[derive(Clone, Copy, Debug)]
-struct Sample {
-    point: DVec3,
-    surface: SurfaceId,
-    reference: f64,
-    penumbra: bool,
+pub struct Sample {
+    pub point: DVec3,
+    pub surface: SurfaceId,
+    pub direct: f64,
+    pub penumbra: bool,
 }
 
-/// Runs the sweep. Only direct-only sweeps are scored so far; a full solution needs the
-/// path-traced reference at the samples.
+/// Runs the sweep at `samples` (from [`sample_points`]) against `reference`.
 pub fn sweep(
     loaded: &LoadedScene,
     options: &SweepOptions,
+    samples: &[Sample],
+    reference: &Reference,
     progress: &dyn Progress,
 ) -> Result<Sweep, RunError> {
     let scene = &loaded.scene;
-    let visibility = Visibility::build(scene);
-    let samples = reference_samples(scene, &visibility, options.samples, options.seed);
+    let values: Vec<f64> = match reference {
+        Reference::ExactDirect => samples.iter().map(|s| s.direct).collect(),
+        Reference::PathTraced(v) => v.iter().map(|r| r.radiosity.mean()).collect(),
+    };
     let n = samples.len().max(1) as f64;
-    let mean = samples.iter().map(|s| s.reference).sum::<f64>() / n;
+    let mean = values.iter().sum::<f64>() / n;
+    let reference_standard_error = match reference {
+        Reference::ExactDirect => 0.0,
+        Reference::PathTraced(v) => {
+            (v.iter()
+                .map(|r| r.standard_error * r.standard_error)
+                .sum::<f64>()
+                / n)
+                .sqrt()
+                / mean.max(f64::MIN_POSITIVE)
+        }
+    };
     let methods = [
         ("uniform", MeshMethod::Uniform, false),
         ("uniform+adaptive", MeshMethod::Uniform, true),
@@ -110,7 +139,7 @@ pub fn sweep(
             let result = run(loaded.clone(), &run_options, &penumbra_solver::NoProgress)?;
             let (mut sum2, mut max, mut pen2, mut pen_n) = (0.0, 0.0f64, 0.0, 0usize);
             let locators: Vec<Locator> = result.mesh.surfaces.iter().map(Locator::new).collect();
-            for s in &samples {
+            for (s, &reference) in samples.iter().zip(&values) {
                 let value = locators[s.surface]
                     .interpolate(
                         &result.mesh.surfaces[s.surface],
@@ -118,7 +147,7 @@ pub fn sweep(
                         s.point,
                     )
                     .mean();
-                let e = value - s.reference;
+                let e = value - reference;
                 sum2 += e * e;
                 max = max.max(e.abs());
                 if s.penumbra {
@@ -145,7 +174,11 @@ pub fn sweep(
     Ok(Sweep {
         format: "penumbra-sweep/1",
         scene: scene.name.clone(),
-        reference: "exact direct light",
+        reference: match reference {
+            Reference::ExactDirect => "exact direct light",
+            Reference::PathTraced(_) => "path traced",
+        },
+        reference_standard_error,
         samples: samples.len(),
         penumbra_samples: samples.iter().filter(|s| s.penumbra).count(),
         reference_mean: mean,
@@ -155,7 +188,7 @@ pub fn sweep(
 
 /// Seeded points spread over the scene's surfaces by area (emitters left out), with the exact
 /// direct radiosity there and whether some emitter is partly hidden.
-fn reference_samples(
+pub fn sample_points(
     scene: &Scene,
     visibility: &Visibility,
     count: usize,
@@ -199,7 +232,7 @@ fn reference_samples(
             let surface = &scene.surfaces[t.surface];
             let normal = surface.normal();
             let h = direct.irradiance(&ReceivingPoint::interior(point, normal), t.surface);
-            let reference = (surface.emission + surface.reflectance.mul_rgb(h)).mean();
+            let direct = (surface.emission + surface.reflectance.mul_rgb(h)).mean();
             let penumbra = probes.iter().any(|p| {
                 let f = p.visible_fraction(visibility, point, normal, t.surface);
                 f > 0.0 && f < 1.0
@@ -207,7 +240,7 @@ fn reference_samples(
             Some(Sample {
                 point,
                 surface: t.surface,
-                reference,
+                direct,
                 penumbra,
             })
         })

@@ -323,7 +323,59 @@ fn sweep_writes_a_row_per_method_and_budget() {
             .expect("row")
     };
     assert!(rms_of("discontinuity") < rms_of("uniform"));
-    let o = penumbra(&["sweep", "textbook", "--out", out.to_str().expect("utf-8")]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("--direct-only"));
+}
+
+/// Without `--direct-only` the sweep scores full solutions against path tracing at the samples,
+/// traced once and cached in the output directory.
+#[test]
+fn full_sweeps_trace_their_reference_once() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("sweep");
+    let args = [
+        "sweep",
+        "textbook",
+        "--budgets",
+        "600",
+        "--samples",
+        "60",
+        "--reference-paths",
+        "100",
+        "--out",
+        out.to_str().expect("utf-8"),
+        "--quiet",
+    ];
+    let o = penumbra(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let reference = std::fs::read(out.join("reference.json")).expect("cached reference");
+    let sweep = json(&out.join("sweep.json"));
+    assert_eq!(sweep["reference"], "path traced");
+    assert!(
+        sweep["reference_standard_error"]
+            .as_f64()
+            .expect("error")
+            .is_finite()
+    );
+    assert_eq!(sweep["rows"].as_array().expect("rows").len(), 4);
+    let first = std::fs::read(out.join("sweep.json")).expect("sweep.json");
+    // A second run reads the reference back, and the same runs give the same bytes.
+    let o = penumbra(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(
+        std::fs::read(out.join("reference.json")).expect("cached"),
+        reference
+    );
+    let second: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("sweep.json")).expect("sweep.json"))
+            .expect("json");
+    let first: serde_json::Value = serde_json::from_slice(&first).expect("json");
+    // Timings differ between runs; the errors do not.
+    let errors = |v: &serde_json::Value| -> Vec<f64> {
+        v["rows"]
+            .as_array()
+            .expect("rows")
+            .iter()
+            .map(|r| r["rms"].as_f64().expect("rms"))
+            .collect()
+    };
+    assert_eq!(errors(&first), errors(&second));
 }

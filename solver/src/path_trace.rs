@@ -41,7 +41,7 @@ impl Default for PathTraceOptions {
 }
 
 /// A point's radiosity and the standard error of its estimate (channel means).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, serde::Deserialize)]
 pub struct ReferenceValue {
     pub radiosity: Rgb,
     pub standard_error: f64,
