@@ -1,7 +1,7 @@
 //! The discrete model the solvers work on: receivers (mesh vertices), elements (mesh triangles)
 //! and patches (groups of neighbouring elements that shoot together, after Cohen et al. 1988).
 
-use std::collections::{BTreeMap, HashSet};
+use std::collections::{BTreeMap, HashMap, HashSet};
 
 use glam::{DVec2, DVec3};
 use penumbra_meshing::SceneMesh;
@@ -100,7 +100,14 @@ impl Discretization {
                     .min(DVec2::new(cells_x - 1.0, cells_y - 1.0));
                 cells.entry((k.x as i64, k.y as i64)).or_default().push(t);
             }
-            for triangles in cells.into_values() {
+            // A cell's triangles that share no vertex path (the two sides of a contact line, whose
+            // vertices are split) make separate patches: a patch shoots one radiosity, and the
+            // dark floor under a block must not dilute the lit floor beside it.
+            let pieces = cells
+                .into_values()
+                .flat_map(|triangles| connected_pieces(&triangles, m))
+                .collect::<Vec<_>>();
+            for triangles in pieces {
                 let patch = patches.len();
                 let first = elements.len();
                 for &t in &triangles {
@@ -168,6 +175,39 @@ impl Discretization {
             })
             .sum()
     }
+}
+
+/// Splits `triangles` (of mesh `m`) into groups connected through shared vertices, each in
+/// ascending order, groups ordered by their first triangle.
+fn connected_pieces(triangles: &[usize], m: &penumbra_meshing::SurfaceMesh) -> Vec<Vec<usize>> {
+    fn root(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    let mut parent: Vec<usize> = (0..triangles.len()).collect();
+    let mut owner: HashMap<u32, usize> = HashMap::new();
+    for (k, &t) in triangles.iter().enumerate() {
+        for &v in &m.triangles[t] {
+            match owner.get(&v) {
+                Some(&j) => {
+                    let (a, b) = (root(&mut parent, k), root(&mut parent, j));
+                    parent[a.max(b)] = a.min(b);
+                }
+                None => {
+                    owner.insert(v, k);
+                }
+            }
+        }
+    }
+    let mut groups: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
+    for (k, &t) in triangles.iter().enumerate() {
+        let r = root(&mut parent, k);
+        groups.entry(r).or_default().push(t);
+    }
+    groups.into_values().collect()
 }
 
 fn make_patch(
