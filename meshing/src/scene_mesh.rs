@@ -54,7 +54,9 @@ impl SceneMesh {
         surface: SurfaceId,
         triangles: &[usize],
     ) -> usize {
-        let mesh = &self.surfaces[surface];
+        let Some(mesh) = self.surfaces.get(surface) else {
+            return 0;
+        };
         let at: Vec<glam::DVec2> = triangles
             .iter()
             .filter_map(|&t| mesh.triangles.get(t))
@@ -65,9 +67,15 @@ impl SceneMesh {
                     / 3.0
             })
             .collect();
-        let added = self.refinable[surface].split_at(&at);
+        // A mesh put together without its triangulations cannot be refined.
+        let (Some(refinable), Some(s)) =
+            (self.refinable.get_mut(surface), scene.surfaces.get(surface))
+        else {
+            return 0;
+        };
+        let added = refinable.split_at(&at);
         if added > 0 {
-            self.surfaces[surface] = self.refinable[surface].mesh(&scene.surfaces[surface]);
+            self.surfaces[surface] = refinable.mesh(s);
         }
         added
     }
