@@ -33,6 +33,8 @@ pub enum RefineStop {
     Budget,
     /// The last round was run.
     Rounds,
+    /// The time budget ran out.
+    TimeBudget,
 }
 
 /// One round: the residuals found, and what was split.
@@ -104,6 +106,14 @@ pub fn refine_adaptively(
         }
         if round == options.max_rounds {
             rounds.push(this);
+            break;
+        }
+        if solver
+            .deadline
+            .is_some_and(|d| std::time::Instant::now() >= d)
+        {
+            rounds.push(this);
+            stop = RefineStop::TimeBudget;
             break;
         }
         // Largest share of the squared error (residual squared times area) first. A split adds

@@ -77,6 +77,10 @@ struct RunArgs {
     /// With --refine-tol: rounds of refinement at most.
     #[arg(long, default_value_t = 16)]
     refine_rounds: usize,
+    /// Stop adaptive refinement and shooting after this many seconds (from the start of the run)
+    /// and write the best solution so far; report.json says so.
+    #[arg(long)]
+    time_budget: Option<f64>,
     /// Discontinuity meshes: leave out EEE events (emitter edge with two blocker edges).
     #[arg(long)]
     no_eee: bool,
@@ -378,6 +382,13 @@ fn run(args: &RunArgs) -> Result<(), Failure> {
             args.penumbra_density
         )));
     }
+    if let Some(t) = args.time_budget
+        && !(t > 0.0 && t.is_finite())
+    {
+        return Err(usage(anyhow::anyhow!(
+            "--time-budget must be a positive number of seconds, not {t}"
+        )));
+    }
     if let Some(tol) = args.refine_tol
         && !(tol > 0.0 && tol.is_finite())
     {
@@ -404,6 +415,7 @@ fn run(args: &RunArgs) -> Result<(), Failure> {
         },
         max_elements: args.max_elements,
         penumbra_density: args.penumbra_density,
+        time_budget: args.time_budget,
         refine: args
             .refine_tol
             .map(|tolerance| penumbra::adaptive::RefineOptions {

@@ -37,6 +37,8 @@ pub struct RunOptions {
     pub discontinuity: DiscontinuityOptions,
     /// Adaptive refinement from a coarser mesh up to `max_elements`, if asked for.
     pub refine: Option<RefineOptions>,
+    /// Seconds after which refinement and shooting stop and the best solution so far is kept.
+    pub time_budget: Option<f64>,
     pub solver: SolverOptions,
     pub render: RenderOptions,
 }
@@ -49,6 +51,7 @@ impl Default for RunOptions {
             penumbra_density: DEFAULT_PENUMBRA_DENSITY,
             discontinuity: DiscontinuityOptions::default(),
             refine: None,
+            time_budget: None,
             solver: SolverOptions::default(),
             render: RenderOptions::default(),
         }
@@ -111,6 +114,14 @@ pub fn run(
 ) -> Result<RunResult, RunError> {
     options.solver.validate()?;
     let started = Instant::now();
+    // An anytime run: everything after meshing stops at the deadline.
+    let solver = SolverOptions {
+        deadline: options
+            .time_budget
+            .and_then(|seconds| std::time::Duration::try_from_secs_f64(seconds.max(0.0)).ok())
+            .and_then(|budget| started.checked_add(budget)),
+        ..options.solver.clone()
+    };
     let mut times = StageTimes::default();
     let scene = &loaded.scene;
 
@@ -153,7 +164,7 @@ pub fn run(
                 &mut mesh,
                 options.max_elements,
                 refine,
-                &options.solver,
+                &solver,
             )?;
             progress.finish();
             Some(report)
@@ -162,7 +173,7 @@ pub fn run(
     };
     times.refine = t.elapsed().as_secs_f64();
 
-    let solution = solve_progressive(scene, &mesh, &visibility, &options.solver, progress)?;
+    let solution = solve_progressive(scene, &mesh, &visibility, &solver, progress)?;
     times.direct = solution.stats.direct_seconds;
     times.shooting = solution.stats.shooting_seconds;
 

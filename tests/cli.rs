@@ -379,3 +379,31 @@ fn full_sweeps_trace_their_reference_once() {
     };
     assert_eq!(errors(&first), errors(&second));
 }
+
+/// `--time-budget` stops shooting when the time is spent and says so; the solution written is
+/// the best so far, with the unshot light reported. A budget that is not positive is a usage
+/// error.
+#[test]
+fn a_spent_time_budget_is_reported() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("out");
+    run_quietly(
+        "cornell",
+        &out,
+        &["--time-budget", "0.2", "--width", "64", "--height", "64"],
+    );
+    let report = json(&out.join("report.json"));
+    assert_eq!(report["solver"]["stop"], "time_budget");
+    assert_eq!(report["method"]["time_budget"].as_f64(), Some(0.2));
+    let unshot = report["energy"]["unshot_fraction"]
+        .as_f64()
+        .expect("fraction");
+    assert!(unshot > 1e-3, "{unshot}");
+    check_radiosity(&json(&out.join("solution.json")));
+    assert_eq!(
+        penumbra(&["run", "textbook", "--time-budget", "0"])
+            .status
+            .code(),
+        Some(2)
+    );
+}

@@ -42,6 +42,8 @@ pub struct SolverOptions {
     pub seed: u64,
     /// Memory allowed for caching vertex–patch form factors, in bytes.
     pub cache_bytes: usize,
+    /// Stop shooting at this moment, converged or not (an anytime solve).
+    pub deadline: Option<Instant>,
 }
 
 pub const DEFAULT_EPSILON: f64 = 1e-3;
@@ -56,6 +58,7 @@ impl Default for SolverOptions {
             direct_only: false,
             seed: 0x5EED,
             cache_bytes: 1 << 30,
+            deadline: None,
         }
     }
 }
@@ -88,6 +91,8 @@ pub enum StopReason {
     ShotLimit,
     /// Direct light only: one exact bounce, nothing to iterate.
     DirectOnly,
+    /// The time budget ran out: the solution is the best so far.
+    TimeBudget,
 }
 
 /// Figures of a solve. Powers are in W per channel (radiosity times area in scene units).
@@ -224,6 +229,9 @@ pub fn solve_progressive(
             }
             if shots >= options.max_shots {
                 break StopReason::ShotLimit;
+            }
+            if options.deadline.is_some_and(|d| Instant::now() >= d) {
+                break StopReason::TimeBudget;
             }
             // The patch with the most unshot power (ties: the lowest index).
             let Some((p, power)) = patch_power
