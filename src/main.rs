@@ -163,6 +163,15 @@ impl<E: Into<anyhow::Error>> From<E> for Failure {
     }
 }
 
+/// A pipeline error: the user's (exit 2) when it comes from bad options, else the run's.
+fn run_failure(e: penumbra::RunError) -> Failure {
+    if e.is_usage() {
+        usage(e)
+    } else {
+        Failure::from(e)
+    }
+}
+
 fn usage(error: impl Into<anyhow::Error>) -> Failure {
     Failure {
         error: error.into(),
@@ -229,17 +238,16 @@ fn sweep(args: &SweepArgs) -> Result<(), Failure> {
     let reference = if args.direct_only {
         penumbra::sweep::Reference::ExactDirect
     } else {
-        penumbra::sweep::Reference::PathTraced(traced_reference(args, &loaded, &samples)?)
+        penumbra::sweep::Reference::PathTraced(traced_reference(
+            args,
+            &loaded,
+            &visibility,
+            &samples,
+        )?)
     };
     let bars = Bars::new(args.quiet);
-    let result =
-        penumbra::sweep::sweep(&loaded, &options, &samples, &reference, &bars).map_err(|e| {
-            if e.is_usage() {
-                usage(e)
-            } else {
-                Failure::from(e)
-            }
-        })?;
+    let result = penumbra::sweep::sweep(&loaded, &options, &samples, &reference, &bars)
+        .map_err(run_failure)?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
     let csv = penumbra::sweep::sweep_csv(&result);
@@ -283,6 +291,7 @@ fn sweep(args: &SweepArgs) -> Result<(), Failure> {
 fn traced_reference(
     args: &SweepArgs,
     loaded: &penumbra_scenes::LoadedScene,
+    visibility: &penumbra_scenes::Visibility,
     samples: &[penumbra::sweep::Sample],
 ) -> Result<Vec<penumbra_solver::path_trace::ReferenceValue>, Failure> {
     #[derive(serde::Serialize, serde::Deserialize)]
@@ -320,8 +329,7 @@ fn traced_reference(
             path.display()
         );
     }
-    let visibility = penumbra_scenes::Visibility::build(&loaded.scene);
-    let tracer = penumbra_solver::path_trace::PathTracer::new(&loaded.scene, &visibility);
+    let tracer = penumbra_solver::path_trace::PathTracer::new(&loaded.scene, visibility);
     let points: Vec<_> = samples.iter().map(|s| (s.point, s.surface)).collect();
     let values = tracer.radiosity(
         &points,
@@ -443,13 +451,7 @@ fn run(args: &RunArgs) -> Result<(), Failure> {
         },
     };
     let bars = Bars::new(args.quiet);
-    let result = penumbra::run(loaded, &options, &bars).map_err(|e| {
-        if e.is_usage() {
-            usage(e)
-        } else {
-            Failure::from(e)
-        }
-    })?;
+    let result = penumbra::run(loaded, &options, &bars).map_err(run_failure)?;
     let written = write_outputs(&result, &args.out)?;
     if !args.quiet {
         let stats = &result.solution.stats;

@@ -121,29 +121,33 @@ impl EeeSearch<'_> {
             let source = [t.points[ia], t.points[ib]];
             // Edges lying on the receiver are contact lines, not blockers of its light; edges
             // whose shadow from the emitter edge misses the receiver cannot cast an event on it.
-            let usable: Vec<bool> = list
+            // Each usable edge keeps the corners of the region beyond it.
+            let regions: Vec<Option<[DVec3; 6]>> = list
                 .iter()
                 .map(|&(u, w)| {
                     let b = [t.points[u], t.points[w]];
-                    b.iter().any(|&p| self.receiver_frame.height(p) > self.tol)
-                        && self.can_be_silhouette(u, w, source)
-                        && self.shadow_meets_receiver(&self.beyond(source, b)[2..])
+                    if !(b.iter().any(|&p| self.receiver_frame.height(p) > self.tol)
+                        && self.can_be_silhouette(u, w, source))
+                    {
+                        return None;
+                    }
+                    let corners = self.beyond(source, b);
+                    self.shadow_meets_receiver(&corners[2..]).then_some(corners)
                 })
                 .collect();
             for (i1, &first) in list.iter().enumerate() {
-                if !usable[i1] {
+                let Some(corners) = regions[i1] else {
                     continue;
-                }
+                };
                 round += 1;
                 let b1 = [t.points[first.0], t.points[first.1]];
-                let corners = self.beyond(source, b1);
                 let hull = super::hull::hull_planes(&corners, self.tol);
                 let outside =
                     |points: &[DVec3]| super::hull::beyond_a_face(&hull, points, self.tol);
                 let mut polygon: Vec<DVec3> = Vec::new();
                 partners.clear();
                 let mut take = |i: usize, partners: &mut Vec<usize>| {
-                    if edge_stamp[i] != round && i != i1 && usable[i] {
+                    if edge_stamp[i] != round && i != i1 && regions[i].is_some() {
                         edge_stamp[i] = round;
                         partners.push(i);
                     }
