@@ -254,6 +254,13 @@ fn sweep(args: &SweepArgs) -> Result<(), Failure> {
     penumbra::outputs::write_atomic(&args.out.join("sweep.csv"), csv.as_bytes())?;
     let json = serde_json::to_string_pretty(&result)?;
     penumbra::outputs::write_atomic(&args.out.join("sweep.json"), json.as_bytes())?;
+    for (stem, chart) in penumbra::sweep::sweep_charts(&result) {
+        penumbra::outputs::write_atomic(
+            &args.out.join(format!("{stem}.svg")),
+            chart.svg().as_bytes(),
+        )?;
+        penumbra::outputs::write_atomic(&args.out.join(format!("{stem}.png")), &chart.png()?)?;
+    }
     if !args.quiet {
         println!(
             "{}: {} samples ({} in penumbrae), reference ({}) mean {:.4e}, standard error {:.3}%",
@@ -280,7 +287,10 @@ fn sweep(args: &SweepArgs) -> Result<(), Failure> {
                 100.0 * r.penumbra_rms
             );
         }
-        println!("wrote sweep.csv and sweep.json to {}", args.out.display());
+        println!(
+            "wrote sweep.csv, sweep.json and the charts error-vs-elements and error-vs-time (SVG, PNG) to {}",
+            args.out.display()
+        );
     }
     Ok(())
 }

@@ -14,6 +14,7 @@ use penumbra_scenes::rng::SplitMix64;
 use penumbra_scenes::{LoadedScene, Rgb, Scene, SurfaceId, Visibility};
 use penumbra_solver::path_trace::ReferenceValue;
 use penumbra_solver::{DirectLight, Progress, ReceivingPoint, SolverOptions};
+use penumbra_viz::{LogLogChart, Series};
 use serde::Serialize;
 
 use crate::adaptive::RefineOptions;
@@ -56,6 +57,18 @@ pub struct SweepRow {
     pub rms: f64,
     pub max: f64,
     pub penumbra_rms: f64,
+    /// The sample with the largest error, to see where a method fails.
+    pub worst: Option<WorstSample>,
+}
+
+/// Where a run's error is largest.
+#[derive(Clone, Debug, Serialize)]
+pub struct WorstSample {
+    pub surface: String,
+    pub point: [f64; 3],
+    /// Reference and interpolated radiosity (channel means).
+    pub reference: f64,
+    pub value: f64,
 }
 
 /// A sweep's samples, reference and rows.
@@ -138,6 +151,7 @@ pub fn sweep(
             };
             let result = run(loaded.clone(), &run_options, &penumbra_solver::NoProgress)?;
             let (mut sum2, mut max, mut pen2, mut pen_n) = (0.0, 0.0f64, 0.0, 0usize);
+            let mut worst = None;
             let locators: Vec<Locator> = result.mesh.surfaces.iter().map(Locator::new).collect();
             for (s, &reference) in samples.iter().zip(&values) {
                 let value = locators[s.surface]
@@ -149,7 +163,15 @@ pub fn sweep(
                     .mean();
                 let e = value - reference;
                 sum2 += e * e;
-                max = max.max(e.abs());
+                if e.abs() > max {
+                    max = e.abs();
+                    worst = Some(WorstSample {
+                        surface: scene.surfaces[s.surface].name.clone(),
+                        point: s.point.to_array(),
+                        reference,
+                        value,
+                    });
+                }
                 if s.penumbra {
                     pen2 += e * e;
                     pen_n += 1;
@@ -166,6 +188,7 @@ pub fn sweep(
                 rms: (sum2 / n).sqrt() / scale,
                 max: max / scale,
                 penumbra_rms: (pen2 / pen_n.max(1) as f64).sqrt() / scale,
+                worst,
             });
             progress.set(rows.len() as u64);
         }
@@ -313,6 +336,52 @@ impl Locator {
             (0..3).map(|k| values[tri[k] as usize] * w[k]).sum()
         })
     }
+}
+
+/// The sweep's log–log charts, one line per method: RMS error against triangles and against
+/// seconds, with their file stems.
+pub fn sweep_charts(sweep: &Sweep) -> Vec<(&'static str, LogLogChart)> {
+    let mut methods: Vec<&str> = Vec::new();
+    for r in &sweep.rows {
+        if !methods.contains(&r.method) {
+            methods.push(r.method);
+        }
+    }
+    let series = |x: fn(&SweepRow) -> f64| -> Vec<Series> {
+        methods
+            .iter()
+            .map(|&m| Series {
+                name: m.to_owned(),
+                points: sweep
+                    .rows
+                    .iter()
+                    .filter(|r| r.method == m)
+                    .map(|r| (x(r), 100.0 * r.rms))
+                    .collect(),
+            })
+            .collect()
+    };
+    let y_label = format!("RMS error, % of mean ({})", sweep.reference);
+    vec![
+        (
+            "error-vs-elements",
+            LogLogChart {
+                title: format!("{}: error against triangles", sweep.scene),
+                x_label: "triangles in the scene".to_owned(),
+                y_label: y_label.clone(),
+                series: series(|r| r.triangles as f64),
+            },
+        ),
+        (
+            "error-vs-time",
+            LogLogChart {
+                title: format!("{}: error against time", sweep.scene),
+                x_label: "seconds (mesh and solve, no render)".to_owned(),
+                y_label,
+                series: series(|r| r.seconds),
+            },
+        ),
+    ]
 }
 
 /// The sweep as CSV, a row per run.

@@ -323,6 +323,25 @@ fn sweep_writes_a_row_per_method_and_budget() {
             .expect("row")
     };
     assert!(rms_of("discontinuity") < rms_of("uniform"));
+    // The worst sample is where the maximum error is.
+    for r in rows {
+        let worst = &r["worst"];
+        let e = (worst["value"].as_f64().expect("value")
+            - worst["reference"].as_f64().expect("ref"))
+        .abs()
+            / sweep["reference_mean"].as_f64().expect("mean");
+        assert!((e - r["max"].as_f64().expect("max")).abs() <= 1e-12 * e.max(1.0));
+    }
+    // Both charts, as SVG with a line per method and as PNG.
+    for stem in ["error-vs-elements", "error-vs-time"] {
+        let svg = std::fs::read_to_string(out.join(format!("{stem}.svg"))).expect("svg");
+        assert_eq!(svg.matches("<polyline").count(), 1 + 4, "frame and 4 lines");
+        for method in ["uniform+adaptive", "discontinuity+adaptive"] {
+            assert!(svg.contains(method));
+        }
+        let png = std::fs::read(out.join(format!("{stem}.png"))).expect("png");
+        assert!(png.starts_with(b"\x89PNG"));
+    }
 }
 
 /// Without `--direct-only` the sweep scores full solutions against path tracing at the samples,

@@ -33,6 +33,7 @@
 //! ```
 
 pub mod camera;
+pub mod chart;
 mod clip;
 pub mod error;
 mod raster;
@@ -42,6 +43,7 @@ mod svg_plot;
 pub mod tonemap;
 
 pub use camera::default_camera;
+pub use chart::{LogLogChart, Series};
 pub use error::VizError;
 pub use render::{Render, RenderOptions, encode_png, render};
 pub use surface_svg::surface_svg;
