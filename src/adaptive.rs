@@ -1,15 +1,19 @@
-//! Adaptive refinement: split the triangles whose linear interpolation misses the exact direct
-//! radiosity by more than a tolerance, round after round, within the element budget.
+//! Adaptive refinement: split the triangles whose linear interpolation misses the solution by
+//! more than a tolerance, round after round, within the element budget, feeding the refined mesh
+//! to the progressive solver without restarting it.
 //!
-//! Each round solves the direct light exactly at every vertex, measures each triangle's residual
-//! at its edge midpoints and centroid ([`penumbra_solver::estimate`]), and splits the triangles
-//! over the tolerance, largest share of the squared error first, by longest-edge bisection in the surface's constrained
-//! triangulation: never across a discontinuity, with quality restored around the splits.
+//! Each round measures every triangle's residual ([`penumbra_solver::estimate`]): the exact
+//! direct light at its edge midpoints and centroid and, in full solutions, the light gathered at
+//! its centroid from the patches shot so far. The triangles over the tolerance are split, largest
+//! share of the squared error first, by longest-edge bisection in the surface's constrained
+//! triangulation: never across a discontinuity, with quality restored around the splits. The
+//! solver then takes the new mesh: new vertices get the exact direct light and gather what has
+//! been shot, and shooting goes on.
 
 use penumbra_meshing::SceneMesh;
 use penumbra_scenes::{Scene, Visibility};
-use penumbra_solver::estimate::{ResidualSummary, direct_residuals, summarize};
-use penumbra_solver::{DirectLight, NoProgress, SolveError, SolverOptions, solve_progressive};
+use penumbra_solver::estimate::{ResidualSummary, solution_residuals, summarize};
+use penumbra_solver::{Progress, ProgressiveSolver, Solution, SolveError, SolverOptions};
 use serde::Serialize;
 
 /// How adaptive refinement runs.
@@ -37,14 +41,21 @@ pub enum RefineStop {
     TimeBudget,
 }
 
+/// Light left unshot (fraction of the emitted power) when a round's residuals are measured in a
+/// full solution. The indirect light is smooth, and what is still unshot changes it little.
+pub const ROUND_EPSILON: f64 = 0.02;
+
 /// One round: the residuals found, and what was split.
 #[derive(Clone, Debug, Serialize)]
 pub struct RefineRound {
     pub triangles: usize,
+    /// Patch shots so far (none in direct-only runs).
+    pub shots: usize,
     pub residual: ResidualSummary,
-    /// Triangles over the tolerance, and how many of them were split.
+    /// Triangles over the tolerance, how many of them were split, and the triangles that made.
     pub over_tolerance: usize,
     pub split: usize,
+    pub added: usize,
 }
 
 /// What adaptive refinement did.
@@ -57,31 +68,25 @@ pub struct RefineReport {
     pub residual: ResidualSummary,
 }
 
-/// Refines `mesh` adaptively within `max_elements` triangles.
+/// Refines `mesh` adaptively within `max_elements` triangles, solving as it goes; returns what
+/// it did and the solution on the final mesh (shot to `solver.epsilon`).
 pub fn refine_adaptively(
     scene: &Scene,
     visibility: &Visibility,
     mesh: &mut SceneMesh,
     max_elements: usize,
     options: &RefineOptions,
-    solver: &SolverOptions,
-) -> Result<RefineReport, SolveError> {
-    let direct = DirectLight::new(scene, visibility);
-    let direct_only = SolverOptions {
-        direct_only: true,
-        ..solver.clone()
-    };
+    solver_options: &SolverOptions,
+    progress: &dyn Progress,
+) -> Result<(RefineReport, Solution), SolveError> {
+    let mut solver = ProgressiveSolver::new(scene, mesh, visibility, solver_options, progress)?;
     let mut rounds = Vec::new();
     let mut stop = RefineStop::Rounds;
     let mut residual = ResidualSummary::default();
     for round in 0..=options.max_rounds {
-        let solution = solve_progressive(scene, mesh, visibility, &direct_only, &NoProgress)?;
-        let residuals: Vec<Vec<f64>> = mesh
-            .surfaces
-            .iter()
-            .map(|m| direct_residuals(scene, &direct, m, &solution.radiosity[m.surface]))
-            .collect();
-        residual = summarize(&mesh.surfaces, &solution.radiosity, &residuals);
+        solver.shoot(ROUND_EPSILON.max(solver_options.epsilon), progress);
+        let residuals = solution_residuals(scene, &solver);
+        residual = summarize(&mesh.surfaces, &solver.radiosity(), &residuals);
         let tolerance = options.tolerance * residual.mean_radiosity;
         let mut over: Vec<(f64, usize, usize)> = residuals
             .iter()
@@ -95,9 +100,11 @@ pub fn refine_adaptively(
             .collect();
         let mut this = RefineRound {
             triangles: mesh.triangle_count(),
+            shots: solver.shots(),
             residual,
             over_tolerance: over.len(),
             split: 0,
+            added: 0,
         };
         if over.is_empty() {
             rounds.push(this);
@@ -108,7 +115,7 @@ pub fn refine_adaptively(
             rounds.push(this);
             break;
         }
-        if solver
+        if solver_options
             .deadline
             .is_some_and(|d| std::time::Instant::now() >= d)
         {
@@ -124,7 +131,13 @@ pub fn refine_adaptively(
         }
         over.sort_by(|a, b| b.0.total_cmp(&a.0).then((a.1, a.2).cmp(&(b.1, b.2))));
         let room = max_elements.saturating_sub(mesh.triangle_count());
-        let mut take = over.len().min(room / 3);
+        // The last 2 % of the budget is not worth a round (and, in full solutions, the
+        // vertices' gathering and the patches' new columns).
+        let mut take = if room * 50 < max_elements {
+            0
+        } else {
+            over.len().min(room / 3)
+        };
         let refined = loop {
             if take == 0 {
                 break None;
@@ -145,19 +158,26 @@ pub fn refine_adaptively(
             take /= 2;
         };
         this.split = take;
-        rounds.push(this);
         match refined {
-            Some(m) if m.triangle_count() > mesh.triangle_count() => *mesh = m,
+            Some(m) if m.triangle_count() > mesh.triangle_count() => {
+                this.added = m.triangle_count() - mesh.triangle_count();
+                rounds.push(this);
+                *mesh = m;
+                solver.remesh(mesh, progress)?;
+            }
             _ => {
+                rounds.push(this);
                 stop = RefineStop::Budget;
                 break;
             }
         }
     }
-    Ok(RefineReport {
+    solver.shoot(solver_options.epsilon, progress);
+    let report = RefineReport {
         tolerance: options.tolerance,
         rounds,
         stop,
         residual,
-    })
+    };
+    Ok((report, solver.solution()))
 }

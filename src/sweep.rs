@@ -7,11 +7,11 @@
 //! ([`penumbra_solver::path_trace`]). Samples where some emitter is partly hidden form the
 //! penumbra subset, scored on its own.
 
-use glam::{DVec2, DVec3};
-use penumbra_meshing::SurfaceMesh;
+use glam::DVec3;
 use penumbra_meshing::discontinuity::EmitterProbe;
+use penumbra_meshing::locate::TriangleLocator;
 use penumbra_scenes::rng::SplitMix64;
-use penumbra_scenes::{LoadedScene, Rgb, Scene, SurfaceId, Visibility};
+use penumbra_scenes::{LoadedScene, Scene, SurfaceId, Visibility};
 use penumbra_solver::path_trace::ReferenceValue;
 use penumbra_solver::{DirectLight, Progress, ReceivingPoint, SolverOptions};
 use penumbra_viz::{LogLogChart, Series};
@@ -152,7 +152,12 @@ pub fn sweep(
             let result = run(loaded.clone(), &run_options, &penumbra_solver::NoProgress)?;
             let (mut sum2, mut max, mut pen2, mut pen_n) = (0.0, 0.0f64, 0.0, 0usize);
             let mut worst = None;
-            let locators: Vec<Locator> = result.mesh.surfaces.iter().map(Locator::new).collect();
+            let locators: Vec<TriangleLocator> = result
+                .mesh
+                .surfaces
+                .iter()
+                .map(TriangleLocator::new)
+                .collect();
             for (s, &reference) in samples.iter().zip(&values) {
                 let value = locators[s.surface]
                     .interpolate(
@@ -268,74 +273,6 @@ pub fn sample_points(
             })
         })
         .collect()
-}
-
-/// Finds the triangle of a mesh that holds a point: triangles bucketed by their boxes on a grid
-/// over the mesh coordinates.
-struct Locator {
-    lo: DVec2,
-    cell: f64,
-    side: usize,
-    buckets: Vec<Vec<u32>>,
-}
-
-impl Locator {
-    fn new(mesh: &SurfaceMesh) -> Locator {
-        let (lo, hi) = mesh
-            .local
-            .iter()
-            .fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), &p| {
-                (lo.min(p), hi.max(p))
-            });
-        let side = ((mesh.triangles.len() as f64).sqrt().ceil() as usize).clamp(1, 512);
-        let cell = ((hi - lo).max_element() / side as f64).max(f64::MIN_POSITIVE);
-        let mut buckets = vec![Vec::new(); side * side];
-        let index = |x: f64| ((x / cell).floor().max(0.0) as usize).min(side - 1);
-        for (t, tri) in mesh.triangles.iter().enumerate() {
-            let p = tri.map(|i| mesh.local[i as usize] - lo);
-            let (a, b) = (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]));
-            for i in index(a.x)..=index(b.x) {
-                for j in index(a.y)..=index(b.y) {
-                    buckets[j * side + i].push(t as u32);
-                }
-            }
-        }
-        Locator {
-            lo,
-            cell,
-            side,
-            buckets,
-        }
-    }
-
-    /// The linear interpolation of `values` at `point` (3D, on the mesh's surface): in the
-    /// triangle that holds it, or the one it is least outside of.
-    fn interpolate(&self, mesh: &SurfaceMesh, values: &[Rgb], point: DVec3) -> Rgb {
-        let q = mesh.frame.to_2d(point) / mesh.scale;
-        let index = |x: f64| ((x / self.cell).floor().max(0.0) as usize).min(self.side - 1);
-        let bucket = &self.buckets[index(q.y - self.lo.y) * self.side + index(q.x - self.lo.x)];
-        let mut best: Option<(f64, [f64; 3], [u32; 3])> = None;
-        for &t in bucket {
-            let tri = mesh.triangles[t as usize];
-            let [a, b, c] = tri.map(|i| mesh.local[i as usize]);
-            let area = (b - a).perp_dot(c - a);
-            if area == 0.0 {
-                continue;
-            }
-            let w = [
-                (b - q).perp_dot(c - q) / area,
-                (c - q).perp_dot(a - q) / area,
-                (a - q).perp_dot(b - q) / area,
-            ];
-            let outside = -w.iter().copied().fold(f64::INFINITY, f64::min);
-            if best.is_none_or(|(o, _, _)| outside < o) {
-                best = Some((outside, w, tri));
-            }
-        }
-        best.map_or(Rgb::ZERO, |(_, w, tri)| {
-            (0..3).map(|k| values[tri[k] as usize] * w[k]).sum()
-        })
-    }
 }
 
 /// The sweep's log–log charts, one line per method: RMS error against triangles and against

@@ -8,12 +8,16 @@ use penumbra_scenes::{Scene, Visibility, builtin};
 use penumbra_solver::measure::direct_interpolation_error;
 use penumbra_solver::{DirectLight, NoProgress, SolverOptions, solve_progressive};
 
-fn floor_rms(scene: &Scene, vis: &Visibility, mesh: &SceneMesh) -> f64 {
-    let options = SolverOptions {
+fn direct_only() -> SolverOptions {
+    SolverOptions {
         direct_only: true,
         ..SolverOptions::default()
-    };
-    let solution = solve_progressive(scene, mesh, vis, &options, &NoProgress).expect("solves");
+    }
+}
+
+fn floor_rms(scene: &Scene, vis: &Visibility, mesh: &SceneMesh) -> f64 {
+    let solution =
+        solve_progressive(scene, mesh, vis, &direct_only(), &NoProgress).expect("solves");
     let direct = DirectLight::new(scene, vis);
     let r = scene.surface_id("floor").expect("floor");
     let e = direct_interpolation_error(
@@ -44,7 +48,7 @@ fn rounds_keep_meshes_sane_and_cut_the_error() {
             let before = floor_rms(&scene, &vis, &mesh);
             let budget = 8_000;
             for round in 0..4 {
-                let report = refine_adaptively(
+                let (report, _) = refine_adaptively(
                     &scene,
                     &vis,
                     &mut mesh,
@@ -54,7 +58,8 @@ fn rounds_keep_meshes_sane_and_cut_the_error() {
                         initial_elements: 2_000,
                         max_rounds: 1,
                     },
-                    &SolverOptions::default(),
+                    &direct_only(),
+                    &NoProgress,
                 )
                 .expect("refines");
                 mesh.sanity_check()
@@ -92,7 +97,7 @@ fn a_met_tolerance_stops_refinement() {
     let vis = Visibility::build(&scene);
     let found = find_discontinuities(&scene, &vis, &DiscontinuityOptions::default());
     let mut mesh = mesh_scene_discontinuity(&scene, &vis, found, 3_000, 8.0).expect("meshes");
-    let report = refine_adaptively(
+    let (report, _) = refine_adaptively(
         &scene,
         &vis,
         &mut mesh,
@@ -102,11 +107,69 @@ fn a_met_tolerance_stops_refinement() {
             initial_elements: 3_000,
             max_rounds: 20,
         },
-        &SolverOptions::default(),
+        &direct_only(),
+        &NoProgress,
     )
     .expect("refines");
     assert_eq!(report.stop, RefineStop::Tolerance, "{report:#?}");
     assert!(mesh.triangle_count() < 30_000);
     assert!(report.residual.max <= 2e-3 * report.residual.mean_radiosity);
     assert!(report.rounds.len() >= 2, "{report:#?}");
+}
+
+/// The refined mesh fed to the solver without restarting it holds the same energy as a solve from
+/// scratch on the final mesh: exactly (to 1e-6 of the emitted power) for the direct light, and
+/// to 0.3 % for full solutions (measured: 0.18 % at epsilon 2e-3, 0.13 % at 1e-4). Every
+/// incremental solution balances: emitted = absorbed + unshot + escaped.
+#[test]
+fn incremental_and_from_scratch_solves_agree_on_energy() {
+    let scene = builtin::cornell();
+    let vis = Visibility::build(&scene);
+    let found = find_discontinuities(&scene, &vis, &DiscontinuityOptions::default());
+    let start = mesh_scene_discontinuity(&scene, &vis, found, 1_500, 8.0).expect("meshes");
+    for options in [
+        direct_only(),
+        SolverOptions {
+            epsilon: 2e-3,
+            ..SolverOptions::default()
+        },
+    ] {
+        let mut mesh = start.clone();
+        let (report, incremental) = refine_adaptively(
+            &scene,
+            &vis,
+            &mut mesh,
+            6_000,
+            &RefineOptions {
+                tolerance: 1e-3,
+                initial_elements: 1_500,
+                max_rounds: 3,
+            },
+            &options,
+            &NoProgress,
+        )
+        .expect("refines");
+        mesh.sanity_check().expect("sane");
+        assert!(report.rounds.len() >= 2 && incremental.stats.remeshes >= 1);
+        let scratch =
+            solve_progressive(&scene, &mesh, &vis, &options, &NoProgress).expect("solves");
+        let s = &incremental.stats;
+        let emitted = s.emitted.mean();
+        let balance = (s.emitted - s.absorbed - s.unshot - s.escaped).mean().abs();
+        assert!(balance <= 1e-9 * emitted, "energy balance off by {balance}");
+        let difference = (s.absorbed - scratch.stats.absorbed).mean().abs() / emitted;
+        eprintln!(
+            "direct only {}: absorbed {:.6} (incremental) vs {:.6} (from scratch) of the emitted power, \
+             difference {difference:.2e}; {} vs {} shots",
+            options.direct_only,
+            s.absorbed.mean() / emitted,
+            scratch.stats.absorbed.mean() / emitted,
+            s.shots,
+            scratch.stats.shots
+        );
+        // Full solutions: the light shot early leaves the coarse mesh's larger patches, whose
+        // sampled visibility fractions (ratio estimates) differ slightly from the fine ones'.
+        let allowed = if options.direct_only { 1e-6 } else { 3e-3 };
+        assert!(difference <= allowed, "{difference:e}");
+    }
 }

@@ -16,6 +16,7 @@ pub mod constrained;
 pub mod error;
 pub mod fuzzing;
 pub mod grading;
+pub mod locate;
 pub mod mesh;
 pub mod planar;
 pub mod scene_mesh;

@@ -4,45 +4,44 @@
 
 use std::f64::consts::PI;
 
-use penumbra_scenes::Visibility;
+use penumbra_scenes::{SurfaceId, Visibility};
 
-use crate::elements::{Discretization, Element, Patch};
+use crate::elements::{Discretization, Patch};
 use crate::lambert::{ReceivingPoint, edge_term, form_factor};
 use penumbra_scenes::rng::SplitMix64;
 
-/// Form factors from receivers (mesh vertices) to shooting patches.
-#[derive(Debug)]
-pub struct PatchCoupling<'a> {
-    pub disc: &'a Discretization,
+/// Form factors from points to patches: Lambert's formula times a visibility fraction.
+#[derive(Clone, Copy, Debug)]
+pub struct Coupler<'a> {
     pub visibility: &'a Visibility,
-    /// Rays per vertex–patch pair for the visibility fraction.
+    /// Rays per point–patch pair for the visibility fraction.
     pub rays: usize,
     pub seed: u64,
 }
 
-impl PatchCoupling<'_> {
+impl Coupler<'_> {
     fn tol(&self) -> f64 {
         self.visibility.contact_distance()
     }
 
-    /// The unoccluded form factor from receiver `v` to patch `p` (zero if either faces away).
-    pub fn unoccluded(&self, v: usize, p: usize) -> f64 {
-        let patch = &self.disc.patches[p];
-        let x = &self.disc.receivers[v];
-        if self.disc.receiver_surface[v] == patch.surface
-            || !x.in_front_of(patch.origin, patch.normal, self.tol())
-        {
+    /// The unoccluded form factor from `x` (on `surface`) to `patch` (zero if either faces away).
+    pub fn unoccluded(&self, x: &ReceivingPoint, surface: SurfaceId, patch: &Patch) -> f64 {
+        if surface == patch.surface || !x.in_front_of(patch.origin, patch.normal, self.tol()) {
             return 0.0;
         }
-        patch_form_factor(x, patch, &self.disc.elements, self.tol())
+        patch_form_factor(x, patch, self.tol())
     }
 
-    /// Fraction of patch `p` visible from receiver `v`, weighted by the form-factor kernel, and
-    /// the number of rays cast for it.
-    pub fn visible_fraction(&self, v: usize, p: usize) -> (f64, u32) {
-        let patch = &self.disc.patches[p];
-        let x = &self.disc.receivers[v];
-        let own = [self.disc.receiver_surface[v], patch.surface];
+    /// Fraction of `patch` visible from `x`, weighted by the form-factor kernel, and the number
+    /// of rays cast for it. `key` seeds the pair's own random stream.
+    pub fn visible_fraction(
+        &self,
+        x: &ReceivingPoint,
+        surface: SurfaceId,
+        patch: &Patch,
+        key: [u64; 2],
+    ) -> (f64, u32) {
+        let own = [surface, patch.surface];
         // Nothing else in the box around both: nothing can block.
         let shaft = patch.bounds.including(x.point);
         if !self
@@ -54,7 +53,7 @@ impl PatchCoupling<'_> {
         // Rays leave from just inside the receiving surface, so that a vertex on a junction sees
         // past (not along) the surfaces it touches: the one-sided limit again.
         let origin = x.point + x.inward * self.visibility.junction_offset();
-        let mut rng = SplitMix64::keyed(self.seed, &[v as u64, p as u64]);
+        let mut rng = SplitMix64::keyed(self.seed, &key);
         let total = patch.area;
         let (mut seen, mut weight, mut count) = (0.0, 0.0, 0u32);
         // Samples that face away (behind x's tangent plane, or behind the patch) carry no weight
@@ -67,12 +66,10 @@ impl PatchCoupling<'_> {
             let idx = patch
                 .cumulative_area
                 .partition_point(|&c| c < u)
-                .min(patch.elements.len() - 1);
-            let e = &self.disc.elements[patch.elements[idx]];
+                .min(patch.triangles.len() - 1);
+            let t = &patch.triangles[idx];
             let (r1, r2) = (rng.next_f64().sqrt(), rng.next_f64());
-            let y = e.points[0] * (1.0 - r1)
-                + e.points[1] * (r1 * (1.0 - r2))
-                + e.points[2] * (r1 * r2);
+            let y = t[0] * (1.0 - r1) + t[1] * (r1 * (1.0 - r2)) + t[2] * (r1 * r2);
             let d = y - origin;
             let w = x.normal.dot(d) * -patch.normal.dot(d) / d.length_squared().powi(2);
             if !(w > 0.0) {
@@ -90,19 +87,63 @@ impl PatchCoupling<'_> {
     }
 
     /// Form factor times visibility, and the rays it took.
-    pub fn coupling(&self, v: usize, p: usize) -> (f64, u32) {
-        let f = self.unoccluded(v, p);
+    pub fn coupling(
+        &self,
+        x: &ReceivingPoint,
+        surface: SurfaceId,
+        patch: &Patch,
+        key: [u64; 2],
+    ) -> (f64, u32) {
+        let f = self.unoccluded(x, surface, patch);
         if f <= 0.0 {
             return (0.0, 0);
         }
-        let (vis, rays) = self.visible_fraction(v, p);
+        let (vis, rays) = self.visible_fraction(x, surface, patch, key);
         (f * vis, rays)
+    }
+}
+
+/// Form factors from the receivers (mesh vertices) of a discretization to its patches.
+#[derive(Debug)]
+pub struct PatchCoupling<'a> {
+    pub disc: &'a Discretization,
+    pub visibility: &'a Visibility,
+    /// Rays per vertex–patch pair for the visibility fraction.
+    pub rays: usize,
+    pub seed: u64,
+}
+
+impl PatchCoupling<'_> {
+    fn coupler(&self) -> Coupler<'_> {
+        Coupler {
+            visibility: self.visibility,
+            rays: self.rays,
+            seed: self.seed,
+        }
+    }
+
+    /// The unoccluded form factor from receiver `v` to patch `p`.
+    pub fn unoccluded(&self, v: usize, p: usize) -> f64 {
+        let d = self.disc;
+        self.coupler()
+            .unoccluded(&d.receivers[v], d.receiver_surface[v], &d.patches[p])
+    }
+
+    /// Form factor times visibility from receiver `v` to patch `p`, and the rays it took.
+    pub fn coupling(&self, v: usize, p: usize) -> (f64, u32) {
+        let d = self.disc;
+        self.coupler().coupling(
+            &d.receivers[v],
+            d.receiver_surface[v],
+            &d.patches[p],
+            [v as u64, p as u64],
+        )
     }
 }
 
 /// Lambert's formula over a patch: over its outline when the patch lies wholly in front of x,
 /// else over its elements one by one, each clipped to x's tangent half-space.
-pub fn patch_form_factor(x: &ReceivingPoint, patch: &Patch, elements: &[Element], tol: f64) -> f64 {
+pub fn patch_form_factor(x: &ReceivingPoint, patch: &Patch, tol: f64) -> f64 {
     let (mut any_front, mut any_behind) = (false, false);
     for &c in &patch.corners {
         let h = x.height(c, tol);
@@ -120,9 +161,5 @@ pub fn patch_form_factor(x: &ReceivingPoint, patch: &Patch, elements: &[Element]
             .sum();
         return sum.abs() / (2.0 * PI);
     }
-    patch
-        .elements
-        .iter()
-        .map(|&e| form_factor(x, &elements[e].points, tol))
-        .sum()
+    patch.triangles.iter().map(|t| form_factor(x, t, tol)).sum()
 }

@@ -18,6 +18,8 @@ pub struct Element {
     pub points: [DVec3; 3],
     pub area: f64,
     pub patch: usize,
+    /// Index of the triangle in its surface's mesh.
+    pub triangle: usize,
 }
 
 /// Neighbouring elements of one surface that shoot their unshot power together.
@@ -35,6 +37,9 @@ pub struct Patch {
     /// Lambert's formula (edges inside the patch cancel, so they are left out).
     pub outline: Vec<[DVec3; 2]>,
     pub bounds: Bounds,
+    /// The elements' corners, in the order of `elements`: the patch's geometry on its own, so
+    /// that it can still be shot from (or gathered from) after the mesh has changed.
+    pub triangles: Vec<[DVec3; 3]>,
     /// Cumulative element areas, for sampling points by area.
     pub cumulative_area: Vec<f64>,
 }
@@ -118,6 +123,7 @@ impl Discretization {
                         points: tri.map(|i| m.points3[i as usize]),
                         area: m.triangle_area(t),
                         patch,
+                        triangle: t,
                     });
                 }
                 patches.push(make_patch(
@@ -257,6 +263,7 @@ fn make_patch(
             .collect(),
         bounds: Bounds::from_points(&corners),
         corners,
+        triangles: mine.iter().map(|e| e.points).collect(),
         cumulative_area,
     }
 }

@@ -34,4 +34,6 @@ pub use elements::Discretization;
 pub use error::SolveError;
 pub use lambert::{ReceivingPoint, form_factor};
 pub use progress::{NoProgress, Progress};
-pub use progressive::{Solution, SolveStats, SolverOptions, StopReason, solve_progressive};
+pub use progressive::{
+    ProgressiveSolver, Solution, SolveStats, SolverOptions, StopReason, solve_progressive,
+};

@@ -9,21 +9,28 @@
 //!    elements around the vertex (the linear interpolant's integral), and so on, until the unshot
 //!    power is below `epsilon` of the emitted power or the shot cap is reached.
 //!
+//! The solver can be fed a refined mesh without restarting ([`ProgressiveSolver::remesh`], as in
+//! Cohen et al.'s patches and elements): it keeps every patch that has shot, with the radiosity it
+//! shot, and a new vertex gathers from all of them, so its value is consistent with the solution
+//! so far; what each element has shot is carried over by area, so no power is lost or made.
+//!
 //! Results do not depend on the thread count: receivers are evaluated in parallel, but every
 //! sum is taken in a fixed order.
 
 use std::collections::HashMap;
 use std::time::Instant;
 
-use penumbra_meshing::SceneMesh;
-use penumbra_scenes::{Rgb, Scene, Visibility};
+use penumbra_meshing::locate::{TriangleLocator, transfer_density};
+use penumbra_meshing::{SceneMesh, SurfaceMesh};
+use penumbra_scenes::{Rgb, Scene, SurfaceId, Visibility};
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::coupling::PatchCoupling;
+use crate::coupling::Coupler;
 use crate::direct::DirectLight;
-use crate::elements::Discretization;
+use crate::elements::{Discretization, Patch};
 use crate::error::SolveError;
+use crate::lambert::ReceivingPoint;
 use crate::progress::Progress;
 
 /// Options of the progressive solver; every field is checked by [`SolverOptions::validate`].
@@ -112,10 +119,16 @@ pub struct SolveStats {
     /// Shot power that no vertex received: light leaving an open scene, plus the discretization
     /// error of vertex-sampled form factors (in a closed scene, only the latter).
     pub escaped: Rgb,
-    /// Unshot power over emitted power (channel means).
+    /// Unshot power over emitted power (channel means; patch by patch in absolute value, since
+    /// after a remesh a patch may owe negative power).
     pub unshot_fraction: f64,
     pub direct_seconds: f64,
     pub shooting_seconds: f64,
+    /// Times the mesh was replaced by a refined one, and the vertices that then gathered the
+    /// light shot so far.
+    pub remeshes: usize,
+    pub gathered: usize,
+    pub gather_seconds: f64,
 }
 
 /// Radiosity and irradiance at every mesh vertex, per surface.
@@ -137,13 +150,25 @@ pub fn direct_irradiance(
     progress: &dyn Progress,
 ) -> Vec<Rgb> {
     let direct = DirectLight::new(scene, visibility);
-    let n = disc.receiver_count();
-    progress.start("direct light", n as u64);
+    let all: Vec<usize> = (0..disc.receiver_count()).collect();
+    irradiance_at(&all, "direct light", progress, |v| {
+        direct.irradiance(&disc.receivers[v], disc.receiver_surface[v])
+    })
+}
+
+/// `f` at each of `receivers`, in parallel, with a progress bar.
+fn irradiance_at(
+    receivers: &[usize],
+    stage: &str,
+    progress: &dyn Progress,
+    f: impl Fn(usize) -> Rgb + Sync,
+) -> Vec<Rgb> {
+    progress.start(stage, receivers.len() as u64);
     let done = std::sync::atomic::AtomicU64::new(0);
-    let out = (0..n)
-        .into_par_iter()
-        .map(|v| {
-            let h = direct.irradiance(&disc.receivers[v], disc.receiver_surface[v]);
+    let out = receivers
+        .par_iter()
+        .map(|&v| {
+            let h = f(v);
             let d = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             if d.is_multiple_of(256) {
                 progress.set(d);
@@ -163,174 +188,474 @@ pub fn solve_progressive(
     options: &SolverOptions,
     progress: &dyn Progress,
 ) -> Result<Solution, SolveError> {
-    options.validate()?;
-    if mesh.surfaces.len() != scene.surfaces.len() {
-        return Err(SolveError::MeshMismatch {
-            surfaces: scene.surfaces.len(),
-            meshes: mesh.surfaces.len(),
-        });
-    }
-    let disc = Discretization::new(scene, mesh, options.elements_per_patch);
-    let n = disc.receiver_count();
+    let mut solver = ProgressiveSolver::new(scene, mesh, visibility, options, progress)?;
+    solver.shoot(options.epsilon, progress);
+    Ok(solver.solution())
+}
 
-    let started = Instant::now();
-    let mut irradiance = direct_irradiance(scene, &disc, visibility, progress);
-    let direct_seconds = started.elapsed().as_secs_f64();
+/// A patch that has shot: its geometry, kept after the mesh changes, and the radiosity it shot.
+#[derive(Clone, Debug)]
+struct Shooter {
+    patch: Patch,
+    radiosity: Rgb,
+}
 
-    let emitted = scene.emitted_power();
-    let radiosity_of = |h: &[Rgb]| -> Vec<Rgb> {
-        (0..n)
-            .map(|v| disc.emission[v] + disc.reflectance[v].mul_rgb(h[v]))
-            .collect()
-    };
-    let received_direct = disc.integrate(&irradiance, |_| Rgb::splat(1.0));
-    let mut escaped = emitted - received_direct;
+/// Progressive refinement as a process: shoot, look at the solution, refine the mesh, shoot on.
+#[derive(Debug)]
+pub struct ProgressiveSolver<'a> {
+    scene: &'a Scene,
+    visibility: &'a Visibility,
+    direct: DirectLight<'a>,
+    options: SolverOptions,
+    /// The surface meshes the state below belongs to.
+    meshes: Vec<SurfaceMesh>,
+    disc: Discretization,
+    direct_irradiance: Vec<Rgb>,
+    irradiance: Vec<Rgb>,
+    /// Per element: the reflected radiosity its area has shot so far (its patch's shots).
+    element_shot: Vec<Rgb>,
+    shooters: Vec<Shooter>,
+    /// Per patch of the current discretization: its shooter, once it has shot.
+    patch_shooter: Vec<Option<usize>>,
+    cache: HashMap<usize, Vec<f32>>,
+    shot_power: Rgb,
+    escaped: Rgb,
+    stop: StopReason,
+    shots: usize,
+    rays_cast: u64,
+    remeshes: usize,
+    gathered: usize,
+    direct_seconds: f64,
+    shooting_seconds: f64,
+    gather_seconds: f64,
+}
 
-    // Unshot radiosity per element: the mean of its vertices' reflected irradiance.
-    let mut element_unshot: Vec<Rgb> = disc
-        .elements
-        .iter()
-        .map(|e| {
-            let rho = scene.surfaces[e.surface].reflectance;
-            e.vertices
-                .iter()
-                .map(|&v| irradiance[v])
-                .sum::<Rgb>()
-                .mul_rgb(rho)
-                / 3.0
-        })
-        .collect();
-
-    let shooting_started = Instant::now();
-    let mut shots = 0usize;
-    let mut rays_cast = 0u64;
-    let stop;
-    if options.direct_only {
-        stop = StopReason::DirectOnly;
-    } else {
-        let coupling = PatchCoupling {
-            disc: &disc,
+impl<'a> ProgressiveSolver<'a> {
+    /// Meshes are checked against the scene and the direct light is solved at every vertex.
+    pub fn new(
+        scene: &'a Scene,
+        mesh: &SceneMesh,
+        visibility: &'a Visibility,
+        options: &SolverOptions,
+        progress: &dyn Progress,
+    ) -> Result<ProgressiveSolver<'a>, SolveError> {
+        options.validate()?;
+        check_mesh(scene, mesh)?;
+        let disc = Discretization::new(scene, mesh, options.elements_per_patch);
+        let started = Instant::now();
+        let direct_irradiance = direct_irradiance(scene, &disc, visibility, progress);
+        let direct_seconds = started.elapsed().as_secs_f64();
+        let received = disc.integrate(&direct_irradiance, |_| Rgb::splat(1.0));
+        Ok(ProgressiveSolver {
+            scene,
             visibility,
-            rays: options.visibility_rays,
-            seed: options.seed,
-        };
-        let mut cache: HashMap<usize, Vec<f32>> = HashMap::new();
-        let cache_limit = options.cache_bytes / (4 * n.max(1));
-        let emitted_mean = emitted.mean().max(f64::MIN_POSITIVE);
-        let goal = -options.epsilon.log10();
+            direct: DirectLight::new(scene, visibility),
+            options: options.clone(),
+            meshes: mesh.surfaces.clone(),
+            element_shot: vec![Rgb::ZERO; disc.elements.len()],
+            patch_shooter: vec![None; disc.patches.len()],
+            irradiance: direct_irradiance.clone(),
+            direct_irradiance,
+            disc,
+            shooters: Vec::new(),
+            cache: HashMap::new(),
+            shot_power: Rgb::ZERO,
+            escaped: scene.emitted_power() - received,
+            stop: if options.direct_only {
+                StopReason::DirectOnly
+            } else {
+                StopReason::ShotLimit
+            },
+            shots: 0,
+            rays_cast: 0,
+            remeshes: 0,
+            gathered: 0,
+            direct_seconds,
+            shooting_seconds: 0.0,
+            gather_seconds: 0.0,
+        })
+    }
+
+    fn coupler(&self) -> Coupler<'a> {
+        Coupler {
+            visibility: self.visibility,
+            rays: self.options.visibility_rays,
+            seed: self.options.seed,
+        }
+    }
+
+    /// Unshot reflected radiosity of every element: what it reflects (the mean of its vertices'
+    /// irradiance times ρ) less what its area has shot.
+    fn element_unshot(&self) -> Vec<Rgb> {
+        self.disc
+            .elements
+            .iter()
+            .zip(&self.element_shot)
+            .map(|(e, &shot)| {
+                let rho = self.scene.surfaces[e.surface].reflectance;
+                e.vertices
+                    .iter()
+                    .map(|&v| self.irradiance[v])
+                    .sum::<Rgb>()
+                    .mul_rgb(rho)
+                    / 3.0
+                    - shot
+            })
+            .collect()
+    }
+
+    /// Unshot power of every patch: Σ area × unshot radiosity of its elements.
+    fn patch_unshot_power(&self) -> Vec<Rgb> {
+        let unshot = self.element_unshot();
+        self.disc
+            .patches
+            .iter()
+            .map(|p| {
+                p.elements
+                    .iter()
+                    .map(|&e| unshot[e] * self.disc.elements[e].area)
+                    .sum()
+            })
+            .collect()
+    }
+
+    /// Shoots until the unshot power is below `epsilon` of the emitted power, the shot cap or
+    /// the deadline; returns why it stopped.
+    pub fn shoot(&mut self, epsilon: f64, progress: &dyn Progress) -> StopReason {
+        if self.options.direct_only {
+            return StopReason::DirectOnly;
+        }
+        let started = Instant::now();
+        let n = self.disc.receiver_count();
+        let cache_limit = self.options.cache_bytes / (4 * n.max(1));
+        let emitted_mean = self.scene.emitted_power().mean().max(f64::MIN_POSITIVE);
+        let goal = -epsilon.log10();
         progress.start("shooting", 1000);
-        stop = loop {
-            let patch_power: Vec<Rgb> = patch_unshot_power(&disc, &element_unshot);
-            let total_unshot: Rgb = patch_power.iter().copied().sum();
-            let fraction = total_unshot.mean() / emitted_mean;
+        self.stop = loop {
+            let patch_power = self.patch_unshot_power();
+            let fraction = unshot_magnitude(&patch_power) / emitted_mean;
             progress.set(((-fraction.max(1e-300).log10() / goal).clamp(0.0, 1.0) * 1000.0) as u64);
-            if fraction < options.epsilon {
+            if fraction < epsilon {
                 break StopReason::Converged;
             }
-            if shots >= options.max_shots {
+            if self.shots >= self.options.max_shots {
                 break StopReason::ShotLimit;
             }
-            if options.deadline.is_some_and(|d| Instant::now() >= d) {
+            if self.options.deadline.is_some_and(|d| Instant::now() >= d) {
                 break StopReason::TimeBudget;
             }
-            // The patch with the most unshot power (ties: the lowest index).
+            // The patch with the most unshot power (ties: the lowest index). After a remesh a
+            // patch may have shot more than its finer elements now reflect: it shoots the
+            // negative difference back, so that the light shot matches the light reflected.
             let Some((p, power)) = patch_power
                 .iter()
                 .enumerate()
-                .max_by(|a, b| a.1.mean().total_cmp(&b.1.mean()).then(b.0.cmp(&a.0)))
+                .max_by(|a, b| {
+                    magnitude(*a.1)
+                        .total_cmp(&magnitude(*b.1))
+                        .then(b.0.cmp(&a.0))
+                })
                 .map(|(p, &w)| (p, w))
             else {
                 break StopReason::Converged;
             };
-            let patch = &disc.patches[p];
-            let shot_radiosity = power / patch.area;
-
-            let column = match cache.get(&p) {
+            let k = match self.patch_shooter[p] {
+                Some(k) => k,
+                None => {
+                    self.shooters.push(Shooter {
+                        patch: self.disc.patches[p].clone(),
+                        radiosity: Rgb::ZERO,
+                    });
+                    self.patch_shooter[p] = Some(self.shooters.len() - 1);
+                    self.shooters.len() - 1
+                }
+            };
+            let shot_radiosity = power / self.disc.patches[p].area;
+            let column = match self.cache.get(&p) {
                 Some(c) => c.clone(),
                 None => {
+                    let coupler = self.coupler();
+                    let disc = &self.disc;
+                    let patch = &disc.patches[p];
                     let computed: Vec<(f32, u32)> = (0..n)
                         .into_par_iter()
                         .map(|v| {
-                            let (f, r) = coupling.coupling(v, p);
+                            let (f, r) = coupler.coupling(
+                                &disc.receivers[v],
+                                disc.receiver_surface[v],
+                                patch,
+                                [v as u64, k as u64],
+                            );
                             (f as f32, r)
                         })
                         .collect();
-                    rays_cast += computed.iter().map(|&(_, r)| r as u64).sum::<u64>();
+                    self.rays_cast += computed.iter().map(|&(_, r)| r as u64).sum::<u64>();
                     let column: Vec<f32> = computed.into_iter().map(|(f, _)| f).collect();
-                    if cache.len() < cache_limit {
-                        cache.insert(p, column.clone());
+                    if self.cache.len() < cache_limit {
+                        self.cache.insert(p, column.clone());
                     }
                     column
                 }
             };
             let delta: Vec<Rgb> = column.iter().map(|&f| shot_radiosity * f as f64).collect();
-            for v in 0..n {
-                irradiance[v] += delta[v];
+            for (h, d) in self.irradiance.iter_mut().zip(&delta) {
+                *h += *d;
             }
-            for &e in &patch.elements {
-                element_unshot[e] = Rgb::ZERO;
+            for &e in &self.disc.patches[p].elements {
+                self.element_shot[e] += shot_radiosity;
             }
-            for (e, unshot) in disc.elements.iter().zip(element_unshot.iter_mut()) {
-                let rho = scene.surfaces[e.surface].reflectance;
-                *unshot += e
-                    .vertices
-                    .iter()
-                    .map(|&v| delta[v])
-                    .sum::<Rgb>()
-                    .mul_rgb(rho)
-                    / 3.0;
-            }
-            escaped += power - disc.integrate(&delta, |_| Rgb::splat(1.0));
-            shots += 1;
+            self.shooters[k].radiosity += shot_radiosity;
+            self.shot_power += power;
+            self.escaped += power - self.disc.integrate(&delta, |_| Rgb::splat(1.0));
+            self.shots += 1;
         };
         progress.finish();
+        self.shooting_seconds += started.elapsed().as_secs_f64();
+        self.stop
     }
-    let shooting_seconds = shooting_started.elapsed().as_secs_f64();
 
-    let radiosity = radiosity_of(&irradiance);
-    let unshot: Rgb = patch_unshot_power(&disc, &element_unshot).into_iter().sum();
-    let absorbed = disc.integrate(&irradiance, |e| {
-        Rgb::splat(1.0) - scene.surfaces[e.surface].reflectance
-    });
-    let total_area: f64 = disc.elements.iter().map(|e| e.area).sum();
-    let mean_rho: Rgb = disc
-        .elements
-        .iter()
-        .map(|e| scene.surfaces[e.surface].reflectance * e.area)
-        .sum::<Rgb>()
-        / total_area;
-    let ambient = (unshot / total_area).mul_rgb(mean_rho.map(|r| 1.0 / (1.0 - r)));
-    let stats = SolveStats {
-        stop,
-        shots,
-        patches: disc.patches.len(),
-        receivers: n,
-        rays_cast,
-        emitted,
-        absorbed,
-        unshot,
-        escaped,
-        unshot_fraction: unshot.mean() / emitted.mean().max(f64::MIN_POSITIVE),
-        direct_seconds,
-        shooting_seconds,
-    };
-    Ok(Solution {
-        radiosity: disc.per_surface(&radiosity),
-        irradiance: disc.per_surface(&irradiance),
-        ambient,
-        stats,
-    })
+    /// Irradiance at `x` (on `surface`) from everything shot so far, less the direct light.
+    fn gather(&self, x: &ReceivingPoint, surface: SurfaceId, key: u64) -> (Rgb, u64) {
+        let coupler = self.coupler();
+        let mut rays = 0u64;
+        let h = self
+            .shooters
+            .iter()
+            .enumerate()
+            .map(|(k, s)| {
+                let (f, r) = coupler.coupling(x, surface, &s.patch, [key, k as u64]);
+                rays += r as u64;
+                s.radiosity * f
+            })
+            .sum();
+        (h, rays)
+    }
+
+    /// Replaces the mesh by a refinement of it (the same surfaces, vertices kept where they
+    /// were): vertices already solved keep their values, new ones get the exact direct light
+    /// and gather the light shot so far, and what each element has shot is carried over by
+    /// area. Shooting then goes on from where it was.
+    pub fn remesh(&mut self, mesh: &SceneMesh, progress: &dyn Progress) -> Result<(), SolveError> {
+        check_mesh(self.scene, mesh)?;
+        let disc = Discretization::new(self.scene, mesh, self.options.elements_per_patch);
+
+        // What each element has shot, as a density over its surface, moved to the new triangles.
+        let mut per_triangle: Vec<Vec<Rgb>> = self
+            .meshes
+            .iter()
+            .map(|m| vec![Rgb::ZERO; m.triangle_count()])
+            .collect();
+        for (e, &shot) in self.disc.elements.iter().zip(&self.element_shot) {
+            per_triangle[e.surface][e.triangle] = shot;
+        }
+        let moved: Vec<Vec<Rgb>> = mesh
+            .surfaces
+            .par_iter()
+            .map(|new| {
+                let old = &self.meshes[new.surface];
+                transfer_density(
+                    old,
+                    &per_triangle[new.surface],
+                    &TriangleLocator::new(old),
+                    new,
+                )
+            })
+            .collect();
+        let element_shot: Vec<Rgb> = disc
+            .elements
+            .iter()
+            .map(|e| moved[e.surface][e.triangle])
+            .collect();
+
+        // Vertices that were there before keep their values; where a position repeats (the two
+        // sides of a contact line) the copy whose interior direction agrees best is taken.
+        let mut old_at: HashMap<(SurfaceId, [u64; 3]), Vec<usize>> = HashMap::new();
+        for (v, x) in self.disc.receivers.iter().enumerate() {
+            old_at
+                .entry((
+                    self.disc.receiver_surface[v],
+                    x.point.to_array().map(f64::to_bits),
+                ))
+                .or_default()
+                .push(v);
+        }
+        let n = disc.receiver_count();
+        let (mut direct, mut irradiance) = (vec![Rgb::ZERO; n], vec![Rgb::ZERO; n]);
+        let mut fresh = Vec::new();
+        for v in 0..n {
+            let x = &disc.receivers[v];
+            let key = (
+                disc.receiver_surface[v],
+                x.point.to_array().map(f64::to_bits),
+            );
+            let same = old_at.get(&key).and_then(|olds| {
+                olds.iter().copied().max_by(|&a, &b| {
+                    let (da, db) = (
+                        self.disc.receivers[a].inward.dot(x.inward),
+                        self.disc.receivers[b].inward.dot(x.inward),
+                    );
+                    da.total_cmp(&db).then(b.cmp(&a))
+                })
+            });
+            match same {
+                Some(old) => {
+                    direct[v] = self.direct_irradiance[old];
+                    irradiance[v] = self.irradiance[old];
+                }
+                None => fresh.push(v),
+            }
+        }
+        let t = Instant::now();
+        let new_direct = irradiance_at(&fresh, "direct light", progress, |v| {
+            self.direct
+                .irradiance(&disc.receivers[v], disc.receiver_surface[v])
+        });
+        self.direct_seconds += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let rays = std::sync::atomic::AtomicU64::new(0);
+        let gathered = if self.shooters.is_empty() {
+            vec![Rgb::ZERO; fresh.len()]
+        } else {
+            irradiance_at(&fresh, "gathering", progress, |v| {
+                let (h, r) = self.gather(&disc.receivers[v], disc.receiver_surface[v], v as u64);
+                rays.fetch_add(r, std::sync::atomic::Ordering::Relaxed);
+                h
+            })
+        };
+        self.gather_seconds += t.elapsed().as_secs_f64();
+        self.rays_cast += rays.into_inner();
+        for ((&v, d), g) in fresh.iter().zip(new_direct).zip(gathered) {
+            direct[v] = d;
+            irradiance[v] = d + g;
+        }
+        self.gathered += fresh.len();
+
+        // Every shot's power either reached a vertex of the new mesh or escaped.
+        let received = disc.integrate(&irradiance, |_| Rgb::splat(1.0));
+        self.escaped = self.scene.emitted_power() + self.shot_power - received;
+        self.patch_shooter = vec![None; disc.patches.len()];
+        self.cache.clear();
+        self.meshes = mesh.surfaces.clone();
+        self.disc = disc;
+        self.direct_irradiance = direct;
+        self.irradiance = irradiance;
+        self.element_shot = element_shot;
+        self.remeshes += 1;
+        Ok(())
+    }
+
+    /// Radiosity at every vertex, per surface: E + ρ H.
+    pub fn radiosity(&self) -> Vec<Vec<Rgb>> {
+        self.disc.per_surface(&self.radiosity_of(&self.irradiance))
+    }
+
+    /// The direct part of the radiosity at every vertex, per surface: E + ρ H_direct.
+    pub fn direct_radiosity(&self) -> Vec<Vec<Rgb>> {
+        self.disc
+            .per_surface(&self.radiosity_of(&self.direct_irradiance))
+    }
+
+    fn radiosity_of(&self, h: &[Rgb]) -> Vec<Rgb> {
+        (0..self.disc.receiver_count())
+            .map(|v| self.disc.emission[v] + self.disc.reflectance[v].mul_rgb(h[v]))
+            .collect()
+    }
+
+    /// Irradiance at an interior point of `surface` from the patches shot so far (without the
+    /// direct light), for error estimates; `key` picks the random stream.
+    pub fn indirect_irradiance(&self, point: glam::DVec3, surface: SurfaceId, key: u64) -> Rgb {
+        let normal = self.meshes[surface].frame.normal;
+        self.gather(&ReceivingPoint::interior(point, normal), surface, key)
+            .0
+    }
+
+    /// Patch shots so far.
+    pub fn shots(&self) -> usize {
+        self.shots
+    }
+
+    /// The surface meshes the solution lives on.
+    pub fn meshes(&self) -> &[SurfaceMesh] {
+        &self.meshes
+    }
+
+    /// Whether any light has been shot beyond the direct light.
+    pub fn has_indirect(&self) -> bool {
+        !self.shooters.is_empty()
+    }
+
+    /// The exact direct light's evaluator.
+    pub fn direct_light(&self) -> &DirectLight<'a> {
+        &self.direct
+    }
+
+    /// The solution so far.
+    pub fn solution(&self) -> Solution {
+        let scene = self.scene;
+        let disc = &self.disc;
+        let unshot: Rgb = self.patch_unshot_power().into_iter().sum();
+        let absorbed = disc.integrate(&self.irradiance, |e| {
+            Rgb::splat(1.0) - scene.surfaces[e.surface].reflectance
+        });
+        let total_area: f64 = disc.elements.iter().map(|e| e.area).sum();
+        let mean_rho: Rgb = disc
+            .elements
+            .iter()
+            .map(|e| scene.surfaces[e.surface].reflectance * e.area)
+            .sum::<Rgb>()
+            / total_area;
+        let ambient = (unshot / total_area).mul_rgb(mean_rho.map(|r| 1.0 / (1.0 - r)));
+        let emitted = scene.emitted_power();
+        let stats = SolveStats {
+            stop: self.stop,
+            shots: self.shots,
+            patches: disc.patches.len(),
+            receivers: disc.receiver_count(),
+            rays_cast: self.rays_cast,
+            emitted,
+            absorbed,
+            unshot,
+            escaped: self.escaped,
+            unshot_fraction: unshot_magnitude(&self.patch_unshot_power())
+                / emitted.mean().max(f64::MIN_POSITIVE),
+            direct_seconds: self.direct_seconds,
+            shooting_seconds: self.shooting_seconds,
+            remeshes: self.remeshes,
+            gathered: self.gathered,
+            gather_seconds: self.gather_seconds,
+        };
+        Solution {
+            radiosity: self.radiosity(),
+            irradiance: disc.per_surface(&self.irradiance),
+            ambient,
+            stats,
+        }
+    }
 }
 
-/// Unshot power of every patch: Σ area × unshot radiosity of its elements.
-fn patch_unshot_power(disc: &Discretization, element_unshot: &[Rgb]) -> Vec<Rgb> {
-    disc.patches
-        .iter()
-        .map(|p| {
-            p.elements
-                .iter()
-                .map(|&e| element_unshot[e] * disc.elements[e].area)
-                .sum()
-        })
-        .collect()
+/// Size of a patch's unshot power, whatever its sign: the channels' mean absolute value.
+fn magnitude(power: Rgb) -> f64 {
+    (power.r.abs() + power.g.abs() + power.b.abs()) / 3.0
+}
+
+/// How much power is left to shoot: the sum of the patches' [`magnitude`]s. Before any remesh
+/// every patch's unshot power is non-negative and this is the mean of the total.
+fn unshot_magnitude(patch_power: &[Rgb]) -> f64 {
+    patch_power.iter().map(|&p| magnitude(p)).sum()
+}
+
+fn check_mesh(scene: &Scene, mesh: &SceneMesh) -> Result<(), SolveError> {
+    if mesh.surfaces.len() != scene.surfaces.len()
+        || mesh
+            .surfaces
+            .iter()
+            .enumerate()
+            .any(|(s, m)| m.surface != s)
+    {
+        return Err(SolveError::MeshMismatch {
+            surfaces: scene.surfaces.len(),
+            meshes: mesh.surfaces.len(),
+        });
+    }
+    Ok(())
 }
