@@ -143,6 +143,22 @@ struct SweepArgs {
     /// Paths per sample of the path-traced reference.
     #[arg(long, default_value_t = 16_000)]
     reference_paths: usize,
+    /// Score on these surfaces only (names, comma-separated; default: every surface that does
+    /// not emit).
+    #[arg(long, value_delimiter = ',')]
+    surfaces: Vec<String>,
+    /// The methods to run (comma-separated; default: all four).
+    #[arg(long, value_delimiter = ',', value_parser = ["uniform", "uniform+adaptive", "discontinuity", "discontinuity+adaptive"])]
+    methods: Vec<String>,
+    /// The adaptive runs start from this fraction of the budget.
+    #[arg(long, default_value_t = 0.25)]
+    initial_fraction: f64,
+    /// Stop shooting when the unshot power falls below this fraction of the emitted power.
+    #[arg(long, default_value_t = SolverOptions::default().epsilon)]
+    epsilon: f64,
+    /// Rays per vertex–patch pair for visibility.
+    #[arg(long, default_value_t = SolverOptions::default().visibility_rays)]
+    rays: usize,
     /// No progress bar and no table.
     #[arg(long)]
     quiet: bool,
@@ -219,22 +235,51 @@ fn sweep(args: &SweepArgs) -> Result<(), Failure> {
             args.refine_tol
         )));
     }
+    if !(args.initial_fraction > 0.0 && args.initial_fraction <= 1.0) {
+        return Err(usage(anyhow::anyhow!(
+            "--initial-fraction must be in (0, 1], not {}",
+            args.initial_fraction
+        )));
+    }
     let loaded = load(&args.scene)?;
+    let mut surfaces = Vec::new();
+    for name in &args.surfaces {
+        surfaces.push(loaded.scene.surface_id(name).ok_or_else(|| {
+            usage(anyhow::anyhow!(
+                "--surfaces: the scene has no surface named {name:?}"
+            ))
+        })?);
+    }
+    let methods = penumbra::sweep::SweepMethod::ALL
+        .into_iter()
+        .filter(|m| args.methods.is_empty() || args.methods.iter().any(|n| n == m.name()))
+        .collect();
     let options = penumbra::sweep::SweepOptions {
         budgets: args.budgets.clone(),
+        methods,
         refine_tol: args.refine_tol,
+        initial_fraction: args.initial_fraction,
         samples: sample_count,
         seed: args.seed,
         solver: SolverOptions {
             direct_only: args.direct_only,
+            epsilon: args.epsilon,
+            visibility_rays: args.rays,
             ..SolverOptions::default()
         },
     };
+    options.solver.validate().map_err(usage)?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
     let scene = &loaded.scene;
     let visibility = penumbra_scenes::Visibility::build(scene);
-    let samples = penumbra::sweep::sample_points(scene, &visibility, sample_count, args.seed);
+    let samples =
+        penumbra::sweep::sample_points(scene, &visibility, &surfaces, sample_count, args.seed);
+    if samples.is_empty() {
+        return Err(usage(anyhow::anyhow!(
+            "no sample points: the surfaces scored must not all be emitters"
+        )));
+    }
     let reference = if args.direct_only {
         penumbra::sweep::Reference::ExactDirect
     } else {
@@ -312,6 +357,8 @@ fn traced_reference(
         samples: usize,
         seed: u64,
         paths: usize,
+        #[serde(default)]
+        surfaces: Vec<String>,
         values: Vec<penumbra_solver::path_trace::ReferenceValue>,
     }
     let path = args.out.join("reference.json");
@@ -322,6 +369,7 @@ fn traced_reference(
             && c.samples == samples.len()
             && c.seed == args.seed
             && c.paths == args.reference_paths
+            && c.surfaces == args.surfaces
             && c.values.len() == samples.len()
     };
     if let Some(cached) = std::fs::read_to_string(&path)
@@ -355,6 +403,7 @@ fn traced_reference(
         samples: samples.len(),
         seed: args.seed,
         paths: args.reference_paths,
+        surfaces: args.surfaces.clone(),
         values,
     };
     penumbra::outputs::write_atomic(&path, serde_json::to_string(&cached)?.as_bytes())?;

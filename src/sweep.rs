@@ -20,11 +20,55 @@ use serde::Serialize;
 use crate::adaptive::RefineOptions;
 use crate::pipeline::{MeshMethod, RunError, RunOptions, run};
 
+/// A way of meshing that a sweep compares.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SweepMethod {
+    Uniform,
+    UniformAdaptive,
+    Discontinuity,
+    DiscontinuityAdaptive,
+}
+
+impl SweepMethod {
+    pub const ALL: [SweepMethod; 4] = [
+        SweepMethod::Uniform,
+        SweepMethod::UniformAdaptive,
+        SweepMethod::Discontinuity,
+        SweepMethod::DiscontinuityAdaptive,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            SweepMethod::Uniform => "uniform",
+            SweepMethod::UniformAdaptive => "uniform+adaptive",
+            SweepMethod::Discontinuity => "discontinuity",
+            SweepMethod::DiscontinuityAdaptive => "discontinuity+adaptive",
+        }
+    }
+
+    fn mesh(self) -> MeshMethod {
+        match self {
+            SweepMethod::Uniform | SweepMethod::UniformAdaptive => MeshMethod::Uniform,
+            _ => MeshMethod::Discontinuity,
+        }
+    }
+
+    fn adaptive(self) -> bool {
+        matches!(
+            self,
+            SweepMethod::UniformAdaptive | SweepMethod::DiscontinuityAdaptive
+        )
+    }
+}
+
 /// What a sweep runs.
 #[derive(Clone, Debug)]
 pub struct SweepOptions {
     /// Element budgets (`--max-elements` of each run).
     pub budgets: Vec<usize>,
+    pub methods: Vec<SweepMethod>,
+    /// The adaptive runs start from this fraction of the budget.
+    pub initial_fraction: f64,
     /// Tolerance of the adaptive runs at the first budget; it shrinks in proportion as the
     /// budget grows, so that larger budgets are spent.
     pub refine_tol: f64,
@@ -122,23 +166,18 @@ pub fn sweep(
                 / mean.max(f64::MIN_POSITIVE)
         }
     };
-    let methods = [
-        ("uniform", MeshMethod::Uniform, false),
-        ("uniform+adaptive", MeshMethod::Uniform, true),
-        ("discontinuity", MeshMethod::Discontinuity, false),
-        ("discontinuity+adaptive", MeshMethod::Discontinuity, true),
-    ];
+    let methods = &options.methods;
     let first = options.budgets.first().copied().unwrap_or(1);
     let mut rows = Vec::new();
     progress.start("sweep", (options.budgets.len() * methods.len()) as u64);
     for &budget in &options.budgets {
-        for (name, mesh, adaptive) in methods {
+        for &method in methods {
             let run_options = RunOptions {
-                mesh,
+                mesh: method.mesh(),
                 max_elements: budget,
-                refine: adaptive.then(|| RefineOptions {
+                refine: method.adaptive().then(|| RefineOptions {
                     tolerance: options.refine_tol * first as f64 / budget.max(1) as f64,
-                    initial_elements: budget / 4,
+                    initial_elements: ((budget as f64 * options.initial_fraction) as usize).max(1),
                     max_rounds: 16,
                 }),
                 solver: options.solver.clone(),
@@ -184,7 +223,7 @@ pub fn sweep(
             }
             let scale = mean.max(f64::MIN_POSITIVE);
             rows.push(SweepRow {
-                method: name,
+                method: method.name(),
                 max_elements: budget,
                 refine_tol: run_options.refine.as_ref().map(|r| r.tolerance),
                 triangles: result.mesh.triangle_count(),
@@ -214,11 +253,13 @@ pub fn sweep(
     })
 }
 
-/// Seeded points spread over the scene's surfaces by area (emitters left out), with the exact
-/// direct radiosity there and whether some emitter is partly hidden.
+/// Seeded points spread over the scene's surfaces by area (emitters left out; only `surfaces`
+/// if that is not empty), with the exact direct radiosity there and whether some emitter is
+/// partly hidden.
 pub fn sample_points(
     scene: &Scene,
     visibility: &Visibility,
+    surfaces: &[SurfaceId],
     count: usize,
     seed: u64,
 ) -> Vec<Sample> {
@@ -226,6 +267,7 @@ pub fn sample_points(
         .triangles()
         .iter()
         .filter(|t| !scene.surfaces[t.surface].is_emitter())
+        .filter(|t| surfaces.is_empty() || surfaces.contains(&t.surface))
         .collect();
     let areas: Vec<f64> = triangles
         .iter()
