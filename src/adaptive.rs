@@ -21,7 +21,8 @@ use serde::Serialize;
 pub struct RefineOptions {
     /// Split triangles whose residual exceeds this fraction of the scene's mean radiosity.
     pub tolerance: f64,
-    /// Triangles of the mesh refinement starts from (the budget caps where it ends).
+    /// Triangles of the mesh refinement starts from (the budget caps where it ends);
+    /// [`INITIAL_FRACTION`] of the budget by default.
     pub initial_elements: usize,
     /// Rounds at most.
     pub max_rounds: usize,
@@ -40,6 +41,15 @@ pub enum RefineStop {
     /// The time budget ran out.
     TimeBudget,
 }
+
+/// The fraction of the element budget adaptive runs start from, by default: the estimate, not a
+/// guess made before any solving, should place most triangles. On the Cornell floor, direct light
+/// only, 30,000 triangles: RMS error 0.096 % from a tenth, 0.105 % from a quarter.
+pub const INITIAL_FRACTION: f64 = 0.1;
+
+/// Rounds of refinement at most, by default. A round takes at most a third of the room left, so
+/// going from a tenth of the budget to its last half percent takes about 13.
+pub const DEFAULT_MAX_ROUNDS: usize = 32;
 
 /// Light left unshot (fraction of the emitted power) when a round's residuals are measured in a
 /// full solution. The indirect light is smooth, and what is still unshot changes it little.
@@ -123,6 +133,13 @@ pub fn refine_adaptively(
             stop = RefineStop::TimeBudget;
             break;
         }
+        // Only triangles worse than the mesh's typical (RMS) residual are split: refinement
+        // spreads the error evenly instead of polishing large smooth triangles whose residual
+        // is already below it. On the Cornell floor, direct light only, 30,000 triangles: RMS
+        // error 0.092 %; splitting every triangle over a tolerance of 8e-5, 0.116 %.
+        if over.iter().any(|o| o.0 > residual.rms) {
+            over.retain(|o| o.0 > residual.rms);
+        }
         // Largest share of the squared error (residual squared times area) first. A split adds
         // about two triangles and quality refinement a few more, so a round takes at most a
         // third of the room left, and halves that until it fits.
@@ -131,9 +148,11 @@ pub fn refine_adaptively(
         }
         over.sort_by(|a, b| b.0.total_cmp(&a.0).then((a.1, a.2).cmp(&(b.1, b.2))));
         let room = max_elements.saturating_sub(mesh.triangle_count());
-        // The last 2 % of the budget is not worth a round (and, in full solutions, the
-        // vertices' gathering and the patches' new columns).
-        let mut take = if room * 50 < max_elements {
+        // The last sliver of the budget is not worth a round: 0.5 % of it when only the direct
+        // light is solved, 2 % in full solutions, where a round also costs the new vertices'
+        // gathering and the patches' new columns.
+        let last = if solver_options.direct_only { 200 } else { 50 };
+        let mut take = if room * last < max_elements {
             0
         } else {
             over.len().min(room / 3)

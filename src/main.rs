@@ -63,19 +63,20 @@ struct RunArgs {
     #[arg(long, default_value_t = DEFAULT_MAX_ELEMENTS)]
     max_elements: usize,
     /// Discontinuity meshes: how many times smaller in area triangles are in partial shadow than
-    /// in full light or full shadow (1: no grading).
-    #[arg(long, default_value_t = DEFAULT_PENUMBRA_DENSITY)]
-    penumbra_density: f64,
+    /// in full light or full shadow (1: no grading). Default: 8, or 1 with --refine-tol, where
+    /// refinement finds the penumbrae itself.
+    #[arg(long)]
+    penumbra_density: Option<f64>,
     /// Adaptive refinement: start from a coarser mesh and split, round after round, the triangles
     /// whose interpolation misses the exact direct light by more than this fraction of the
     /// scene's mean radiosity, up to --max-elements.
     #[arg(long)]
     refine_tol: Option<f64>,
-    /// With --refine-tol: triangles of the starting mesh (default: a quarter of --max-elements).
+    /// With --refine-tol: triangles of the starting mesh (default: a tenth of --max-elements).
     #[arg(long)]
     initial_elements: Option<usize>,
     /// With --refine-tol: rounds of refinement at most.
-    #[arg(long, default_value_t = 16)]
+    #[arg(long, default_value_t = penumbra::adaptive::DEFAULT_MAX_ROUNDS)]
     refine_rounds: usize,
     /// Stop adaptive refinement and shooting after this many seconds (from the start of the run)
     /// and write the best solution so far; report.json says so.
@@ -127,7 +128,7 @@ struct SweepArgs {
     #[arg(long, value_delimiter = ',', default_values_t = [2500, 5000, 10000, 20000, 30000])]
     budgets: Vec<usize>,
     /// Tolerance of the adaptive runs at the first budget, relative to the scene's mean
-    /// radiosity; it shrinks in proportion as the budget grows.
+    /// radiosity; it shrinks in proportion as the budget grows, so that larger budgets are spent.
     #[arg(long, default_value_t = 1e-3)]
     refine_tol: f64,
     /// Sample points the runs are scored at (default: 4000 with --direct-only, else 1000).
@@ -150,8 +151,9 @@ struct SweepArgs {
     /// The methods to run (comma-separated; default: all four).
     #[arg(long, value_delimiter = ',', value_parser = ["uniform", "uniform+adaptive", "discontinuity", "discontinuity+adaptive"])]
     methods: Vec<String>,
-    /// The adaptive runs start from this fraction of the budget.
-    #[arg(long, default_value_t = 0.25)]
+    /// The adaptive runs start from this fraction of the budget (their initial meshes are not
+    /// graded: refinement finds the penumbrae).
+    #[arg(long, default_value_t = penumbra::adaptive::INITIAL_FRACTION)]
     initial_fraction: f64,
     /// Stop shooting when the unshot power falls below this fraction of the emitted power.
     #[arg(long, default_value_t = SolverOptions::default().epsilon)]
@@ -443,10 +445,16 @@ fn run(args: &RunArgs) -> Result<(), Failure> {
             .build_global()
             .context("cannot start the worker threads")?;
     }
-    if !(args.penumbra_density >= 1.0 && args.penumbra_density <= 1e6) {
+    let penumbra_density = args
+        .penumbra_density
+        .unwrap_or(if args.refine_tol.is_some() {
+            1.0
+        } else {
+            DEFAULT_PENUMBRA_DENSITY
+        });
+    if !(1.0..=1e6).contains(&penumbra_density) {
         return Err(usage(anyhow::anyhow!(
-            "--penumbra-density must be between 1 and 1e6, not {}",
-            args.penumbra_density
+            "--penumbra-density must be between 1 and 1e6, not {penumbra_density}"
         )));
     }
     if let Some(t) = args.time_budget
@@ -481,13 +489,15 @@ fn run(args: &RunArgs) -> Result<(), Failure> {
             Some(MeshArg::Discontinuity) => MeshMethod::Discontinuity,
         },
         max_elements: args.max_elements,
-        penumbra_density: args.penumbra_density,
+        penumbra_density,
         time_budget: args.time_budget,
         refine: args
             .refine_tol
             .map(|tolerance| penumbra::adaptive::RefineOptions {
                 tolerance,
-                initial_elements: args.initial_elements.unwrap_or(args.max_elements / 4),
+                initial_elements: args.initial_elements.unwrap_or(
+                    (args.max_elements as f64 * penumbra::adaptive::INITIAL_FRACTION) as usize,
+                ),
                 max_rounds: args.refine_rounds,
             }),
         discontinuity: penumbra_meshing::discontinuity::DiscontinuityOptions {

@@ -9,6 +9,7 @@
 
 use glam::DVec3;
 use penumbra_meshing::discontinuity::EmitterProbe;
+use penumbra_meshing::grading::DEFAULT_PENUMBRA_DENSITY;
 use penumbra_meshing::locate::TriangleLocator;
 use penumbra_scenes::rng::SplitMix64;
 use penumbra_scenes::{LoadedScene, Scene, SurfaceId, Visibility};
@@ -175,10 +176,15 @@ pub fn sweep(
             let run_options = RunOptions {
                 mesh: method.mesh(),
                 max_elements: budget,
+                penumbra_density: if method.adaptive() {
+                    1.0
+                } else {
+                    DEFAULT_PENUMBRA_DENSITY
+                },
                 refine: method.adaptive().then(|| RefineOptions {
                     tolerance: options.refine_tol * first as f64 / budget.max(1) as f64,
                     initial_elements: ((budget as f64 * options.initial_fraction) as usize).max(1),
-                    max_rounds: 16,
+                    max_rounds: crate::adaptive::DEFAULT_MAX_ROUNDS,
                 }),
                 solver: options.solver.clone(),
                 render: penumbra_viz::RenderOptions {

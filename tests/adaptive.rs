@@ -118,8 +118,9 @@ fn a_met_tolerance_stops_refinement() {
 }
 
 /// The refined mesh fed to the solver without restarting it holds the same energy as a solve from
-/// scratch on the final mesh: exactly (to 1e-6 of the emitted power) for the direct light, and
-/// to 0.3 % for full solutions (measured: 0.18 % at epsilon 2e-3, 0.13 % at 1e-4). Every
+/// scratch on the final mesh: for the direct light every vertex to 1e-9 and the absorbed power
+/// to 1e-6 of the emitted power (measured: 0), and to 0.3 % for full solutions (measured: 0.06 % at
+/// epsilon 2e-3). Every
 /// incremental solution balances: emitted = absorbed + unshot + escaped.
 #[test]
 fn incremental_and_from_scratch_solves_agree_on_energy() {
@@ -170,6 +171,24 @@ fn incremental_and_from_scratch_solves_agree_on_energy() {
         // Full solutions: the light shot early leaves the coarse mesh's larger patches, whose
         // sampled visibility fractions (ratio estimates) differ slightly from the fine ones'.
         let allowed = if options.direct_only { 1e-6 } else { 3e-3 };
+        if options.direct_only {
+            // Vertices kept from coarser meshes were evaluated from a slightly different
+            // interior direction (the one-sided offset of 1e-7 of the scene), nothing more.
+            let largest = scratch
+                .radiosity
+                .iter()
+                .flatten()
+                .map(|b| b.mean())
+                .fold(0.0, f64::max);
+            for (a, b) in incremental
+                .radiosity
+                .iter()
+                .flatten()
+                .zip(scratch.radiosity.iter().flatten())
+            {
+                assert!((*a - *b).mean().abs() <= 1e-9 * largest, "{a:?} vs {b:?}");
+            }
+        }
         assert!(difference <= allowed, "{difference:e}");
     }
 }

@@ -467,18 +467,20 @@ impl<'a> ProgressiveSolver<'a> {
             .map(|e| moved[e.surface][e.triangle])
             .collect();
 
-        // Vertices that were there before keep their values; where a position repeats (the two
-        // sides of a contact line) the copy whose interior direction agrees best is taken.
-        let mut old_at: HashMap<(SurfaceId, [u64; 3]), Vec<usize>> = HashMap::new();
-        for (v, x) in self.disc.receivers.iter().enumerate() {
-            old_at
-                .entry((
-                    self.disc.receiver_surface[v],
-                    x.point.to_array().map(f64::to_bits),
-                ))
-                .or_default()
-                .push(v);
-        }
+        // Vertices that were there before keep their values. Where a position repeats (the
+        // sides of a contact line, the corners of a block standing on the surface) each copy's
+        // value is a one-sided limit from its own triangles, so a copy is reused only when the
+        // old one looked from the same direction; elsewhere the light is continuous.
+        let positions = |d: &Discretization| {
+            let mut at: HashMap<(SurfaceId, [u64; 3]), Vec<usize>> = HashMap::new();
+            for (v, x) in d.receivers.iter().enumerate() {
+                at.entry((d.receiver_surface[v], x.point.to_array().map(f64::to_bits)))
+                    .or_default()
+                    .push(v);
+            }
+            at
+        };
+        let (old_at, new_at) = (positions(&self.disc), positions(&disc));
         let n = disc.receiver_count();
         let (mut direct, mut irradiance) = (vec![Rgb::ZERO; n], vec![Rgb::ZERO; n]);
         let mut fresh = Vec::new();
@@ -488,15 +490,12 @@ impl<'a> ProgressiveSolver<'a> {
                 disc.receiver_surface[v],
                 x.point.to_array().map(f64::to_bits),
             );
-            let same = old_at.get(&key).and_then(|olds| {
-                olds.iter().copied().max_by(|&a, &b| {
-                    let (da, db) = (
-                        self.disc.receivers[a].inward.dot(x.inward),
-                        self.disc.receivers[b].inward.dot(x.inward),
-                    );
-                    da.total_cmp(&db).then(b.cmp(&a))
-                })
-            });
+            let olds = old_at.get(&key).map_or(&[][..], Vec::as_slice);
+            let unique = olds.len() == 1 && new_at.get(&key).is_some_and(|c| c.len() == 1);
+            let same = olds
+                .iter()
+                .copied()
+                .find(|&old| unique || self.disc.receivers[old].inward.dot(x.inward) >= 1.0 - 1e-9);
             match same {
                 Some(old) => {
                     direct[v] = self.direct_irradiance[old];
