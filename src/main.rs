@@ -259,6 +259,7 @@ fn sweep(args: &SweepArgs) -> Result<(), Failure> {
     let options = penumbra::sweep::SweepOptions {
         budgets: args.budgets.clone(),
         methods,
+        surfaces: args.surfaces.clone(),
         refine_tol: args.refine_tol,
         initial_fraction: args.initial_fraction,
         samples: sample_count,

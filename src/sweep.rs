@@ -68,6 +68,9 @@ pub struct SweepOptions {
     /// Element budgets (`--max-elements` of each run).
     pub budgets: Vec<usize>,
     pub methods: Vec<SweepMethod>,
+    /// Names of the surfaces scored, for the record (empty: all; the samples are chosen by
+    /// [`sample_points`]).
+    pub surfaces: Vec<String>,
     /// The adaptive runs start from this fraction of the budget.
     pub initial_fraction: f64,
     /// Tolerance of the adaptive runs at the first budget; it shrinks in proportion as the
@@ -121,6 +124,8 @@ pub struct WorstSample {
 pub struct Sweep {
     pub format: &'static str,
     pub scene: String,
+    /// The surfaces scored (empty: every surface that does not emit).
+    pub surfaces: Vec<String>,
     pub reference: &'static str,
     /// Root mean square of the reference's standard errors relative to the mean (zero for the
     /// exact direct light).
@@ -247,6 +252,7 @@ pub fn sweep(
     Ok(Sweep {
         format: "penumbra-sweep/1",
         scene: scene.name.clone(),
+        surfaces: options.surfaces.clone(),
         reference: match reference {
             Reference::ExactDirect => "exact direct light",
             Reference::PathTraced(_) => "path traced",
@@ -347,11 +353,16 @@ pub fn sweep_charts(sweep: &Sweep) -> Vec<(&'static str, LogLogChart)> {
             .collect()
     };
     let y_label = format!("RMS error, % of mean ({})", sweep.reference);
+    let scene = if sweep.surfaces.is_empty() {
+        sweep.scene.clone()
+    } else {
+        format!("{} ({})", sweep.scene, sweep.surfaces.join(", "))
+    };
     vec![
         (
             "error-vs-elements",
             LogLogChart {
-                title: format!("{}: error against triangles", sweep.scene),
+                title: format!("{scene}: error against triangles"),
                 x_label: "triangles in the scene".to_owned(),
                 y_label: y_label.clone(),
                 series: series(|r| r.triangles as f64),
@@ -360,7 +371,7 @@ pub fn sweep_charts(sweep: &Sweep) -> Vec<(&'static str, LogLogChart)> {
         (
             "error-vs-time",
             LogLogChart {
-                title: format!("{}: error against time", sweep.scene),
+                title: format!("{scene}: error against time"),
                 x_label: "seconds (mesh and solve, no render)".to_owned(),
                 y_label,
                 series: series(|r| r.seconds),

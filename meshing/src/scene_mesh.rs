@@ -21,6 +21,8 @@ pub struct SceneMesh {
     pub refinable: Vec<RefinableSurface>,
     /// Each surface's discontinuity segments (empty lists for uniform meshes).
     pub discontinuities: Vec<Vec<DiscontinuitySegment>>,
+    /// Each surface's contact lines under hovering faces, with their gaps (3D ends, gap).
+    pub hovering: Vec<Vec<(DVec3, DVec3, f64)>>,
     pub discontinuity_stats: Option<DiscontinuityStats>,
 }
 
@@ -139,6 +141,7 @@ pub fn mesh_scene_uniform(scene: &Scene, max_elements: usize) -> Result<SceneMes
         .collect();
     Ok(SceneMesh {
         discontinuities: vec![Vec::new(); scene.surfaces.len()],
+        hovering: vec![Vec::new(); scene.surfaces.len()],
         surfaces,
         refinable,
         discontinuity_stats: None,
@@ -225,10 +228,13 @@ pub fn mesh_scene_discontinuity(
         .collect();
     let mut discontinuities = found.segments;
     discontinuities.resize(scene.surfaces.len(), Vec::new());
+    let mut hovering = found.hovering;
+    hovering.resize(scene.surfaces.len(), Vec::new());
     Ok(SceneMesh {
         surfaces,
         refinable,
         discontinuities,
+        hovering,
         discontinuity_stats: Some(found.stats),
     })
 }

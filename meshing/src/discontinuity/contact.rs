@@ -1,24 +1,40 @@
 //! Contact lines: where a blocker touches or pierces a receiver, the light jumps (D0) — from
 //! whatever reaches the open side to nothing under the blocker.
+//!
+//! A face that hovers over a receiver, parallel to it and closer than [`HOVER`] of its own size
+//! (a light panel hung just below a ceiling), casts a shadow that is sharp from every direction
+//! light comes from: under it the receiver sees almost nothing. Its outline, projected onto the
+//! receiver, counts as a contact line too.
 
 use glam::DVec3;
-use penumbra_scenes::{PlaneFrame, Scene, SurfaceId, Visibility};
+use penumbra_scenes::{Bounds, PlaneFrame, Scene, SurfaceId, Visibility};
 
 use super::clip_to_polygon;
 
-/// For each receiver with contacts, the segments (in 3D, on the receiver) where other surfaces
-/// stand on it or pass through it from its front side.
+/// A contact line on a receiver: its ends (3D, on the receiver) and the gap under the face that
+/// casts it (zero where the face touches the receiver, positive where it hovers).
+pub type ContactLine = (DVec3, DVec3, f64);
+
+/// For each receiver with contacts, the segments where other surfaces stand on it, pass through
+/// it from its front side, or hover over it.
 pub fn contact_lines(
     scene: &Scene,
     frames: &[Option<PlaneFrame>],
     visibility: &Visibility,
-) -> Vec<(SurfaceId, Vec<(DVec3, DVec3)>)> {
+) -> Vec<(SurfaceId, Vec<ContactLine>)> {
     let tol = visibility.contact_distance();
     let mut out = Vec::new();
     for (r, receiver) in scene.surfaces.iter().enumerate() {
         let Some(rf) = frames[r] else { continue };
         let mut candidates = std::collections::BTreeSet::new();
-        visibility.triangles_overlapping(receiver.bounds(), |t| {
+        // Grown by the largest gap a face of the receiver's size may hover at.
+        let b = receiver.bounds();
+        let reach = DVec3::splat(HOVER * b.diagonal());
+        let near = Bounds {
+            min: b.min - reach,
+            max: b.max + reach,
+        };
+        visibility.triangles_overlapping(near, |t| {
             candidates.insert(visibility.triangles()[t].surface);
         });
         let mut lines = Vec::new();
@@ -38,10 +54,22 @@ pub fn contact_lines(
             if !h.iter().any(|&x| x > 0.0) {
                 continue;
             }
+            if let Some(gap) = hovering(poly, &h, tol) {
+                let n = poly.len();
+                for i in 0..n {
+                    let (p, q) = (poly[i] - rf.normal * gap, poly[(i + 1) % n] - rf.normal * gap);
+                    for [a, c] in clip_to_polygon(&rf, &receiver.polygon, p, q) {
+                        if a.distance(c) > tol {
+                            lines.push((a, c, gap));
+                        }
+                    }
+                }
+                continue;
+            }
             for (p, q) in plane_section(poly, &h) {
                 for [a, c] in clip_to_polygon(&rf, &receiver.polygon, p, q) {
                     if a.distance(c) > tol {
-                        lines.push((a, c));
+                        lines.push((a, c, 0.0));
                     }
                 }
             }
@@ -51,6 +79,23 @@ pub fn contact_lines(
         }
     }
     out
+}
+
+/// How close, relative to its diameter, a parallel face must hover over a receiver for its
+/// shadow to count as a contact: the shadow's edge is then blurred over at most this fraction of
+/// the face's size, whatever the light's direction (up to 45 degrees off the normal).
+pub const HOVER: f64 = 1e-3;
+
+/// The gap under a polygon lying parallel to the plane, given its vertices' heights, if it hovers
+/// within [`HOVER`] of its diameter.
+fn hovering(poly: &[DVec3], h: &[f64], tol: f64) -> Option<f64> {
+    let gap = h.first().copied()?;
+    let diameter = poly
+        .iter()
+        .flat_map(|a| poly.iter().map(move |b| a.distance(*b)))
+        .fold(0.0, f64::max);
+    let parallel = h.iter().all(|&x| (x - gap).abs() <= tol);
+    (parallel && gap > 0.0 && gap <= HOVER * diameter).then_some(gap)
 }
 
 /// Where a planar polygon meets a plane, given its vertices' heights above it (zero: on it):

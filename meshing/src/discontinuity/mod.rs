@@ -119,6 +119,9 @@ pub struct DiscontinuityStats {
 #[derive(Clone, Debug, Default)]
 pub struct Discontinuities {
     pub segments: Vec<Vec<DiscontinuitySegment>>,
+    /// Per surface, the contact lines cast by faces hovering over it, with their gaps: values
+    /// at these lines are taken a few gaps off them (see [`contact::HOVER`]).
+    pub hovering: Vec<Vec<contact::ContactLine>>,
     pub stats: DiscontinuityStats,
 }
 
@@ -349,9 +352,11 @@ pub fn find_discontinuities(
     }
 
     // Contact lines, for every receiver that something touches.
+    let mut hovering = vec![Vec::new(); scene.surfaces.len()];
     for (r, contacts) in contact::contact_lines(scene, &frames, visibility) {
         stats.contact_segments += contacts.len();
-        for (from, to) in contacts {
+        hovering[r].extend(contacts.iter().copied().filter(|c| c.2 > 0.0));
+        for (from, to, _) in contacts {
             for (e, _) in scene.emitters() {
                 raw[r].push(DiscontinuitySegment {
                     surface: r,
@@ -391,7 +396,11 @@ pub fn find_discontinuities(
         segments.push(classified);
     }
     stats.seconds = started.elapsed().as_secs_f64();
-    Discontinuities { segments, stats }
+    Discontinuities {
+        segments,
+        hovering,
+        stats,
+    }
 }
 
 /// Surfaces other than `e` and `r` with a triangle in `bounds` for which `keep` holds, sorted.
