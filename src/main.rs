@@ -141,8 +141,9 @@ struct SweepArgs {
     /// scored against path tracing at the samples, cached in the output directory.
     #[arg(long)]
     direct_only: bool,
-    /// Paths per sample of the path-traced reference.
-    #[arg(long, default_value_t = 16_000)]
+    /// Paths per sample of the path-traced reference (on the Cornell box, 100,000 paths give a
+    /// standard error of about 0.2 % of the mean).
+    #[arg(long, default_value_t = 100_000)]
     reference_paths: usize,
     /// Score on these surfaces only (names, comma-separated; default: every surface that does
     /// not emit).

@@ -273,3 +273,61 @@ fn eee_curves_are_where_the_light_changes_form() {
         );
     }
 }
+
+/// The Cornell light hangs 0.1 below the ceiling: its outline, projected onto the ceiling, is a
+/// contact line (the ceiling above it sees almost nothing), and the vertices on it are evaluated
+/// ten gaps (1.0) off the line, each on its own side. Nothing else hovers.
+#[test]
+fn a_hovering_light_casts_contact_lines_on_the_ceiling() {
+    let scene = builtin::cornell();
+    let vis = Visibility::build(&scene);
+    let found = find_discontinuities(&scene, &vis, &DiscontinuityOptions::default());
+    let ceiling = scene.surface_id("ceiling").expect("ceiling");
+    let light = &scene.surfaces[scene.surface_id("light").expect("light")].polygon;
+    let on_outline = |p: DVec3| {
+        (0..light.len()).any(|i| {
+            let (a, b) = (light[i], light[(i + 1) % light.len()]);
+            let (a, b) = (DVec3::new(a.x, 548.8, a.z), DVec3::new(b.x, 548.8, b.z));
+            let d = b - a;
+            let t = ((p - a).dot(d) / d.length_squared()).clamp(0.0, 1.0);
+            p.distance(a + d * t) < 1e-9 * 1000.0
+        })
+    };
+    let contacts: Vec<_> = found.segments[ceiling]
+        .iter()
+        .filter(|s| s.event == Event::Contact)
+        .collect();
+    assert_eq!(contacts.len(), 4, "{contacts:#?}");
+    for s in &contacts {
+        assert_eq!(s.order, 0);
+        assert!(on_outline(s.from) && on_outline(s.to), "{s:?}");
+    }
+    assert_eq!(found.hovering[ceiling].len(), 4);
+    for (gap, hovering) in found.hovering.iter().enumerate().map(|(s, h)| (s, h.len())) {
+        assert!(gap == ceiling || hovering == 0);
+    }
+    for h in &found.hovering[ceiling] {
+        assert!((h.2 - 0.1).abs() < 1e-9, "gap {}", h.2);
+    }
+    // Vertices on the outline are split, and each copy is evaluated 1.0 into its own triangles.
+    let mesh = penumbra_meshing::mesh_scene_discontinuity(&scene, &vis, found, 10_000, 8.0)
+        .expect("meshes");
+    let disc = penumbra_solver::Discretization::new(&scene, &mesh, 24);
+    let m = &mesh.surfaces[ceiling];
+    let offset = disc.offsets[ceiling];
+    let mut lifted = 0;
+    for v in 0..m.vertex_count() {
+        let x = &disc.receivers[offset + v];
+        if on_outline(m.points3[v]) {
+            let lift = x.point.distance(m.points3[v]);
+            assert!(
+                lift > 0.0 && lift <= 1.0 + 1e-9,
+                "vertex {v}: lifted {lift}"
+            );
+            lifted += 1;
+        } else {
+            assert_eq!(x.point, m.points3[v]);
+        }
+    }
+    assert!(lifted >= 8, "{lifted} vertices on the outline");
+}

@@ -192,7 +192,11 @@ pub const HOVER_LIFT: f64 = 10.0;
 /// Per vertex of `m`, how far to move it into its own triangles before evaluating it: a
 /// [`HOVER_LIFT`] of gaps for vertices on the contact line of a hovering face, at most a quarter
 /// of its shortest edge; zero elsewhere.
-fn hover_lifts(m: &penumbra_meshing::SurfaceMesh, lines: &[(DVec3, DVec3, f64)], tol: f64) -> Vec<f64> {
+fn hover_lifts(
+    m: &penumbra_meshing::SurfaceMesh,
+    lines: &[(DVec3, DVec3, f64)],
+    tol: f64,
+) -> Vec<f64> {
     let mut lifts = vec![0.0; m.vertex_count()];
     if lines.is_empty() {
         return lifts;
@@ -211,7 +215,8 @@ fn hover_lifts(m: &penumbra_meshing::SurfaceMesh, lines: &[(DVec3, DVec3, f64)],
             .iter()
             .filter(|(a, b, _)| {
                 let d = *b - *a;
-                let t = ((*p - *a).dot(d) / d.length_squared().max(f64::MIN_POSITIVE)).clamp(0.0, 1.0);
+                let t =
+                    ((*p - *a).dot(d) / d.length_squared().max(f64::MIN_POSITIVE)).clamp(0.0, 1.0);
                 p.distance(*a + d * t) <= tol
             })
             .map(|l| l.2)

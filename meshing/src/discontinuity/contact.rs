@@ -57,7 +57,10 @@ pub fn contact_lines(
             if let Some(gap) = hovering(poly, &h, tol) {
                 let n = poly.len();
                 for i in 0..n {
-                    let (p, q) = (poly[i] - rf.normal * gap, poly[(i + 1) % n] - rf.normal * gap);
+                    let (p, q) = (
+                        poly[i] - rf.normal * gap,
+                        poly[(i + 1) % n] - rf.normal * gap,
+                    );
                     for [a, c] in clip_to_polygon(&rf, &receiver.polygon, p, q) {
                         if a.distance(c) > tol {
                             lines.push((a, c, gap));
