@@ -12,7 +12,7 @@
 
 use penumbra_meshing::SceneMesh;
 use penumbra_scenes::{Scene, Visibility};
-use penumbra_solver::estimate::{ResidualSummary, solution_residuals, summarize};
+use penumbra_solver::estimate::{IndirectEstimate, ResidualSummary, solution_residuals, summarize};
 use penumbra_solver::{Progress, ProgressiveSolver, Solution, SolveError, SolverOptions};
 use serde::Serialize;
 
@@ -26,6 +26,8 @@ pub struct RefineOptions {
     pub initial_elements: usize,
     /// Rounds at most.
     pub max_rounds: usize,
+    /// How full solutions estimate the indirect light's error.
+    pub indirect: IndirectEstimate,
 }
 
 /// Why refinement stopped.
@@ -96,7 +98,7 @@ pub fn refine_adaptively(
     let mut residual = ResidualSummary::default();
     for round in 0..=options.max_rounds {
         solver.shoot(ROUND_EPSILON.max(solver_options.epsilon), progress);
-        let residuals = solution_residuals(scene, &solver);
+        let residuals = solution_residuals(scene, &solver, options.indirect);
         residual = summarize(&mesh.surfaces, &solver.radiosity(), &residuals);
         let tolerance = options.tolerance * residual.mean_radiosity;
         let mut over: Vec<(f64, usize, usize)> = residuals

@@ -48,6 +48,23 @@ enum MeshArg {
     Discontinuity,
 }
 
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum IndirectArg {
+    /// From the jumps of the indirect light's gradient across each triangle's edges.
+    Gradient,
+    /// Gathered at each triangle's centroid from the patches shot so far.
+    Gathered,
+}
+
+impl From<IndirectArg> for penumbra_solver::estimate::IndirectEstimate {
+    fn from(a: IndirectArg) -> Self {
+        match a {
+            IndirectArg::Gradient => Self::GradientJumps,
+            IndirectArg::Gathered => Self::Gathered,
+        }
+    }
+}
+
 #[derive(clap::Args, Debug)]
 struct RunArgs {
     /// A .json or .obj file, or the name of a built-in scene (see `penumbra scenes`).
@@ -75,6 +92,11 @@ struct RunArgs {
     /// With --refine-tol: triangles of the starting mesh (default: a tenth of --max-elements).
     #[arg(long)]
     initial_elements: Option<usize>,
+    /// With --refine-tol, in full solutions: how the indirect light's interpolation error is
+    /// estimated: from its gradient's jumps across edges (free), or gathered at each triangle's
+    /// centroid from the patches shot so far (a form factor per shooter and triangle).
+    #[arg(long, value_enum, default_value_t = IndirectArg::Gradient)]
+    refine_indirect: IndirectArg,
     /// With --refine-tol: rounds of refinement at most.
     #[arg(long, default_value_t = penumbra::adaptive::DEFAULT_MAX_ROUNDS)]
     refine_rounds: usize,
@@ -501,6 +523,7 @@ fn run(args: &RunArgs) -> Result<(), Failure> {
                     (args.max_elements as f64 * penumbra::adaptive::INITIAL_FRACTION) as usize,
                 ),
                 max_rounds: args.refine_rounds,
+                indirect: args.refine_indirect.into(),
             }),
         discontinuity: penumbra_meshing::discontinuity::DiscontinuityOptions {
             eee: !args.no_eee,

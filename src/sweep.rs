@@ -190,6 +190,7 @@ pub fn sweep(
                     tolerance: options.refine_tol * first as f64 / budget.max(1) as f64,
                     initial_elements: ((budget as f64 * options.initial_fraction) as usize).max(1),
                     max_rounds: crate::adaptive::DEFAULT_MAX_ROUNDS,
+                    indirect: Default::default(),
                 }),
                 solver: options.solver.clone(),
                 render: penumbra_viz::RenderOptions {

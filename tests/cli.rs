@@ -247,8 +247,9 @@ fn solutions_are_byte_identical_whatever_the_thread_count() {
     assert!(solutions.windows(2).all(|w| w[0] == w[1]));
 }
 
-/// `--refine-tol` refines adaptively from a quarter of the budget and says how in `report.json`;
-/// a tolerance that is not positive is a usage error.
+/// `--refine-tol` refines adaptively from a tenth of the budget and says how in `report.json`;
+/// a tolerance that is not positive is a usage error. Full solutions refine as they shoot, with
+/// either estimate of the indirect light's error, and the mesh that comes out is the one solved.
 #[test]
 fn adaptive_refinement_is_reported() {
     let dir = tempfile::tempdir().expect("temp dir");
@@ -282,6 +283,31 @@ fn adaptive_refinement_is_reported() {
             .code(),
         Some(2)
     );
+    for estimate in ["gradient", "gathered"] {
+        let out = dir.path().join(estimate);
+        run_quietly(
+            "cornell",
+            &out,
+            &[
+                "--max-elements",
+                "3000",
+                "--refine-tol",
+                "0.002",
+                "--refine-indirect",
+                estimate,
+                "--epsilon",
+                "0.01",
+            ],
+        );
+        let report = json(&out.join("report.json"));
+        let solver = &report["solver"];
+        let rounds = report["refinement"]["rounds"].as_array().expect("rounds");
+        assert!(rounds.len() >= 2 && rounds[0]["shots"].as_u64().expect("shots") > 0);
+        assert_eq!(solver["remeshes"].as_u64(), Some(rounds.len() as u64 - 1));
+        assert!(solver["gathered"].as_u64().expect("gathered") > 0);
+        assert_eq!(solver["receivers"], report["counts"]["vertices"]);
+        assert_eq!(solver["stop"], "converged");
+    }
 }
 
 /// `penumbra sweep` runs the four methods per budget and writes a row for each, in CSV and JSON;

@@ -6,9 +6,10 @@
 //! full solution the indirect part (what the vertices gathered from the patches shot so far) is
 //! smooth, and its interpolation error is estimated from the jumps of its gradient across the
 //! triangle's edges: for a quadratic, the error inside an element of size h is h/8 times the
-//! jump. (Gathering it at every sample instead costs a ray-cast form factor per shooting patch
-//! and sample: for the Cornell box, ten times the whole solve.) A triangle's indicator is the
-//! largest of these, in radiosity units.
+//! jump. Gathering it at each triangle's centroid from the patches shot so far, as a new vertex
+//! would ([`IndirectEstimate::Gathered`]), costs a ray-cast form factor per shooting patch and
+//! triangle: on the Cornell box, several times the whole solve per round. A triangle's indicator
+//! is the largest of these, in radiosity units.
 
 use std::collections::HashMap;
 
@@ -36,8 +37,24 @@ const SAMPLES: [[f64; 3]; 4] = [
     [1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0],
 ];
 
+/// How the indirect light's interpolation error is estimated.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum IndirectEstimate {
+    /// From the jumps of its gradient across the triangle's edges (free).
+    #[default]
+    GradientJumps,
+    /// Gathered at the triangle's centroid from the patches shot so far and compared with the
+    /// interpolant there (one form factor per shooter and triangle).
+    Gathered,
+}
+
 /// Residuals of a progressive solver's current solution, per surface and triangle of its mesh.
-pub fn solution_residuals(scene: &Scene, solver: &ProgressiveSolver) -> Vec<Vec<f64>> {
+pub fn solution_residuals(
+    scene: &Scene,
+    solver: &ProgressiveSolver,
+    how: IndirectEstimate,
+) -> Vec<Vec<f64>> {
     let direct_values = solver.direct_radiosity();
     let values = solver.radiosity();
     let indirect = solver.has_indirect();
@@ -54,14 +71,40 @@ pub fn solution_residuals(scene: &Scene, solver: &ProgressiveSolver) -> Vec<Vec<
                     .zip(&direct_values[s])
                     .map(|(b, d)| (*b - *d).mean())
                     .collect();
-                for (r, j) in residuals
-                    .iter_mut()
-                    .zip(gradient_jump_estimate(mesh, &part))
-                {
+                let estimate = match how {
+                    IndirectEstimate::GradientJumps => gradient_jump_estimate(mesh, &part),
+                    IndirectEstimate::Gathered => gathered_estimate(scene, solver, mesh, &part),
+                };
+                for (r, j) in residuals.iter_mut().zip(estimate) {
                     *r = r.max(j);
                 }
             }
             residuals
+        })
+        .collect()
+}
+
+/// Per triangle, the reflected indirect light gathered at its centroid from the patches shot so
+/// far, against the interpolation of `part` (the vertices' indirect radiosity) there.
+pub fn gathered_estimate(
+    scene: &Scene,
+    solver: &ProgressiveSolver,
+    mesh: &SurfaceMesh,
+    part: &[f64],
+) -> Vec<f64> {
+    let rho = scene.surfaces[mesh.surface].reflectance;
+    (0..mesh.triangle_count())
+        .into_par_iter()
+        .map(|t| {
+            let tri = mesh.triangles[t];
+            let centroid: DVec3 =
+                tri.iter().map(|&i| mesh.points3[i as usize]).sum::<DVec3>() / 3.0;
+            let interpolated: f64 = tri.iter().map(|&i| part[i as usize]).sum::<f64>() / 3.0;
+            let key = (1 << 63) | (mesh.surface as u64) << 40 | t as u64;
+            let gathered = rho
+                .mul_rgb(solver.indirect_irradiance(centroid, mesh.surface, key))
+                .mean();
+            (interpolated - gathered).abs()
         })
         .collect()
 }
