@@ -10,4 +10,8 @@ pub enum SolveError {
     },
     #[error("the mesh has {meshes} surfaces but the scene has {surfaces} (this is a bug)")]
     MeshMismatch { surfaces: usize, meshes: usize },
+    #[error(
+        "the radiosity system is singular (a closed scene with reflectance 1 has no steady state)"
+    )]
+    Singular,
 }

@@ -23,6 +23,7 @@ pub mod direct;
 pub mod elements;
 pub mod error;
 pub mod estimate;
+pub mod gathering;
 pub mod lambert;
 pub mod measure;
 pub mod path_trace;
@@ -32,6 +33,7 @@ pub mod progressive;
 pub use direct::DirectLight;
 pub use elements::Discretization;
 pub use error::SolveError;
+pub use gathering::{ConvergencePoint, SolverMethod, solve_gathering};
 pub use lambert::{ReceivingPoint, form_factor};
 pub use progress::{NoProgress, Progress};
 pub use progressive::{

@@ -124,6 +124,11 @@ pub struct SolveStats {
     pub unshot_fraction: f64,
     pub direct_seconds: f64,
     pub shooting_seconds: f64,
+    /// Iterations of the solver (shots for progressive refinement, sweeps for gathering) and
+    /// its final residual relative to the light put in: the unshot fraction for progressive
+    /// refinement, ‖c + K B − B‖ / ‖c‖ for gathering and direct solves.
+    pub iterations: usize,
+    pub residual: f64,
     /// Times the mesh was replaced by a refined one, and the vertices that then gathered the
     /// light shot so far.
     pub remeshes: usize,
@@ -198,6 +203,9 @@ pub fn solve_progressive(
 struct Shooter {
     patch: Patch,
     radiosity: Rgb,
+    /// Seeds its random streams: the patch's index in its mesh, and that mesh's generation, so a
+    /// solve that never remeshes samples exactly what [`crate::coupling::PatchCoupling`] does.
+    key: u64,
 }
 
 /// Progressive refinement as a process: shoot, look at the solution, refine the mesh, shoot on.
@@ -365,6 +373,7 @@ impl<'a> ProgressiveSolver<'a> {
                     self.shooters.push(Shooter {
                         patch: self.disc.patches[p].clone(),
                         radiosity: Rgb::ZERO,
+                        key: (self.remeshes as u64) << 32 | p as u64,
                     });
                     self.patch_shooter[p] = Some(self.shooters.len() - 1);
                     self.shooters.len() - 1
@@ -384,7 +393,7 @@ impl<'a> ProgressiveSolver<'a> {
                                 &disc.receivers[v],
                                 disc.receiver_surface[v],
                                 patch,
-                                [v as u64, k as u64],
+                                [v as u64, self.shooters[k].key],
                             );
                             (f as f32, r)
                         })
@@ -421,9 +430,8 @@ impl<'a> ProgressiveSolver<'a> {
         let h = self
             .shooters
             .iter()
-            .enumerate()
-            .map(|(k, s)| {
-                let (f, r) = coupler.coupling(x, surface, &s.patch, [key, k as u64]);
+            .map(|s| {
+                let (f, r) = coupler.coupling(x, surface, &s.patch, [key, s.key]);
                 rays += r as u64;
                 s.radiosity * f
             })
@@ -616,6 +624,9 @@ impl<'a> ProgressiveSolver<'a> {
             unshot,
             escaped: self.escaped,
             unshot_fraction: unshot_magnitude(&self.patch_unshot_power())
+                / emitted.mean().max(f64::MIN_POSITIVE),
+            iterations: self.shots,
+            residual: unshot_magnitude(&self.patch_unshot_power())
                 / emitted.mean().max(f64::MIN_POSITIVE),
             direct_seconds: self.direct_seconds,
             shooting_seconds: self.shooting_seconds,
