@@ -50,6 +50,15 @@ pub struct ConvergencePoint {
     pub seconds: f64,
 }
 
+/// What solving the patch system gives: B̄ per channel and patch, how the residual fell, and why
+/// the iteration stopped.
+#[derive(Clone, Debug)]
+pub struct SystemSolution {
+    pub patch_radiosity: [Vec<f64>; 3],
+    pub history: Vec<ConvergencePoint>,
+    pub stop: StopReason,
+}
+
 /// The assembled system of a meshed scene.
 #[derive(Debug)]
 pub struct PatchSystem {
@@ -175,7 +184,7 @@ impl PatchSystem {
         tolerance: f64,
         max_iterations: usize,
         deadline: Option<Instant>,
-    ) -> Result<([Vec<f64>; 3], Vec<ConvergencePoint>, StopReason), SolveError> {
+    ) -> Result<SystemSolution, SolveError> {
         let n = self.patches();
         let started = Instant::now();
         let mut b: [Vec<f64>; 3] = std::array::from_fn(|_| vec![0.0; n]);
@@ -195,7 +204,11 @@ impl PatchSystem {
                 residual: residual(&b),
                 seconds: started.elapsed().as_secs_f64(),
             });
-            return Ok((b, history, StopReason::Converged));
+            return Ok(SystemSolution {
+                patch_radiosity: b,
+                history,
+                stop: StopReason::Converged,
+            });
         }
         let mut stop = StopReason::ShotLimit;
         for iteration in 1..=max_iterations {
@@ -239,7 +252,11 @@ impl PatchSystem {
                 break;
             }
         }
-        Ok((b, history, stop))
+        Ok(SystemSolution {
+            patch_radiosity: b,
+            history,
+            stop,
+        })
     }
 
     /// Vertex irradiance from patch radiosities: Hd + F B̄.
@@ -305,8 +322,11 @@ pub fn solve_gathering(
     let started = Instant::now();
     let system = PatchSystem::assemble(scene, mesh, visibility, options, progress);
     let assembled = started.elapsed().as_secs_f64();
-    let (b, history, stop) =
-        system.solve(method, options.epsilon, options.max_shots, options.deadline)?;
+    let SystemSolution {
+        patch_radiosity: b,
+        history,
+        stop,
+    } = system.solve(method, options.epsilon, options.max_shots, options.deadline)?;
     let disc = &system.disc;
     let h = system.irradiance(&b);
     let radiosity: Vec<Rgb> = (0..disc.receiver_count())

@@ -96,10 +96,10 @@ fn gathering_slows_as_reflectance_nears_one() {
             .into_iter()
             .enumerate()
         {
-            let (b, history, _) = system.solve(method, 1e-8, 1_000_000, None).expect("solves");
-            iterations[k] = history.len() - 1;
+            let solved = system.solve(method, 1e-8, 1_000_000, None).expect("solves");
+            iterations[k] = solved.history.len() - 1;
             let expected = rho / (1.0 - rho); // reflected radiosity of a furnace with E = 1
-            for &x in &b[0] {
+            for &x in &solved.patch_radiosity[0] {
                 assert!(
                     (x - expected).abs() < 0.01 * expected,
                     "rho {rho}: {x} vs {expected}"
