@@ -49,6 +49,25 @@ enum MeshArg {
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
+enum SolverArg {
+    Progressive,
+    Jacobi,
+    GaussSeidel,
+    Direct,
+}
+
+impl From<SolverArg> for penumbra_solver::SolverMethod {
+    fn from(a: SolverArg) -> Self {
+        match a {
+            SolverArg::Progressive => Self::Progressive,
+            SolverArg::Jacobi => Self::Jacobi,
+            SolverArg::GaussSeidel => Self::GaussSeidel,
+            SolverArg::Direct => Self::Direct,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
 enum IndirectArg {
     /// From the jumps of the indirect light's gradient across each triangle's edges.
     Gradient,
@@ -100,6 +119,16 @@ struct RunArgs {
     /// With --refine-tol: rounds of refinement at most.
     #[arg(long, default_value_t = penumbra::adaptive::DEFAULT_MAX_ROUNDS)]
     refine_rounds: usize,
+    /// How the radiosity system is solved: progressive refinement (shooting), Jacobi or
+    /// Gauss–Seidel gathering over the patch form-factor matrix, or its dense direct solve (the
+    /// discrete system's exact answer). Gathering and direct solves stop at a relative residual
+    /// of --epsilon, or after --max-shots sweeps.
+    #[arg(long, value_enum, default_value_t = SolverArg::Progressive)]
+    solver: SolverArg,
+    /// Also write the solver's residual against iterations and against time: convergence.csv,
+    /// convergence-iterations.svg/.png and convergence-time.svg/.png.
+    #[arg(long)]
+    convergence: bool,
     /// Stop adaptive refinement and shooting after this many seconds (from the start of the run)
     /// and write the best solution so far; report.json says so.
     #[arg(long)]
@@ -507,6 +536,7 @@ fn run(args: &RunArgs) -> Result<(), Failure> {
         }
     }
     let options = RunOptions {
+        method: args.solver.into(),
         mesh: match args.mesh {
             None => MeshMethod::Auto,
             Some(MeshArg::Uniform) => MeshMethod::Uniform,
@@ -546,12 +576,20 @@ fn run(args: &RunArgs) -> Result<(), Failure> {
     };
     let bars = Bars::new(args.quiet);
     let result = penumbra::run(loaded, &options, &bars).map_err(run_failure)?;
-    let written = write_outputs(&result, &args.out)?;
+    let mut written = write_outputs(&result, &args.out)?;
+    if args.convergence {
+        for (name, bytes) in penumbra::outputs::convergence_files(&result)? {
+            let path = args.out.join(name);
+            penumbra::outputs::write_atomic(&path, &bytes)
+                .with_context(|| format!("cannot write {}", path.display()))?;
+            written.push(path);
+        }
+    }
     if !args.quiet {
         let stats = &result.solution.stats;
         println!(
-            "{}: {} mesh, {} discontinuity segments, {} triangles, {} vertices, {} patches; {} shots ({:?}), \
-             unshot {:.2e} of emitted; {:.2} s",
+            "{}: {} mesh, {} discontinuity segments, {} triangles, {} vertices, {} patches; {} iterations ({:?}), \
+             residual {:.2e}; {:.2} s",
             result.loaded.scene.name,
             if result.mesh.discontinuity_stats.is_some() {
                 "discontinuity"
@@ -562,9 +600,9 @@ fn run(args: &RunArgs) -> Result<(), Failure> {
             result.mesh.triangle_count(),
             result.mesh.vertex_count(),
             stats.patches,
-            stats.shots,
+            stats.iterations,
             stats.stop,
-            stats.unshot_fraction,
+            stats.residual,
             result.times.total
         );
         println!("wrote {} files to {}", written.len(), args.out.display());

@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 use penumbra_meshing::MeshQuality;
 use penumbra_scenes::Rgb;
 use penumbra_solver::SolveStats;
+use penumbra_solver::SolverMethod;
 use serde::Serialize;
 
 use crate::pipeline::{RunResult, StageTimes};
@@ -172,10 +173,13 @@ pub fn report_json(result: &RunResult) -> String {
                 "uniform"
             },
             mesh_requested: opts.mesh,
-            solver: if opts.solver.direct_only {
-                "direct"
-            } else {
-                "progressive"
+            // "direct" has always meant the direct light only; the dense solve is "dense-direct".
+            solver: match (opts.solver.direct_only, opts.method) {
+                (true, _) => "direct",
+                (false, SolverMethod::Progressive) => "progressive",
+                (false, SolverMethod::Jacobi) => "jacobi",
+                (false, SolverMethod::GaussSeidel) => "gauss-seidel",
+                (false, SolverMethod::Direct) => "dense-direct",
             },
             max_elements: opts.max_elements,
             penumbra_density: opts.penumbra_density,
@@ -260,6 +264,58 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
         let _ = std::fs::remove_file(&tmp);
     }
     result
+}
+
+/// The solver's convergence as CSV (iteration, residual, seconds) and as log–log charts against
+/// iterations and against time; returns (file name, bytes) pairs.
+pub fn convergence_files(result: &RunResult) -> anyhow::Result<Vec<(String, Vec<u8>)>> {
+    let history = &result.solution.convergence;
+    let mut csv = String::from("iteration,residual,seconds\n");
+    for p in history {
+        csv += &format!("{},{:.6e},{:.6}\n", p.iteration, p.residual, p.seconds);
+    }
+    let mut files = vec![("convergence.csv".to_owned(), csv.into_bytes())];
+    let name = report_solver_name(result);
+    let y_label = "residual, relative to the light put in".to_owned();
+    let charts = [
+        (
+            "convergence-iterations",
+            "iterations",
+            history
+                .iter()
+                .map(|p| (p.iteration as f64, p.residual))
+                .collect::<Vec<_>>(),
+        ),
+        (
+            "convergence-time",
+            "seconds",
+            history.iter().map(|p| (p.seconds, p.residual)).collect(),
+        ),
+    ];
+    for (stem, x_label, points) in charts {
+        let chart = penumbra_viz::LogLogChart {
+            title: format!("{}: {name} convergence", result.loaded.scene.name),
+            x_label: x_label.to_owned(),
+            y_label: y_label.clone(),
+            series: vec![penumbra_viz::Series {
+                name: name.to_owned(),
+                points,
+            }],
+        };
+        files.push((format!("{stem}.svg"), chart.svg().into_bytes()));
+        files.push((format!("{stem}.png"), chart.png()?));
+    }
+    Ok(files)
+}
+
+fn report_solver_name(result: &RunResult) -> &'static str {
+    match (result.options.solver.direct_only, result.options.method) {
+        (true, _) => "direct light",
+        (false, SolverMethod::Progressive) => "progressive",
+        (false, SolverMethod::Jacobi) => "Jacobi",
+        (false, SolverMethod::GaussSeidel) => "Gauss-Seidel",
+        (false, SolverMethod::Direct) => "dense direct",
+    }
 }
 
 /// Writes every output of a run into `dir` (created if needed); returns the paths written.

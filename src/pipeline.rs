@@ -8,7 +8,9 @@ use penumbra_meshing::discontinuity::{DiscontinuityOptions, find_discontinuities
 use penumbra_meshing::grading::DEFAULT_PENUMBRA_DENSITY;
 use penumbra_meshing::{MeshError, SceneMesh, mesh_scene_discontinuity, mesh_scene_uniform};
 use penumbra_scenes::{LoadedScene, Rgb, Visibility};
-use penumbra_solver::{Progress, Solution, SolveError, SolverOptions, solve_progressive};
+use penumbra_solver::{
+    Progress, Solution, SolveError, SolverMethod, SolverOptions, solve_gathering, solve_progressive,
+};
 use penumbra_viz::{Render, RenderOptions, VizError};
 use serde::Serialize;
 
@@ -40,6 +42,8 @@ pub struct RunOptions {
     /// Seconds after which refinement and shooting stop and the best solution so far is kept.
     pub time_budget: Option<f64>,
     pub solver: SolverOptions,
+    /// How the radiosity system is solved (progressive refinement unless asked otherwise).
+    pub method: SolverMethod,
     pub render: RenderOptions,
 }
 
@@ -53,6 +57,7 @@ impl Default for RunOptions {
             refine: None,
             time_budget: None,
             solver: SolverOptions::default(),
+            method: SolverMethod::Progressive,
             render: RenderOptions::default(),
         }
     }
@@ -158,6 +163,12 @@ pub fn run(
 
     let t = Instant::now();
     let (refinement, solution) = match &options.refine {
+        Some(_) if options.method != SolverMethod::Progressive => {
+            return Err(RunError::Solve(SolveError::InvalidOption {
+                option: "solver",
+                reason: "adaptive refinement feeds the progressive solver; use --solver progressive",
+            }));
+        }
         Some(refine) => {
             let (report, solution) = refine_adaptively(
                 scene,
@@ -170,9 +181,13 @@ pub fn run(
             )?;
             (Some(report), solution)
         }
-        None => (
+        None if solver.direct_only || options.method == SolverMethod::Progressive => (
             None,
             solve_progressive(scene, &mesh, &visibility, &solver, progress)?,
+        ),
+        None => (
+            None,
+            solve_gathering(scene, &mesh, &visibility, &solver, options.method, progress)?.0,
         ),
     };
     let stats = &solution.stats;

@@ -452,3 +452,82 @@ fn a_spent_time_budget_is_reported() {
         Some(2)
     );
 }
+
+/// `--solver` picks how the system is solved; Gauss–Seidel and the dense direct solve agree with
+/// progressive refinement on the same mesh to the solvers' tolerance; `--convergence` writes the
+/// residual's history as CSV and charts; adaptive refinement with another solver is refused.
+#[test]
+fn solvers_agree_and_report_their_convergence() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut solutions = Vec::new();
+    for solver in ["progressive", "gauss-seidel", "direct"] {
+        let out = dir.path().join(solver);
+        run_quietly(
+            "cornell",
+            &out,
+            &[
+                "--max-elements",
+                "1500",
+                "--solver",
+                solver,
+                "--epsilon",
+                "1e-6",
+                "--convergence",
+            ],
+        );
+        let report = json(&out.join("report.json"));
+        let stats = &report["solver"];
+        assert!(
+            stats["residual"].as_f64().expect("residual") < 1e-6,
+            "{stats}"
+        );
+        let csv = std::fs::read_to_string(out.join("convergence.csv")).expect("csv");
+        let rows = csv.lines().count() - 1;
+        assert_eq!(
+            rows as u64,
+            stats["iterations"].as_u64().expect("iterations") + 1
+        );
+        for stem in ["convergence-iterations", "convergence-time"] {
+            assert!(
+                out.join(format!("{stem}.svg")).exists()
+                    && out.join(format!("{stem}.png")).exists()
+            );
+        }
+        let solution = json(&out.join("solution.json"));
+        let values: Vec<f64> = solution["surfaces"]
+            .as_array()
+            .expect("surfaces")
+            .iter()
+            .flat_map(|s| s["radiosity"].as_array().expect("radiosity").clone())
+            .map(|b| b[0].as_f64().expect("r"))
+            .collect();
+        assert!(values.iter().all(|v| v.is_finite() && *v >= 0.0));
+        solutions.push(values);
+    }
+    let largest = solutions[2].iter().copied().fold(0.0, f64::max);
+    for other in &solutions[..2] {
+        let worst = other
+            .iter()
+            .zip(&solutions[2])
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 1e-4 * largest, "{worst} of {largest}");
+    }
+    let o = penumbra(&[
+        "run",
+        "textbook",
+        "--solver",
+        "jacobi",
+        "--refine-tol",
+        "0.01",
+        "--out",
+        dir.path().join("x").to_str().expect("utf-8"),
+        "--quiet",
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}

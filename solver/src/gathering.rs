@@ -24,7 +24,9 @@ use crate::coupling::PatchCoupling;
 use crate::elements::Discretization;
 use crate::error::SolveError;
 use crate::progress::Progress;
-use crate::progressive::{Solution, SolveStats, SolverOptions, StopReason, direct_irradiance};
+use crate::progressive::{
+    ConvergencePoint, Solution, SolveStats, SolverOptions, StopReason, direct_irradiance,
+};
 
 /// How the discrete system is solved.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
@@ -39,15 +41,6 @@ pub enum SolverMethod {
     GaussSeidel,
     /// Gaussian elimination of the dense patch system: the discrete system's exact answer.
     Direct,
-}
-
-/// One iteration of a gathering solver: the residual ‖c + K B̄ − B̄‖ relative to ‖c‖ (channel
-/// means, 2-norms weighted by patch area) and the time since solving began.
-#[derive(Clone, Copy, Debug, Serialize)]
-pub struct ConvergencePoint {
-    pub iteration: usize,
-    pub residual: f64,
-    pub seconds: f64,
 }
 
 /// What solving the patch system gives: B̄ per channel and patch, how the residual fell, and why
@@ -368,6 +361,7 @@ pub fn solve_gathering(
             irradiance: disc.per_surface(&h),
             ambient: Rgb::ZERO,
             stats,
+            convergence: history.clone(),
         },
         history,
     ))

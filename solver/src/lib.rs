@@ -33,9 +33,10 @@ pub mod progressive;
 pub use direct::DirectLight;
 pub use elements::Discretization;
 pub use error::SolveError;
-pub use gathering::{ConvergencePoint, SolverMethod, solve_gathering};
+pub use gathering::{SolverMethod, solve_gathering};
 pub use lambert::{ReceivingPoint, form_factor};
 pub use progress::{NoProgress, Progress};
 pub use progressive::{
-    ProgressiveSolver, Solution, SolveStats, SolverOptions, StopReason, solve_progressive,
+    ConvergencePoint, ProgressiveSolver, Solution, SolveStats, SolverOptions, StopReason,
+    solve_progressive,
 };

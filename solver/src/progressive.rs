@@ -136,6 +136,15 @@ pub struct SolveStats {
     pub gather_seconds: f64,
 }
 
+/// One step of a solver: its residual relative to the light put in (for progressive refinement
+/// the unshot fraction, for gathering ‖c + K B̄ − B̄‖ / ‖c‖) and the seconds since it began.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct ConvergencePoint {
+    pub iteration: usize,
+    pub residual: f64,
+    pub seconds: f64,
+}
+
 /// Radiosity and irradiance at every mesh vertex, per surface.
 #[derive(Clone, Debug)]
 pub struct Solution {
@@ -145,6 +154,8 @@ pub struct Solution {
     /// evenly. Never part of the radiosity.
     pub ambient: Rgb,
     pub stats: SolveStats,
+    /// The residual after each iteration (each shot, each sweep).
+    pub convergence: Vec<ConvergencePoint>,
 }
 
 /// Direct irradiance at every vertex from the exact evaluator.
@@ -230,6 +241,7 @@ pub struct ProgressiveSolver<'a> {
     escaped: Rgb,
     stop: StopReason,
     shots: usize,
+    convergence: Vec<ConvergencePoint>,
     rays_cast: u64,
     remeshes: usize,
     gathered: usize,
@@ -275,6 +287,7 @@ impl<'a> ProgressiveSolver<'a> {
                 StopReason::ShotLimit
             },
             shots: 0,
+            convergence: Vec::new(),
             rays_cast: 0,
             remeshes: 0,
             gathered: 0,
@@ -342,6 +355,11 @@ impl<'a> ProgressiveSolver<'a> {
         self.stop = loop {
             let patch_power = self.patch_unshot_power();
             let fraction = unshot_magnitude(&patch_power) / emitted_mean;
+            self.convergence.push(ConvergencePoint {
+                iteration: self.shots,
+                residual: fraction,
+                seconds: self.shooting_seconds + started.elapsed().as_secs_f64(),
+            });
             progress.set(((-fraction.max(1e-300).log10() / goal).clamp(0.0, 1.0) * 1000.0) as u64);
             if fraction < epsilon {
                 break StopReason::Converged;
@@ -639,6 +657,7 @@ impl<'a> ProgressiveSolver<'a> {
             irradiance: disc.per_surface(&self.irradiance),
             ambient,
             stats,
+            convergence: self.convergence.clone(),
         }
     }
 }

@@ -23,6 +23,8 @@ const TOP: f64 = 40.0;
 const BOTTOM: f64 = 48.0;
 /// Glyph cell of the bitmap font, in points; SVG text uses the same size.
 const FONT: f64 = 8.0;
+/// Series with more points than this are drawn as lines without markers.
+const MAX_MARKERS: usize = 60;
 /// PNG pixels per chart point.
 pub const PNG_SCALE: u32 = 2;
 
@@ -180,7 +182,15 @@ impl LogLogChart {
         let y_axis = Axis::fit(points().map(|p| p.1));
         let longest = self.series.iter().map(|s| s.name.chars().count()).max();
         let right = RIGHT.max(52.0 + FONT * longest.unwrap_or(0) as f64);
-        let (x0, x1, y0, y1) = (LEFT, WIDTH - right, HEIGHT - BOTTOM, TOP);
+        // Room left of the plot for the y label and the widest tick label.
+        let widest = y_axis
+            .ticks
+            .iter()
+            .map(|&t| tick_label(t).chars().count())
+            .max()
+            .unwrap_or(0);
+        let left = LEFT.max(16.0 + 2.0 * FONT + 6.0 + FONT * widest as f64);
+        let (x0, x1, y0, y1) = (left, WIDTH - right, HEIGHT - BOTTOM, TOP);
         let at = |x: f64, y: f64| {
             DVec2::new(
                 x0 + (x1 - x0) * x_axis.unit(x),
@@ -271,7 +281,8 @@ impl LogLogChart {
                     width: 2.0,
                 });
             }
-            for &p in &pts {
+            // Markers show where the data are; on a dense series they would only blot the line.
+            for &p in pts.iter().filter(|_| pts.len() <= MAX_MARKERS) {
                 shapes.push(Shape::Marker {
                     at: p,
                     color,
