@@ -64,6 +64,9 @@ pub struct PatchSystem {
     pub c: [Vec<f64>; 3],
     pub k: [Vec<f64>; 3],
     pub rays_cast: u64,
+    /// Seconds spent on the direct light, and on the form factors and K.
+    pub direct_seconds: f64,
+    pub assembly_seconds: f64,
 }
 
 impl PatchSystem {
@@ -75,7 +78,10 @@ impl PatchSystem {
         progress: &dyn Progress,
     ) -> PatchSystem {
         let disc = Discretization::new(scene, mesh, options.elements_per_patch);
+        let started = Instant::now();
         let direct = direct_irradiance(scene, &disc, visibility, progress);
+        let direct_seconds = started.elapsed().as_secs_f64();
+        let started = Instant::now();
         let n = disc.receiver_count();
         let patches = disc.patches.len();
         let coupling = PatchCoupling {
@@ -144,6 +150,8 @@ impl PatchSystem {
             c,
             k,
             rays_cast,
+            direct_seconds,
+            assembly_seconds: started.elapsed().as_secs_f64(),
         }
     }
 
@@ -314,7 +322,6 @@ pub fn solve_gathering(
     options.validate()?;
     let started = Instant::now();
     let system = PatchSystem::assemble(scene, mesh, visibility, options, progress);
-    let assembled = started.elapsed().as_secs_f64();
     let SystemSolution {
         patch_radiosity: b,
         history,
@@ -349,11 +356,12 @@ pub fn solve_gathering(
         unshot,
         escaped: emitted + sent - received,
         unshot_fraction: unshot.mean().abs() / emitted.mean().max(f64::MIN_POSITIVE),
-        direct_seconds: 0.0,
-        shooting_seconds: started.elapsed().as_secs_f64() - assembled,
+        direct_seconds: system.direct_seconds,
+        // Everything after the direct light: the form factors, K and the sweeps.
+        shooting_seconds: started.elapsed().as_secs_f64() - system.direct_seconds,
         remeshes: 0,
         gathered: 0,
-        gather_seconds: assembled,
+        gather_seconds: 0.0,
     };
     Ok((
         Solution {

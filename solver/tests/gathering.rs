@@ -115,3 +115,69 @@ fn gathering_slows_as_reflectance_nears_one() {
         last = iterations;
     }
 }
+
+/// The closed furnace at the extremes of reflectance: with ρ = 0 every vertex is exactly E and
+/// nothing iterates; with ρ = 0.999 every vertex is within 1 % of E / (1 − ρ) = 1000, where the
+/// discrete form factors of the closed box must sum to 1 within about 1e-5. Gauss–Seidel gets
+/// there in thousands of sweeps, reported as such; progressive refinement capped at fewer shots
+/// than it needs says it stopped at the cap, and is still far from the answer.
+#[test]
+fn furnace_at_reflectance_zero_and_nearly_one() {
+    let still = builtin::furnace(1.0, 0.0);
+    let mesh = mesh_scene_uniform(&still, 600).expect("meshes");
+    for method in [
+        SolverMethod::Progressive,
+        SolverMethod::GaussSeidel,
+        SolverMethod::Direct,
+    ] {
+        let s = solve(&still, &mesh, method, 1e-9);
+        assert!(s.stats.iterations <= 1, "{method:?}: {:?}", s.stats);
+        for b in s.radiosity.iter().flatten() {
+            assert_eq!(b.mean(), 1.0, "{method:?}");
+        }
+    }
+
+    let scene = builtin::furnace(1.0, 0.999);
+    let mesh = mesh_scene_uniform(&scene, 600).expect("meshes");
+    let vis = Visibility::build(&scene);
+    let exact = 1.0 / (1.0 - 0.999);
+    for (method, epsilon, max) in [
+        (SolverMethod::Direct, 1e-9, 1),
+        (SolverMethod::GaussSeidel, 1e-9, 1_000_000),
+    ] {
+        let options = SolverOptions {
+            epsilon,
+            max_shots: max,
+            ..SolverOptions::default()
+        };
+        let (s, history) =
+            solve_gathering(&scene, &mesh, &vis, &options, method, &NoProgress).expect("solves");
+        let (lo, hi) = s
+            .radiosity
+            .iter()
+            .flatten()
+            .fold((f64::INFINITY, 0.0f64), |(lo, hi), b| {
+                (lo.min(b.mean()), hi.max(b.mean()))
+            });
+        eprintln!(
+            "rho 0.999, {method:?}: {} iterations, vertices from {lo:.3} to {hi:.3} (exact {exact})",
+            history.len() - 1
+        );
+        assert!(lo > 0.99 * exact && hi < 1.01 * exact, "{lo} .. {hi}");
+        if method == SolverMethod::GaussSeidel {
+            assert!(
+                history.len() > 1_000,
+                "slow convergence is reported, not hidden"
+            );
+        }
+    }
+    let capped = SolverOptions {
+        epsilon: 1e-9,
+        max_shots: 2_000,
+        ..SolverOptions::default()
+    };
+    let s = solve_progressive(&scene, &mesh, &vis, &capped, &NoProgress).expect("solves");
+    assert_eq!(s.stats.stop, penumbra_solver::StopReason::ShotLimit);
+    assert_eq!(s.stats.iterations, 2_000);
+    assert!(s.stats.unshot_fraction > 0.1, "{:?}", s.stats);
+}
