@@ -19,6 +19,7 @@
 pub mod builtin;
 pub mod color;
 pub mod error;
+pub mod extremes;
 pub mod frame;
 pub mod load;
 pub mod model;

@@ -1,0 +1,164 @@
+//! Scenes at the numerical extremes, each with the behaviour it must show (the tests in
+//! `tests/extremes.rs` hold the solver to it).
+
+use glam::DVec3;
+
+use crate::color::Rgb;
+use crate::model::{Scene, Surface};
+
+fn square(center: DVec3, half: f64) -> Vec<DVec3> {
+    let c = center;
+    vec![
+        DVec3::new(c.x - half, c.y - half, c.z),
+        DVec3::new(c.x + half, c.y - half, c.z),
+        DVec3::new(c.x + half, c.y + half, c.z),
+        DVec3::new(c.x - half, c.y + half, c.z),
+    ]
+}
+
+fn scene(name: &str, surfaces: Vec<Surface>) -> Scene {
+    Scene {
+        name: name.into(),
+        camera: None,
+        surfaces,
+    }
+}
+
+/// Facing down (−z).
+fn light(center: DVec3, half: f64) -> Surface {
+    let mut polygon = square(center, half);
+    polygon.reverse();
+    Surface::new("light", polygon, Rgb::ZERO).with_emission(Rgb::splat(1.0))
+}
+
+/// The textbook scene with a light of side `side` (centred at height 3) over a unit blocker at
+/// height 1 and a floor of side 6. As the light shrinks, the direct light on the floor becomes
+/// that of a point light of the same power, and the blocker's shadow a hard square of half-side
+/// 0.75 (the blocker's half-side 0.5 scaled by 3 / 2).
+pub fn tiny_light(side: f64) -> Scene {
+    scene(
+        "tiny_light",
+        vec![
+            light(DVec3::new(0.0, 0.0, 3.0), side / 2.0),
+            Surface::new(
+                "blocker",
+                square(DVec3::new(0.0, 0.0, 1.0), 0.5),
+                Rgb::splat(0.5),
+            ),
+            Surface::new("floor", square(DVec3::ZERO, 3.0), Rgb::splat(0.7)),
+        ],
+    )
+}
+
+/// A light at height 1 facing up, away from a blocker and a floor below it: nothing but the
+/// light itself may have any radiosity.
+pub fn light_facing_away() -> Scene {
+    let mut up = light(DVec3::new(0.0, 0.0, 1.0), 0.5);
+    up.polygon.reverse();
+    scene(
+        "light_facing_away",
+        vec![
+            up,
+            Surface::new(
+                "blocker",
+                square(DVec3::new(0.0, 0.0, 0.5), 0.3),
+                Rgb::splat(0.5),
+            ),
+            Surface::new("floor", square(DVec3::ZERO, 3.0), Rgb::splat(0.7)),
+        ],
+    )
+}
+
+/// A light facing down, with a receiver above it (behind the light, facing down too) and a floor
+/// below: the receiver gets no direct light, the floor does.
+pub fn receiver_behind_light() -> Scene {
+    let mut ceiling = square(DVec3::new(0.0, 0.0, 2.0), 2.0);
+    ceiling.reverse();
+    scene(
+        "receiver_behind_light",
+        vec![
+            light(DVec3::new(0.0, 0.0, 1.0), 0.5),
+            Surface::new("ceiling", ceiling, Rgb::splat(0.5)),
+            Surface::new("floor", square(DVec3::ZERO, 2.0), Rgb::splat(0.5)),
+        ],
+    )
+}
+
+/// A light sealed in a box (walls facing in) over a floor: the floor outside sees nothing.
+pub fn hidden_emitter() -> Scene {
+    let (lo, hi) = (DVec3::new(-1.0, -1.0, 0.5), DVec3::new(1.0, 1.0, 2.0));
+    let c = (lo + hi) / 2.0;
+    let faces: [[DVec3; 4]; 6] = [
+        [
+            lo,
+            DVec3::new(hi.x, lo.y, lo.z),
+            DVec3::new(hi.x, hi.y, lo.z),
+            DVec3::new(lo.x, hi.y, lo.z),
+        ],
+        [
+            DVec3::new(lo.x, lo.y, hi.z),
+            DVec3::new(hi.x, lo.y, hi.z),
+            hi,
+            DVec3::new(lo.x, hi.y, hi.z),
+        ],
+        [
+            lo,
+            DVec3::new(hi.x, lo.y, lo.z),
+            DVec3::new(hi.x, lo.y, hi.z),
+            DVec3::new(lo.x, lo.y, hi.z),
+        ],
+        [
+            DVec3::new(lo.x, hi.y, lo.z),
+            DVec3::new(hi.x, hi.y, lo.z),
+            hi,
+            DVec3::new(lo.x, hi.y, hi.z),
+        ],
+        [
+            lo,
+            DVec3::new(lo.x, hi.y, lo.z),
+            DVec3::new(lo.x, hi.y, hi.z),
+            DVec3::new(lo.x, lo.y, hi.z),
+        ],
+        [
+            DVec3::new(hi.x, lo.y, lo.z),
+            DVec3::new(hi.x, hi.y, lo.z),
+            hi,
+            DVec3::new(hi.x, lo.y, hi.z),
+        ],
+    ];
+    let mut surfaces = vec![light(DVec3::new(0.0, 0.0, 1.9), 0.3)];
+    for (k, f) in faces.iter().enumerate() {
+        let mut polygon = f.to_vec();
+        // Facing the box's centre.
+        let n = (polygon[1] - polygon[0]).cross(polygon[2] - polygon[0]);
+        if n.dot(c - polygon[0]) < 0.0 {
+            polygon.reverse();
+        }
+        surfaces.push(Surface::new(format!("box{k}"), polygon, Rgb::splat(0.5)));
+    }
+    surfaces.push(Surface::new(
+        "floor",
+        square(DVec3::new(0.0, 0.0, 0.0), 4.0),
+        Rgb::splat(0.5),
+    ));
+    scene("hidden_emitter", surfaces)
+}
+
+/// A light facing down at height `height` over a floor strip that starts 2 units to the side:
+/// with a tiny height every floor point sees the light at a grazing angle, and the irradiance is
+/// tiny, positive and that of the point-light formula.
+pub fn grazing_light(height: f64) -> Scene {
+    let floor = vec![
+        DVec3::new(2.0, -1.0, 0.0),
+        DVec3::new(6.0, -1.0, 0.0),
+        DVec3::new(6.0, 1.0, 0.0),
+        DVec3::new(2.0, 1.0, 0.0),
+    ];
+    scene(
+        "grazing_light",
+        vec![
+            light(DVec3::new(0.0, 0.0, height), 0.005),
+            Surface::new("floor", floor, Rgb::splat(0.5)),
+        ],
+    )
+}
