@@ -115,10 +115,20 @@ pub fn contour_sum(x: &ReceivingPoint, polygon: &[DVec3], tol: f64) -> f64 {
         sum += t;
         magnitude += t.abs();
     }
-    if magnitude > CANCELLATION_LIMIT * sum.abs() {
+    if magnitude > CANCELLATION_LIMIT * sum.abs() && far_from(x.point, polygon) {
         return quadrature_sum(x, polygon);
     }
     sum
+}
+
+/// Whether the polygon is further from `x` than twice its diameter: far enough for a few levels
+/// of subdivision to make quadrature exact to 10⁻¹⁰ (near polygons do not cancel this way).
+fn far_from(x: DVec3, polygon: &[DVec3]) -> bool {
+    let diameter = polygon
+        .iter()
+        .flat_map(|a| polygon.iter().map(move |b| a.distance(*b)))
+        .fold(0.0, f64::max);
+    polygon.iter().all(|p| p.distance(x) > 2.0 * diameter)
 }
 
 /// Edge terms this many times larger than their sum leave fewer than 10 good digits.
@@ -159,7 +169,7 @@ fn triangle_integral(kernel: &impl Fn(DVec3) -> f64, x: DVec3, t: [DVec3; 3], de
         .iter()
         .map(|p| p.distance(x))
         .fold(f64::INFINITY, f64::min);
-    if size > distance / 50.0 && depth < 10 {
+    if size > distance / 50.0 && depth < 6 {
         let m = [
             (t[0] + t[1]) / 2.0,
             (t[1] + t[2]) / 2.0,
