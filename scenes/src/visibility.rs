@@ -67,6 +67,8 @@ pub struct Visibility {
     /// Box queries (obvhs has them on the binary BVH only).
     boxes: Option<Bvh2>,
     center: DVec3,
+    /// Scene units per f32-world unit (the scene diagonal).
+    unit: f64,
     padding: f64,
     contact: f64,
 }
@@ -110,12 +112,20 @@ impl Visibility {
             bounds.center()
         };
         let diagonal = bounds.diagonal();
-        let padding = BOX_PADDING * diagonal;
+        // The f32 world is the scene re-centred and scaled to a diagonal of 1, so that the
+        // absolute epsilons inside the BVH (obvhs clamps ray direction components under f32's
+        // epsilon) mean the same at every scale.
+        let unit = if diagonal > 0.0 && diagonal.is_finite() {
+            diagonal
+        } else {
+            1.0
+        };
+        let padding = BOX_PADDING;
         let boxes: Vec<PaddedBox> = triangles
             .iter()
             .map(|t| {
                 let b = Bounds::from_points(&t.vertices);
-                PaddedBox(to_f32_box(b, center, padding))
+                PaddedBox(to_f32_box(b, center, unit, padding))
             })
             .collect();
         let (rays, box_bvh) = if boxes.is_empty() {
@@ -148,6 +158,7 @@ impl Visibility {
             rays,
             boxes: box_bvh,
             center,
+            unit,
             padding,
             contact: CONTACT_TOLERANCE * diagonal,
         }
@@ -167,18 +178,23 @@ impl Visibility {
         self.contact * (JUNCTION_OFFSET / CONTACT_TOLERANCE)
     }
 
-    fn f32_ray(&self, origin: DVec3, direction: DVec3, t_max: f64) -> Ray {
+    /// The ray in the f32 world, with a unit direction, and the factor that turns the caller's
+    /// ray parameter into the f32 ray's.
+    fn f32_ray(&self, origin: DVec3, direction: DVec3, t_max: f64) -> (Ray, f64) {
+        let length = direction.length();
+        let scale = length / self.unit;
         // The f32 ray only prunes boxes; generous parameter slack keeps that conservative.
-        Ray::new(
-            to_vec3a(origin - self.center),
-            to_vec3a(direction),
+        let ray = Ray::new(
+            to_vec3a((origin - self.center) / self.unit),
+            to_vec3a(direction / length),
             -1e-5,
             if t_max.is_finite() {
-                (t_max * (1.0 + 1e-5)) as f32 + 1e-5
+                (t_max * scale * (1.0 + 1e-5)) as f32 + 1e-5
             } else {
                 f32::INFINITY
             },
-        )
+        );
+        (ray, scale)
     }
 
     /// Whether something other than the `ignore`d surfaces blocks the open segment `from -> to`.
@@ -198,7 +214,7 @@ impl Visibility {
         }
         let margin = self.contact / length;
         let (t_min, t_max) = (margin, 1.0 - margin);
-        let ray = self.f32_ray(from, d, 1.0);
+        let (ray, _) = self.f32_ray(from, d, 1.0);
         !bvh.ray_traverse_miss(ray, |_, id| {
             let index = bvh.primitive_indices[id] as usize;
             let tri = &self.triangles[index];
@@ -232,7 +248,7 @@ impl Visibility {
         if !origin.is_finite() || !direction.is_finite() || direction == DVec3::ZERO {
             return None;
         }
-        let ray = self.f32_ray(origin, direction, t_max);
+        let (ray, scale) = self.f32_ray(origin, direction, t_max);
         let mut best: Option<(f64, usize)> = None;
         let mut hit = RayHit::none();
         bvh.ray_traverse(ray, &mut hit, |_, id| {
@@ -247,7 +263,7 @@ impl Visibility {
                         best = Some((t, index));
                     }
                     // Round up so that the f32 traversal never prunes a closer f64 hit.
-                    ((t * (1.0 + 1e-6)) as f32).max(f32::MIN_POSITIVE) + 1e-6
+                    ((t * scale * (1.0 + 1e-6)) as f32).max(f32::MIN_POSITIVE) + 1e-6
                 }
                 _ => f32::INFINITY,
             }
@@ -266,7 +282,7 @@ impl Visibility {
         let Some(bvh) = &self.boxes else {
             return;
         };
-        let query = to_f32_box(bounds, self.center, self.padding);
+        let query = to_f32_box(bounds, self.center, self.unit, self.padding);
         bvh.aabb_traverse(query, |bvh, node_index| {
             let node = &bvh.nodes[node_index as usize];
             let first = node.first_index as usize;
@@ -288,7 +304,7 @@ impl Visibility {
         let Some(bvh) = &self.boxes else {
             return false;
         };
-        let query = to_f32_box(bounds, self.center, self.padding);
+        let query = to_f32_box(bounds, self.center, self.unit, self.padding);
         let mut found = false;
         bvh.aabb_traverse(query, |bvh, node_index| {
             let node = &bvh.nodes[node_index as usize];
@@ -306,10 +322,10 @@ fn to_vec3a(v: DVec3) -> Vec3A {
     Vec3A::new(v.x as f32, v.y as f32, v.z as f32)
 }
 
-fn to_f32_box(b: Bounds, center: DVec3, padding: f64) -> Aabb {
+fn to_f32_box(b: Bounds, center: DVec3, unit: f64, padding: f64) -> Aabb {
     // Padding covers the f32 rounding of both the box and the rays tested against it.
-    let lo = b.min - center;
-    let hi = b.max - center;
+    let lo = (b.min - center) / unit;
+    let hi = (b.max - center) / unit;
     let slack = padding + 2f64.powi(-22) * lo.abs().max(hi.abs()).max_element();
     Aabb::new(
         to_vec3a(lo - DVec3::splat(slack)),

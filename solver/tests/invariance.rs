@@ -1,5 +1,6 @@
 //! Radiosity does not depend on where the scene sits, how it is turned, or its units: the same
-//! scene moved, rotated and scaled by 1e-3 and 1e3 gives the same radiosity at every vertex —
+//! scene moved, rotated, scaled by 1e-3 and 1e3, and sized to 1e-6 and 1e6 across (a micrometre,
+//! a thousand kilometres) gives the same radiosity at every vertex —
 //! to 1e-9 with the exact direct light alone, and to 0.1 % for the full progressive solution.
 
 use glam::{DAffine3, DQuat, DVec3, EulerRot};
@@ -21,6 +22,22 @@ fn transforms(scene: &Scene) -> Vec<(&'static str, DAffine3)> {
         (
             "scaled 1e3, rotated, translated",
             DAffine3::from_scale_rotation_translation(DVec3::splat(1e3), turn, shift * 1e3),
+        ),
+        (
+            "1e-6 across, rotated, translated",
+            DAffine3::from_scale_rotation_translation(
+                DVec3::splat(1e-6 / size),
+                turn,
+                shift * (1e-6 / size),
+            ),
+        ),
+        (
+            "1e6 across, rotated, translated",
+            DAffine3::from_scale_rotation_translation(
+                DVec3::splat(1e6 / size),
+                turn,
+                shift * (1e6 / size),
+            ),
         ),
     ]
 }
