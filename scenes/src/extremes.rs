@@ -162,3 +162,103 @@ pub fn grazing_light(height: f64) -> Scene {
         ],
     )
 }
+
+/// A square light over a floor with a blocker lying in the floor's own plane (coplanar,
+/// overlapping it): a coplanar blocker hides nothing, so the floor's light is what it is without it.
+pub fn coplanar_blocker(with_blocker: bool) -> Scene {
+    let mut surfaces = vec![
+        light(DVec3::new(0.0, 0.0, 2.0), 0.5),
+        Surface::new("floor", square(DVec3::ZERO, 3.0), Rgb::splat(0.5)),
+    ];
+    if with_blocker {
+        surfaces.push(Surface::new(
+            "blocker",
+            square(DVec3::new(0.5, 0.0, 0.0), 0.5),
+            Rgb::splat(0.5),
+        ));
+    }
+    scene("coplanar_blocker", surfaces)
+}
+
+/// A unit cube standing on a floor under a light: the light jumps across the cube's footprint
+/// (D0 contact lines), from nothing under the cube to the open floor's value beside it.
+pub fn touching_blocker() -> Scene {
+    let (lo, hi) = (DVec3::new(-0.5, -0.5, 0.0), DVec3::new(0.5, 0.5, 1.0));
+    let c = (lo + hi) / 2.0;
+    let mut surfaces = vec![light(DVec3::new(0.3, 0.2, 3.0), 0.5)];
+    let faces: [[DVec3; 4]; 5] = [
+        [
+            DVec3::new(lo.x, lo.y, hi.z),
+            DVec3::new(hi.x, lo.y, hi.z),
+            hi,
+            DVec3::new(lo.x, hi.y, hi.z),
+        ],
+        [
+            lo,
+            DVec3::new(hi.x, lo.y, lo.z),
+            DVec3::new(hi.x, lo.y, hi.z),
+            DVec3::new(lo.x, lo.y, hi.z),
+        ],
+        [
+            DVec3::new(lo.x, hi.y, lo.z),
+            DVec3::new(hi.x, hi.y, lo.z),
+            hi,
+            DVec3::new(lo.x, hi.y, hi.z),
+        ],
+        [
+            lo,
+            DVec3::new(lo.x, hi.y, lo.z),
+            DVec3::new(lo.x, hi.y, hi.z),
+            DVec3::new(lo.x, lo.y, hi.z),
+        ],
+        [
+            DVec3::new(hi.x, lo.y, lo.z),
+            DVec3::new(hi.x, hi.y, lo.z),
+            hi,
+            DVec3::new(hi.x, lo.y, hi.z),
+        ],
+    ];
+    for (k, f) in faces.iter().enumerate() {
+        let mut polygon = f.to_vec();
+        // Facing out of the cube.
+        let n = (polygon[1] - polygon[0]).cross(polygon[2] - polygon[0]);
+        if n.dot(polygon[0] - c) < 0.0 {
+            polygon.reverse();
+        }
+        surfaces.push(Surface::new(format!("cube{k}"), polygon, Rgb::splat(0.5)));
+    }
+    surfaces.push(Surface::new(
+        "floor",
+        square(DVec3::ZERO, 3.0),
+        Rgb::splat(0.5),
+    ));
+    scene("touching_blocker", surfaces)
+}
+
+/// A floor of three tiles under a light, meeting in a T: a large tile on the left (x < 0) and two
+/// small ones on the right, whose shared edge ends on the middle of the large tile's right
+/// edge. Each tile is meshed on its own, so the seams do not share vertices; the light must
+/// still be continuous across them.
+pub fn t_junction() -> Scene {
+    let tile = |x0: f64, x1: f64, y0: f64, y1: f64, name: &str| {
+        Surface::new(
+            name,
+            vec![
+                DVec3::new(x0, y0, 0.0),
+                DVec3::new(x1, y0, 0.0),
+                DVec3::new(x1, y1, 0.0),
+                DVec3::new(x0, y1, 0.0),
+            ],
+            Rgb::splat(0.5),
+        )
+    };
+    scene(
+        "t_junction",
+        vec![
+            light(DVec3::new(0.0, 0.0, 2.0), 0.5),
+            tile(-2.0, 0.0, -2.0, 2.0, "left"),
+            tile(0.0, 2.0, -2.0, 0.0, "lower_right"),
+            tile(0.0, 2.0, 0.0, 2.0, "upper_right"),
+        ],
+    )
+}
