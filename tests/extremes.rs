@@ -294,3 +294,39 @@ fn light_is_continuous_across_t_junctions() {
         assert!((lo - hi).abs() <= 5e-3 * peak, "x {x}: {lo} vs {hi}");
     }
 }
+
+/// Wedge lines 1e-9 of the scene apart (two blockers whose edges almost touch) and, for
+/// comparison, 1e-3 apart: the mesh is sane, every constraint a chain of edges, within budget,
+/// with no triangle smaller than 1e-8 of the floor: no sliver chased between the lines, which
+/// would be under 1e-9 (measured: 2.5e-5 for the billionth, where the lines merge; 2.4e-7 for
+/// the thousandth, a real strip).
+#[test]
+fn wedge_lines_a_billionth_apart_mesh_sanely() {
+    for gap in [1e-9 * 6.0, 1e-3] {
+        let scene = extremes::close_wedges(gap);
+        let vis = Visibility::build(&scene);
+        let found = penumbra_meshing::discontinuity::find_discontinuities(
+            &scene,
+            &vis,
+            &Default::default(),
+        );
+        let mesh = penumbra_meshing::mesh_scene_discontinuity(&scene, &vis, found, 3_000, 8.0)
+            .expect("meshes");
+        mesh.sanity_check().expect("sane");
+        assert!(mesh.triangle_count() <= 3_000);
+        let floor = scene.surface_id("floor").expect("floor");
+        let m = &mesh.surfaces[floor];
+        let smallest = (0..m.triangle_count())
+            .map(|t| m.triangle_area(t))
+            .fold(f64::INFINITY, f64::min);
+        eprintln!(
+            "gap {gap}: smallest triangle {:e} of the floor",
+            smallest / m.area()
+        );
+        assert!(
+            smallest > 1e-8 * m.area(),
+            "gap {gap}: a triangle of {smallest:e}"
+        );
+        solve(scene, false);
+    }
+}

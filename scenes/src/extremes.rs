@@ -262,3 +262,30 @@ pub fn t_junction() -> Scene {
         ],
     )
 }
+
+/// Two blockers side by side at the same height, their facing edges `gap` apart (1e-9 of the
+/// scene for the extreme): their shadows' edges are two wedge lines that close together on the
+/// floor. Meshing must stay sane and within budget instead of chasing the sliver between them.
+pub fn close_wedges(gap: f64) -> Scene {
+    let rect = |x0: f64, x1: f64, name: &str| {
+        Surface::new(
+            name,
+            vec![
+                DVec3::new(x0, -0.5, 1.0),
+                DVec3::new(x1, -0.5, 1.0),
+                DVec3::new(x1, 0.5, 1.0),
+                DVec3::new(x0, 0.5, 1.0),
+            ],
+            Rgb::splat(0.5),
+        )
+    };
+    scene(
+        "close_wedges",
+        vec![
+            light(DVec3::new(0.2, 0.1, 3.0), 0.5),
+            rect(-0.6, 0.0, "left_blocker"),
+            rect(gap, 0.6, "right_blocker"),
+            Surface::new("floor", square(DVec3::ZERO, 3.0), Rgb::splat(0.5)),
+        ],
+    )
+}
