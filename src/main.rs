@@ -203,6 +203,10 @@ struct SweepArgs {
     /// The methods to run (comma-separated; default: all four).
     #[arg(long, value_delimiter = ',', value_parser = ["uniform", "uniform+adaptive", "discontinuity", "discontinuity+adaptive"])]
     methods: Vec<String>,
+    /// The solvers to compare, comma-separated (default: progressive). Adaptive runs use
+    /// progressive refinement only.
+    #[arg(long, value_delimiter = ',', value_enum)]
+    solvers: Vec<SolverArg>,
     /// The adaptive runs start from this fraction of the budget (their initial meshes are not
     /// graded: refinement finds the penumbrae).
     #[arg(long, default_value_t = penumbra::adaptive::INITIAL_FRACTION)]
@@ -322,6 +326,7 @@ fn sweep(args: &SweepArgs) -> Result<(), Failure> {
             visibility_rays: args.rays,
             ..SolverOptions::default()
         },
+        solvers: args.solvers.iter().map(|&s| s.into()).collect(),
     };
     options.solver.validate().map_err(usage)?;
     std::fs::create_dir_all(&args.out)
@@ -372,13 +377,14 @@ fn sweep(args: &SweepArgs) -> Result<(), Failure> {
             100.0 * result.reference_standard_error
         );
         println!(
-            "{:<24} {:>8} {:>9} {:>9} {:>10} {:>10} {:>12}",
-            "method", "budget", "triangles", "seconds", "rms", "max", "penumbra rms"
+            "{:<24} {:<13} {:>8} {:>9} {:>9} {:>10} {:>10} {:>12}",
+            "method", "solver", "budget", "triangles", "seconds", "rms", "max", "penumbra rms"
         );
         for r in &result.rows {
             println!(
-                "{:<24} {:>8} {:>9} {:>9.3} {:>9.4}% {:>9.3}% {:>11.4}%",
+                "{:<24} {:<13} {:>8} {:>9} {:>9.3} {:>9.4}% {:>9.3}% {:>11.4}%",
                 r.method,
+                r.solver,
                 r.max_elements,
                 r.triangles,
                 r.seconds,

@@ -14,7 +14,7 @@ use penumbra_meshing::locate::TriangleLocator;
 use penumbra_scenes::rng::SplitMix64;
 use penumbra_scenes::{LoadedScene, Scene, SurfaceId, Visibility};
 use penumbra_solver::path_trace::ReferenceValue;
-use penumbra_solver::{DirectLight, Progress, ReceivingPoint, SolverOptions};
+use penumbra_solver::{DirectLight, Progress, ReceivingPoint, SolverMethod, SolverOptions};
 use penumbra_viz::{LogLogChart, Series};
 use serde::Serialize;
 
@@ -80,6 +80,9 @@ pub struct SweepOptions {
     pub samples: usize,
     pub seed: u64,
     pub solver: SolverOptions,
+    /// The solvers to compare (each non-adaptive run is repeated with each; adaptive runs and
+    /// direct-light sweeps use progressive refinement only).
+    pub solvers: Vec<SolverMethod>,
 }
 
 /// What the runs are scored against.
@@ -96,6 +99,8 @@ pub enum Reference {
 #[derive(Clone, Debug, Serialize)]
 pub struct SweepRow {
     pub method: &'static str,
+    /// How the system was solved: progressive, jacobi, gauss-seidel or direct.
+    pub solver: &'static str,
     pub max_elements: usize,
     /// The adaptive runs' tolerance.
     pub refine_tol: Option<f64>,
@@ -175,10 +180,21 @@ pub fn sweep(
     let methods = &options.methods;
     let first = options.budgets.first().copied().unwrap_or(1);
     let mut rows = Vec::new();
-    progress.start("sweep", (options.budgets.len() * methods.len()) as u64);
+    let solvers: Vec<SolverMethod> = if options.solver.direct_only || options.solvers.is_empty() {
+        vec![SolverMethod::Progressive]
+    } else {
+        options.solvers.clone()
+    };
+    let combinations: Vec<(SweepMethod, SolverMethod)> = methods
+        .iter()
+        .flat_map(|&m| solvers.iter().map(move |&s| (m, s)))
+        .filter(|&(m, s)| !m.adaptive() || s == SolverMethod::Progressive)
+        .collect();
+    progress.start("sweep", (options.budgets.len() * combinations.len()) as u64);
     for &budget in &options.budgets {
-        for &method in methods {
+        for &(method, solver) in &combinations {
             let run_options = RunOptions {
+                method: solver,
                 mesh: method.mesh(),
                 max_elements: budget,
                 penumbra_density: if method.adaptive() {
@@ -236,6 +252,7 @@ pub fn sweep(
             let scale = mean.max(f64::MIN_POSITIVE);
             rows.push(SweepRow {
                 method: method.name(),
+                solver: solver_name(solver),
                 max_elements: budget,
                 refine_tol: run_options.refine.as_ref().map(|r| r.tolerance),
                 triangles: result.mesh.triangle_count(),
@@ -333,21 +350,27 @@ pub fn sample_points(
 /// The sweep's log–log charts, one line per method: RMS error against triangles and against
 /// seconds, with their file stems.
 pub fn sweep_charts(sweep: &Sweep) -> Vec<(&'static str, LogLogChart)> {
-    let mut methods: Vec<&str> = Vec::new();
+    // One line per method, or per method and solver when the sweep compares solvers.
+    let mut lines: Vec<(&str, &str)> = Vec::new();
     for r in &sweep.rows {
-        if !methods.contains(&r.method) {
-            methods.push(r.method);
+        if !lines.contains(&(r.method, r.solver)) {
+            lines.push((r.method, r.solver));
         }
     }
+    let several_solvers = lines.iter().any(|l| l.1 != lines[0].1);
     let series = |x: fn(&SweepRow) -> f64| -> Vec<Series> {
-        methods
+        lines
             .iter()
-            .map(|&m| Series {
-                name: m.to_owned(),
+            .map(|&(m, solver)| Series {
+                name: if several_solvers {
+                    format!("{m} ({solver})")
+                } else {
+                    m.to_owned()
+                },
                 points: sweep
                     .rows
                     .iter()
-                    .filter(|r| r.method == m)
+                    .filter(|r| r.method == m && r.solver == solver)
                     .map(|r| (x(r), 100.0 * r.rms))
                     .collect(),
             })
@@ -381,14 +404,24 @@ pub fn sweep_charts(sweep: &Sweep) -> Vec<(&'static str, LogLogChart)> {
     ]
 }
 
+/// The command-line name of a solver.
+pub fn solver_name(method: SolverMethod) -> &'static str {
+    match method {
+        SolverMethod::Progressive => "progressive",
+        SolverMethod::Jacobi => "jacobi",
+        SolverMethod::GaussSeidel => "gauss-seidel",
+        SolverMethod::Direct => "direct",
+    }
+}
+
 /// The sweep as CSV, a row per run.
 pub fn sweep_csv(sweep: &Sweep) -> String {
     let mut out = String::from(
-        "method,max_elements,refine_tol,triangles,vertices,seconds,rms_relative,max_relative,penumbra_rms_relative\n",
+        "method,max_elements,refine_tol,triangles,vertices,seconds,rms_relative,max_relative,penumbra_rms_relative,solver\n",
     );
     for r in &sweep.rows {
         out += &format!(
-            "{},{},{},{},{},{:.6},{:.6e},{:.6e},{:.6e}\n",
+            "{},{},{},{},{},{:.6},{:.6e},{:.6e},{:.6e},{}\n",
             r.method,
             r.max_elements,
             r.refine_tol.map_or(String::new(), |t| format!("{t:e}")),
@@ -397,7 +430,8 @@ pub fn sweep_csv(sweep: &Sweep) -> String {
             r.seconds,
             r.rms,
             r.max,
-            r.penumbra_rms
+            r.penumbra_rms,
+            r.solver
         );
     }
     out

@@ -531,3 +531,52 @@ fn solvers_agree_and_report_their_convergence() {
         String::from_utf8_lossy(&o.stderr)
     );
 }
+
+/// `penumbra sweep --solvers` repeats each plain run with each solver (adaptive runs shoot), a
+/// row and a chart line each, the solver named in the CSV's last column.
+#[test]
+fn sweeps_compare_solvers() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("sweep");
+    let o = penumbra(&[
+        "sweep",
+        "textbook",
+        "--budgets",
+        "600",
+        "--samples",
+        "40",
+        "--reference-paths",
+        "64",
+        "--methods",
+        "discontinuity,discontinuity+adaptive",
+        "--solvers",
+        "progressive,gauss-seidel,direct",
+        "--out",
+        out.to_str().expect("utf-8"),
+        "--quiet",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let sweep = json(&out.join("sweep.json"));
+    let rows = sweep["rows"].as_array().expect("rows");
+    let pairs: Vec<(String, String)> = rows
+        .iter()
+        .map(|r| {
+            (
+                r["method"].as_str().expect("method").to_owned(),
+                r["solver"].as_str().expect("solver").to_owned(),
+            )
+        })
+        .collect();
+    assert_eq!(pairs.len(), 4, "{pairs:?}");
+    assert!(pairs.contains(&("discontinuity+adaptive".into(), "progressive".into())));
+    assert!(pairs.contains(&("discontinuity".into(), "direct".into())));
+    let csv = std::fs::read_to_string(out.join("sweep.csv")).expect("csv");
+    assert!(csv.lines().next().expect("header").ends_with(",solver"));
+    let svg = std::fs::read_to_string(out.join("error-vs-elements.svg")).expect("svg");
+    assert_eq!(
+        svg.matches("<polyline").count(),
+        1,
+        "one point per line: markers only"
+    );
+    assert!(svg.contains("discontinuity (gauss-seidel)"));
+}
