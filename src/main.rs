@@ -49,6 +49,12 @@ enum MeshArg {
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
+enum FormFactorArg {
+    Analytic,
+    MonteCarlo,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
 enum SolverArg {
     Progressive,
     Jacobi,
@@ -125,6 +131,13 @@ struct RunArgs {
     /// of --epsilon, or after --max-shots sweeps.
     #[arg(long, value_enum, default_value_t = SolverArg::Progressive)]
     solver: SolverArg,
+    /// How vertex-to-patch form factors are computed: Lambert's formula times a ray-sampled
+    /// visibility fraction, or Monte Carlo over each patch (--ff-samples points, each with a ray).
+    #[arg(long, value_enum, default_value_t = FormFactorArg::Analytic)]
+    form_factors: FormFactorArg,
+    /// With --form-factors monte-carlo: samples per vertex and patch.
+    #[arg(long, default_value_t = 256)]
+    ff_samples: usize,
     /// Also write the solver's residual against iterations and against time: convergence.csv,
     /// convergence-iterations.svg/.png and convergence-time.svg/.png.
     #[arg(long)]
@@ -569,6 +582,14 @@ fn run(args: &RunArgs) -> Result<(), Failure> {
             epsilon: args.epsilon,
             max_shots: args.max_shots,
             visibility_rays: args.rays,
+            form_factors: match args.form_factors {
+                FormFactorArg::Analytic => penumbra_solver::coupling::FormFactorMethod::Analytic,
+                FormFactorArg::MonteCarlo => {
+                    penumbra_solver::coupling::FormFactorMethod::MonteCarlo {
+                        samples: args.ff_samples,
+                    }
+                }
+            },
             elements_per_patch: args.elements_per_patch,
             direct_only: args.direct_only,
             seed: args.seed,

@@ -10,13 +10,27 @@ use crate::elements::{Discretization, Patch};
 use crate::lambert::{ReceivingPoint, edge_term, form_factor};
 use penumbra_scenes::rng::SplitMix64;
 
-/// Form factors from points to patches: Lambert's formula times a visibility fraction.
+/// How point-to-patch form factors are computed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum FormFactorMethod {
+    /// Lambert's formula over the patch, exact, times a visibility fraction from rays.
+    #[default]
+    Analytic,
+    /// Monte Carlo over the patch's area: cos cos / (π r²) at stratified points, each seen or
+    /// not by a ray; unbiased, with an error that falls as one over the square root of samples.
+    MonteCarlo { samples: usize },
+}
+
+/// Form factors from points to patches: Lambert's formula times a visibility fraction, or Monte
+/// Carlo over the patch.
 #[derive(Clone, Copy, Debug)]
 pub struct Coupler<'a> {
     pub visibility: &'a Visibility,
     /// Rays per point–patch pair for the visibility fraction.
     pub rays: usize,
     pub seed: u64,
+    pub method: FormFactorMethod,
 }
 
 impl Coupler<'_> {
@@ -94,12 +108,72 @@ impl Coupler<'_> {
         patch: &Patch,
         key: [u64; 2],
     ) -> (f64, u32) {
+        if let FormFactorMethod::MonteCarlo { samples } = self.method {
+            // A point on the patch's plane (a junction: the edge where a wall meets the floor)
+            // sees the patch at grazing incidence, and its form factor, a one-sided limit, sits
+            // in a vanishing neighbourhood of the point that no sample finds (half of a wall,
+            // missed entirely). Lambert's formula takes the limit there.
+            let on_plane = (x.point - patch.origin).dot(patch.normal).abs() <= self.tol();
+            if !on_plane {
+                return self.monte_carlo(x, surface, patch, key, samples);
+            }
+        }
         let f = self.unoccluded(x, surface, patch);
         if f <= 0.0 {
             return (0.0, 0);
         }
         let (vis, rays) = self.visible_fraction(x, surface, patch, key);
         (f * vis, rays)
+    }
+}
+
+impl Coupler<'_> {
+    /// The form factor by Monte Carlo: the kernel cos cos / (π r²) at `samples` points stratified
+    /// over the patch's area, each counted if a ray reaches it.
+    fn monte_carlo(
+        &self,
+        x: &ReceivingPoint,
+        surface: SurfaceId,
+        patch: &Patch,
+        key: [u64; 2],
+        samples: usize,
+    ) -> (f64, u32) {
+        if surface == patch.surface || !x.in_front_of(patch.origin, patch.normal, self.tol()) {
+            return (0.0, 0);
+        }
+        let own = [surface, patch.surface];
+        let shaft = patch.bounds.including(x.point);
+        let open = !self
+            .visibility
+            .any_triangle_overlapping(shaft, |t| t.surface != own[0] && t.surface != own[1]);
+        let origin = x.point + x.inward * self.visibility.junction_offset();
+        let mut rng = SplitMix64::keyed(self.seed, &key);
+        let (mut sum, mut rays) = (0.0, 0u32);
+        let samples = samples.max(1);
+        for k in 0..samples {
+            let u = (k as f64 + rng.next_f64()) / samples as f64 * patch.area;
+            let idx = patch
+                .cumulative_area
+                .partition_point(|&c| c < u)
+                .min(patch.triangles.len() - 1);
+            let t = &patch.triangles[idx];
+            let (r1, r2) = (rng.next_f64().sqrt(), rng.next_f64());
+            let y = t[0] * (1.0 - r1) + t[1] * (r1 * (1.0 - r2)) + t[2] * (r1 * r2);
+            let d = y - origin;
+            let w = x.normal.dot(d) * -patch.normal.dot(d) / d.length_squared().powi(2);
+            if !(w > 0.0) {
+                continue;
+            }
+            if open {
+                sum += w;
+                continue;
+            }
+            rays += 1;
+            if !self.visibility.occluded(origin, y, own) {
+                sum += w;
+            }
+        }
+        (sum * patch.area / (PI * samples as f64), rays)
     }
 }
 
@@ -111,6 +185,7 @@ pub struct PatchCoupling<'a> {
     /// Rays per vertex–patch pair for the visibility fraction.
     pub rays: usize,
     pub seed: u64,
+    pub method: FormFactorMethod,
 }
 
 impl PatchCoupling<'_> {
@@ -119,6 +194,7 @@ impl PatchCoupling<'_> {
             visibility: self.visibility,
             rays: self.rays,
             seed: self.seed,
+            method: self.method,
         }
     }
 

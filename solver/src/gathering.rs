@@ -89,6 +89,7 @@ impl PatchSystem {
             visibility,
             rays: options.visibility_rays,
             seed: options.seed,
+            method: options.form_factors,
         };
         progress.start("form factors", patches as u64);
         let done = std::sync::atomic::AtomicU64::new(0);

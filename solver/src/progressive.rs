@@ -26,7 +26,7 @@ use penumbra_scenes::{Rgb, Scene, SurfaceId, Visibility};
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::coupling::Coupler;
+use crate::coupling::{Coupler, FormFactorMethod};
 use crate::direct::DirectLight;
 use crate::elements::{Discretization, Patch};
 use crate::error::SolveError;
@@ -51,6 +51,8 @@ pub struct SolverOptions {
     pub cache_bytes: usize,
     /// Stop shooting at this moment, converged or not (an anytime solve).
     pub deadline: Option<Instant>,
+    /// How vertex-to-patch form factors are computed.
+    pub form_factors: FormFactorMethod,
 }
 
 pub const DEFAULT_EPSILON: f64 = 1e-3;
@@ -66,6 +68,7 @@ impl Default for SolverOptions {
             seed: 0x5EED,
             cache_bytes: 1 << 30,
             deadline: None,
+            form_factors: FormFactorMethod::Analytic,
         }
     }
 }
@@ -83,6 +86,9 @@ impl SolverOptions {
         }
         if self.elements_per_patch == 0 {
             return bad("elements per patch", "must be at least 1");
+        }
+        if self.form_factors == (FormFactorMethod::MonteCarlo { samples: 0 }) {
+            return bad("form-factor samples", "must be at least 1");
         }
         Ok(())
     }
@@ -302,6 +308,7 @@ impl<'a> ProgressiveSolver<'a> {
             visibility: self.visibility,
             rays: self.options.visibility_rays,
             seed: self.options.seed,
+            method: self.options.form_factors,
         }
     }
 
