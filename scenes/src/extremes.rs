@@ -16,6 +16,60 @@ fn square(center: DVec3, half: f64) -> Vec<DVec3> {
     ]
 }
 
+/// The faces of the box `lo..hi` (top, sides, and the bottom if `bottom`), each facing into the
+/// box if `inward`, else out of it.
+fn box_faces(lo: DVec3, hi: DVec3, bottom: bool, inward: bool) -> Vec<Vec<DVec3>> {
+    let c = (lo + hi) / 2.0;
+    let at = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
+    let mut faces = vec![
+        vec![
+            at(lo.x, lo.y, hi.z),
+            at(hi.x, lo.y, hi.z),
+            hi,
+            at(lo.x, hi.y, hi.z),
+        ],
+        vec![
+            lo,
+            at(hi.x, lo.y, lo.z),
+            at(hi.x, lo.y, hi.z),
+            at(lo.x, lo.y, hi.z),
+        ],
+        vec![
+            at(lo.x, hi.y, lo.z),
+            at(hi.x, hi.y, lo.z),
+            hi,
+            at(lo.x, hi.y, hi.z),
+        ],
+        vec![
+            lo,
+            at(lo.x, hi.y, lo.z),
+            at(lo.x, hi.y, hi.z),
+            at(lo.x, lo.y, hi.z),
+        ],
+        vec![
+            at(hi.x, lo.y, lo.z),
+            at(hi.x, hi.y, lo.z),
+            hi,
+            at(hi.x, lo.y, hi.z),
+        ],
+    ];
+    if bottom {
+        faces.push(vec![
+            lo,
+            at(hi.x, lo.y, lo.z),
+            at(hi.x, hi.y, lo.z),
+            at(lo.x, hi.y, lo.z),
+        ]);
+    }
+    for polygon in &mut faces {
+        let n = (polygon[1] - polygon[0]).cross(polygon[2] - polygon[0]);
+        if (n.dot(c - polygon[0]) > 0.0) != inward {
+            polygon.reverse();
+        }
+    }
+    faces
+}
+
 fn scene(name: &str, surfaces: Vec<Surface>) -> Scene {
     Scene {
         name: name.into(),
@@ -86,59 +140,19 @@ pub fn receiver_behind_light() -> Scene {
 
 /// A light sealed in a box (walls facing in) over a floor: the floor outside sees nothing.
 pub fn hidden_emitter() -> Scene {
-    let (lo, hi) = (DVec3::new(-1.0, -1.0, 0.5), DVec3::new(1.0, 1.0, 2.0));
-    let c = (lo + hi) / 2.0;
-    let faces: [[DVec3; 4]; 6] = [
-        [
-            lo,
-            DVec3::new(hi.x, lo.y, lo.z),
-            DVec3::new(hi.x, hi.y, lo.z),
-            DVec3::new(lo.x, hi.y, lo.z),
-        ],
-        [
-            DVec3::new(lo.x, lo.y, hi.z),
-            DVec3::new(hi.x, lo.y, hi.z),
-            hi,
-            DVec3::new(lo.x, hi.y, hi.z),
-        ],
-        [
-            lo,
-            DVec3::new(hi.x, lo.y, lo.z),
-            DVec3::new(hi.x, lo.y, hi.z),
-            DVec3::new(lo.x, lo.y, hi.z),
-        ],
-        [
-            DVec3::new(lo.x, hi.y, lo.z),
-            DVec3::new(hi.x, hi.y, lo.z),
-            hi,
-            DVec3::new(lo.x, hi.y, hi.z),
-        ],
-        [
-            lo,
-            DVec3::new(lo.x, hi.y, lo.z),
-            DVec3::new(lo.x, hi.y, hi.z),
-            DVec3::new(lo.x, lo.y, hi.z),
-        ],
-        [
-            DVec3::new(hi.x, lo.y, lo.z),
-            DVec3::new(hi.x, hi.y, lo.z),
-            hi,
-            DVec3::new(hi.x, lo.y, hi.z),
-        ],
-    ];
     let mut surfaces = vec![light(DVec3::new(0.0, 0.0, 1.9), 0.3)];
-    for (k, f) in faces.iter().enumerate() {
-        let mut polygon = f.to_vec();
-        // Facing the box's centre.
-        let n = (polygon[1] - polygon[0]).cross(polygon[2] - polygon[0]);
-        if n.dot(c - polygon[0]) < 0.0 {
-            polygon.reverse();
-        }
+    let sealed = box_faces(
+        DVec3::new(-1.0, -1.0, 0.5),
+        DVec3::new(1.0, 1.0, 2.0),
+        true,
+        true,
+    );
+    for (k, polygon) in sealed.into_iter().enumerate() {
         surfaces.push(Surface::new(format!("box{k}"), polygon, Rgb::splat(0.5)));
     }
     surfaces.push(Surface::new(
         "floor",
-        square(DVec3::new(0.0, 0.0, 0.0), 4.0),
+        square(DVec3::ZERO, 4.0),
         Rgb::splat(0.5),
     ));
     scene("hidden_emitter", surfaces)
@@ -183,48 +197,14 @@ pub fn coplanar_blocker(with_blocker: bool) -> Scene {
 /// A unit cube standing on a floor under a light: the light jumps across the cube's footprint
 /// (D0 contact lines), from nothing under the cube to the open floor's value beside it.
 pub fn touching_blocker() -> Scene {
-    let (lo, hi) = (DVec3::new(-0.5, -0.5, 0.0), DVec3::new(0.5, 0.5, 1.0));
-    let c = (lo + hi) / 2.0;
     let mut surfaces = vec![light(DVec3::new(0.3, 0.2, 3.0), 0.5)];
-    let faces: [[DVec3; 4]; 5] = [
-        [
-            DVec3::new(lo.x, lo.y, hi.z),
-            DVec3::new(hi.x, lo.y, hi.z),
-            hi,
-            DVec3::new(lo.x, hi.y, hi.z),
-        ],
-        [
-            lo,
-            DVec3::new(hi.x, lo.y, lo.z),
-            DVec3::new(hi.x, lo.y, hi.z),
-            DVec3::new(lo.x, lo.y, hi.z),
-        ],
-        [
-            DVec3::new(lo.x, hi.y, lo.z),
-            DVec3::new(hi.x, hi.y, lo.z),
-            hi,
-            DVec3::new(lo.x, hi.y, hi.z),
-        ],
-        [
-            lo,
-            DVec3::new(lo.x, hi.y, lo.z),
-            DVec3::new(lo.x, hi.y, hi.z),
-            DVec3::new(lo.x, lo.y, hi.z),
-        ],
-        [
-            DVec3::new(hi.x, lo.y, lo.z),
-            DVec3::new(hi.x, hi.y, lo.z),
-            hi,
-            DVec3::new(hi.x, lo.y, hi.z),
-        ],
-    ];
-    for (k, f) in faces.iter().enumerate() {
-        let mut polygon = f.to_vec();
-        // Facing out of the cube.
-        let n = (polygon[1] - polygon[0]).cross(polygon[2] - polygon[0]);
-        if n.dot(polygon[0] - c) < 0.0 {
-            polygon.reverse();
-        }
+    let cube = box_faces(
+        DVec3::new(-0.5, -0.5, 0.0),
+        DVec3::new(0.5, 0.5, 1.0),
+        false,
+        false,
+    );
+    for (k, polygon) in cube.into_iter().enumerate() {
         surfaces.push(Surface::new(format!("cube{k}"), polygon, Rgb::splat(0.5)));
     }
     surfaces.push(Surface::new(

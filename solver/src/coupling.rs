@@ -4,6 +4,8 @@
 
 use std::f64::consts::PI;
 
+use glam::DVec3;
+
 use penumbra_scenes::{SurfaceId, Visibility};
 
 use crate::elements::{Discretization, Patch};
@@ -68,24 +70,14 @@ impl Coupler<'_> {
         // past (not along) the surfaces it touches: the one-sided limit again.
         let origin = x.point + x.inward * self.visibility.junction_offset();
         let mut rng = SplitMix64::keyed(self.seed, &key);
-        let total = patch.area;
         let (mut seen, mut weight, mut count) = (0.0, 0.0, 0u32);
         // Samples that face away (behind x's tangent plane, or behind the patch) carry no weight
         // and cast no ray; a patch straddling x's plane may need a few more draws.
         let mut draws = 0;
         while count < self.rays as u32 && draws < 4 * self.rays {
-            // Stratified over the patch's area, then uniform inside the chosen element.
-            let u = ((draws % self.rays) as f64 + rng.next_f64()) / self.rays as f64 * total;
+            let y = sample_patch(patch, draws % self.rays, self.rays, &mut rng);
             draws += 1;
-            let idx = patch
-                .cumulative_area
-                .partition_point(|&c| c < u)
-                .min(patch.triangles.len() - 1);
-            let t = &patch.triangles[idx];
-            let (r1, r2) = (rng.next_f64().sqrt(), rng.next_f64());
-            let y = t[0] * (1.0 - r1) + t[1] * (r1 * (1.0 - r2)) + t[2] * (r1 * r2);
-            let d = y - origin;
-            let w = x.normal.dot(d) * -patch.normal.dot(d) / d.length_squared().powi(2);
+            let w = kernel(x, origin, patch, y);
             if !(w > 0.0) {
                 continue;
             }
@@ -151,16 +143,8 @@ impl Coupler<'_> {
         let (mut sum, mut rays) = (0.0, 0u32);
         let samples = samples.max(1);
         for k in 0..samples {
-            let u = (k as f64 + rng.next_f64()) / samples as f64 * patch.area;
-            let idx = patch
-                .cumulative_area
-                .partition_point(|&c| c < u)
-                .min(patch.triangles.len() - 1);
-            let t = &patch.triangles[idx];
-            let (r1, r2) = (rng.next_f64().sqrt(), rng.next_f64());
-            let y = t[0] * (1.0 - r1) + t[1] * (r1 * (1.0 - r2)) + t[2] * (r1 * r2);
-            let d = y - origin;
-            let w = x.normal.dot(d) * -patch.normal.dot(d) / d.length_squared().powi(2);
+            let y = sample_patch(patch, k, samples, &mut rng);
+            let w = kernel(x, origin, patch, y);
             if !(w > 0.0) {
                 continue;
             }
@@ -175,6 +159,26 @@ impl Coupler<'_> {
         }
         (sum * patch.area / (PI * samples as f64), rays)
     }
+}
+
+/// A point of `patch` in stratum `k` of `strata` (equal shares of its area), uniform inside the
+/// element the stratum's draw falls in.
+fn sample_patch(patch: &Patch, k: usize, strata: usize, rng: &mut SplitMix64) -> DVec3 {
+    let u = (k as f64 + rng.next_f64()) / strata as f64 * patch.area;
+    let idx = patch
+        .cumulative_area
+        .partition_point(|&c| c < u)
+        .min(patch.triangles.len() - 1);
+    let t = &patch.triangles[idx];
+    let (r1, r2) = (rng.next_f64().sqrt(), rng.next_f64());
+    t[0] * (1.0 - r1) + t[1] * (r1 * (1.0 - r2)) + t[2] * (r1 * r2)
+}
+
+/// cos θ_x cos θ_y / r² from `x` (rays leaving from `origin`) to the point `y` of `patch`;
+/// not positive where either faces away.
+fn kernel(x: &ReceivingPoint, origin: DVec3, patch: &Patch, y: DVec3) -> f64 {
+    let d = y - origin;
+    x.normal.dot(d) * -patch.normal.dot(d) / d.length_squared().powi(2)
 }
 
 /// Form factors from the receivers (mesh vertices) of a discretization to its patches.
