@@ -48,6 +48,15 @@ impl Coupler<'_> {
         patch_form_factor(x, patch, self.tol())
     }
 
+    /// Whether nothing but the `own` surfaces is in the box around `x` and the patch: then
+    /// nothing can block, and no ray need be cast.
+    fn open(&self, x: &ReceivingPoint, own: [SurfaceId; 2], patch: &Patch) -> bool {
+        let shaft = patch.bounds.including(x.point);
+        !self
+            .visibility
+            .any_triangle_overlapping(shaft, |t| t.surface != own[0] && t.surface != own[1])
+    }
+
     /// Fraction of `patch` visible from `x`, weighted by the form-factor kernel, and the number
     /// of rays cast for it. `key` seeds the pair's own random stream.
     pub fn visible_fraction(
@@ -58,12 +67,7 @@ impl Coupler<'_> {
         key: [u64; 2],
     ) -> (f64, u32) {
         let own = [surface, patch.surface];
-        // Nothing else in the box around both: nothing can block.
-        let shaft = patch.bounds.including(x.point);
-        if !self
-            .visibility
-            .any_triangle_overlapping(shaft, |t| t.surface != own[0] && t.surface != own[1])
-        {
+        if self.open(x, own, patch) {
             return (1.0, 0);
         }
         // Rays leave from just inside the receiving surface, so that a vertex on a junction sees
@@ -134,10 +138,7 @@ impl Coupler<'_> {
             return (0.0, 0);
         }
         let own = [surface, patch.surface];
-        let shaft = patch.bounds.including(x.point);
-        let open = !self
-            .visibility
-            .any_triangle_overlapping(shaft, |t| t.surface != own[0] && t.surface != own[1]);
+        let open = self.open(x, own, patch);
         let origin = x.point + x.inward * self.visibility.junction_offset();
         let mut rng = SplitMix64::keyed(self.seed, &key);
         let (mut sum, mut rays) = (0.0, 0u32);

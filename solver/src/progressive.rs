@@ -625,7 +625,10 @@ impl<'a> ProgressiveSolver<'a> {
     pub fn solution(&self) -> Solution {
         let scene = self.scene;
         let disc = &self.disc;
-        let unshot: Rgb = self.patch_unshot_power().into_iter().sum();
+        let patch_power = self.patch_unshot_power();
+        let unshot: Rgb = patch_power.iter().copied().sum();
+        let residual =
+            unshot_magnitude(&patch_power) / scene.emitted_power().mean().max(f64::MIN_POSITIVE);
         let absorbed = disc.integrate(&self.irradiance, |e| {
             Rgb::splat(1.0) - scene.surfaces[e.surface].reflectance
         });
@@ -648,11 +651,9 @@ impl<'a> ProgressiveSolver<'a> {
             absorbed,
             unshot,
             escaped: self.escaped,
-            unshot_fraction: unshot_magnitude(&self.patch_unshot_power())
-                / emitted.mean().max(f64::MIN_POSITIVE),
+            unshot_fraction: residual,
             iterations: self.shots,
-            residual: unshot_magnitude(&self.patch_unshot_power())
-                / emitted.mean().max(f64::MIN_POSITIVE),
+            residual,
             direct_seconds: self.direct_seconds,
             shooting_seconds: self.shooting_seconds,
             remeshes: self.remeshes,
