@@ -174,14 +174,7 @@ pub fn report_json(result: &RunResult) -> String {
                 "uniform"
             },
             mesh_requested: opts.mesh,
-            // "direct" has always meant the direct light only; the dense solve is "dense-direct".
-            solver: match (opts.solver.direct_only, opts.method) {
-                (true, _) => "direct",
-                (false, SolverMethod::Progressive) => "progressive",
-                (false, SolverMethod::Jacobi) => "jacobi",
-                (false, SolverMethod::GaussSeidel) => "gauss-seidel",
-                (false, SolverMethod::Direct) => "dense-direct",
-            },
+            solver: report_solver_name(result),
             max_elements: opts.max_elements,
             penumbra_density: opts.penumbra_density,
             eee: opts.discontinuity.eee,
@@ -310,13 +303,13 @@ pub fn convergence_files(result: &RunResult) -> anyhow::Result<Vec<(String, Vec<
     Ok(files)
 }
 
+/// The solver as `report.json` names it: "direct" has always meant the direct light only, so
+/// the dense solve of the full system is "dense-direct".
 fn report_solver_name(result: &RunResult) -> &'static str {
     match (result.options.solver.direct_only, result.options.method) {
-        (true, _) => "direct light",
-        (false, SolverMethod::Progressive) => "progressive",
-        (false, SolverMethod::Jacobi) => "Jacobi",
-        (false, SolverMethod::GaussSeidel) => "Gauss-Seidel",
-        (false, SolverMethod::Direct) => "dense direct",
+        (true, _) => "direct",
+        (false, SolverMethod::Direct) => "dense-direct",
+        (false, method) => method.name(),
     }
 }
 

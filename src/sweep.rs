@@ -252,7 +252,7 @@ pub fn sweep(
             let scale = mean.max(f64::MIN_POSITIVE);
             rows.push(SweepRow {
                 method: method.name(),
-                solver: solver_name(solver),
+                solver: solver.name(),
                 max_elements: budget,
                 refine_tol: run_options.refine.as_ref().map(|r| r.tolerance),
                 triangles: result.mesh.triangle_count(),
@@ -402,16 +402,6 @@ pub fn sweep_charts(sweep: &Sweep) -> Vec<(&'static str, LogLogChart)> {
             },
         ),
     ]
-}
-
-/// The command-line name of a solver.
-pub fn solver_name(method: SolverMethod) -> &'static str {
-    match method {
-        SolverMethod::Progressive => "progressive",
-        SolverMethod::Jacobi => "jacobi",
-        SolverMethod::GaussSeidel => "gauss-seidel",
-        SolverMethod::Direct => "direct",
-    }
 }
 
 /// The sweep as CSV, a row per run.

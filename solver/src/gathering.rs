@@ -43,6 +43,18 @@ pub enum SolverMethod {
     Direct,
 }
 
+impl SolverMethod {
+    /// The method's name on the command line and in sweeps.
+    pub fn name(self) -> &'static str {
+        match self {
+            SolverMethod::Progressive => "progressive",
+            SolverMethod::Jacobi => "jacobi",
+            SolverMethod::GaussSeidel => "gauss-seidel",
+            SolverMethod::Direct => "direct",
+        }
+    }
+}
+
 /// What solving the patch system gives: B̄ per channel and patch, how the residual fell, and why
 /// the iteration stopped.
 #[derive(Clone, Debug)]
