@@ -52,6 +52,7 @@ enum MeshArg {
 enum FormFactorArg {
     Analytic,
     MonteCarlo,
+    Hemicube,
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -132,12 +133,17 @@ struct RunArgs {
     #[arg(long, value_enum, default_value_t = SolverArg::Progressive)]
     solver: SolverArg,
     /// How vertex-to-patch form factors are computed: Lambert's formula times a ray-sampled
-    /// visibility fraction, or Monte Carlo over each patch (--ff-samples points, each with a ray).
+    /// visibility fraction, Monte Carlo over each patch (--ff-samples points, each with a ray),
+    /// or a hemicube z-buffer at each vertex (--hemicube-resolution; not with --refine-tol).
     #[arg(long, value_enum, default_value_t = FormFactorArg::Analytic)]
     form_factors: FormFactorArg,
     /// With --form-factors monte-carlo: samples per vertex and patch.
     #[arg(long, default_value_t = 256)]
     ff_samples: usize,
+    /// With --form-factors hemicube: pixels across the hemicube's top face (even; the side
+    /// faces are half as tall).
+    #[arg(long, default_value_t = 256)]
+    hemicube_resolution: usize,
     /// Also write the solver's residual against iterations and against time: convergence.csv,
     /// convergence-iterations.svg/.png and convergence-time.svg/.png.
     #[arg(long)]
@@ -589,6 +595,9 @@ fn run(args: &RunArgs) -> Result<(), Failure> {
                         samples: args.ff_samples,
                     }
                 }
+                FormFactorArg::Hemicube => penumbra_solver::coupling::FormFactorMethod::Hemicube {
+                    resolution: args.hemicube_resolution,
+                },
             },
             elements_per_patch: args.elements_per_patch,
             direct_only: args.direct_only,

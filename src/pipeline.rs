@@ -120,6 +120,20 @@ pub fn run(
     progress: &dyn Progress,
 ) -> Result<RunResult, RunError> {
     options.solver.validate()?;
+    if options.refine.is_some() {
+        if options.method != SolverMethod::Progressive {
+            return Err(RunError::Solve(SolveError::InvalidOption {
+                option: "solver",
+                reason: "adaptive refinement feeds the progressive solver; use --solver progressive",
+            }));
+        }
+        if options.solver.form_factors.by_rows() && !options.solver.direct_only {
+            return Err(RunError::Solve(SolveError::InvalidOption {
+                option: "form factors",
+                reason: "the hemicube gives the rows of a fixed mesh; adaptive refinement needs analytic or monte-carlo",
+            }));
+        }
+    }
     let started = Instant::now();
     // An anytime run: everything after meshing stops at the deadline.
     let solver = SolverOptions {
@@ -163,12 +177,6 @@ pub fn run(
 
     let t = Instant::now();
     let (refinement, solution) = match &options.refine {
-        Some(_) if options.method != SolverMethod::Progressive => {
-            return Err(RunError::Solve(SolveError::InvalidOption {
-                option: "solver",
-                reason: "adaptive refinement feeds the progressive solver; use --solver progressive",
-            }));
-        }
         Some(refine) => {
             let (report, solution) = refine_adaptively(
                 scene,

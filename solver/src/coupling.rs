@@ -8,8 +8,15 @@ use glam::DVec3;
 
 use penumbra_scenes::{SurfaceId, Visibility};
 
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use rayon::prelude::*;
+
 use crate::elements::{Discretization, Patch};
+use crate::error::SolveError;
+use crate::hemicube::{Hemicube, OCCLUDER};
 use crate::lambert::{ReceivingPoint, edge_term, form_factor};
+use crate::progress::Progress;
 use penumbra_scenes::rng::SplitMix64;
 
 /// How point-to-patch form factors are computed.
@@ -22,6 +29,26 @@ pub enum FormFactorMethod {
     /// Monte Carlo over the patch's area: cos cos / (π r²) at stratified points, each seen or
     /// not by a ray; unbiased, with an error that falls as one over the square root of samples.
     MonteCarlo { samples: usize },
+    /// A hemicube of `resolution` pixels across at each receiver: every patch's form factor
+    /// from that point at once, occlusion by z-buffer (see [`crate::hemicube`]).
+    Hemicube { resolution: usize },
+}
+
+impl FormFactorMethod {
+    /// The method's name on the command line and in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            FormFactorMethod::Analytic => "analytic",
+            FormFactorMethod::MonteCarlo { .. } => "monte-carlo",
+            FormFactorMethod::Hemicube { .. } => "hemicube",
+        }
+    }
+
+    /// Whether the method gives a receiver's form factors to all patches at once (a row), not
+    /// one point–patch pair at a time.
+    pub fn by_rows(self) -> bool {
+        matches!(self, FormFactorMethod::Hemicube { .. })
+    }
 }
 
 /// Form factors from points to patches: Lambert's formula times a visibility fraction, or Monte
@@ -210,7 +237,8 @@ impl PatchCoupling<'_> {
             .unoccluded(&d.receivers[v], d.receiver_surface[v], &d.patches[p])
     }
 
-    /// Form factor times visibility from receiver `v` to patch `p`, and the rays it took.
+    /// Form factor times visibility from receiver `v` to patch `p`, and the rays it took. The
+    /// hemicube has no pairwise form: there, Lambert's formula with sampled visibility.
     pub fn coupling(&self, v: usize, p: usize) -> (f64, u32) {
         let d = self.disc;
         self.coupler().coupling(
@@ -219,6 +247,101 @@ impl PatchCoupling<'_> {
             &d.patches[p],
             [v as u64, p as u64],
         )
+    }
+
+    /// Every patch's column of form factors: the receivers that see it, with their factors; and
+    /// the rays cast for them.
+    pub fn columns(
+        &self,
+        progress: &dyn Progress,
+    ) -> Result<(Vec<Vec<(u32, f32)>>, u64), SolveError> {
+        if let FormFactorMethod::Hemicube { resolution } = self.method {
+            return Ok((self.hemicube_columns(resolution, progress)?, 0));
+        }
+        let (n, patches) = (self.disc.receiver_count(), self.disc.patches.len());
+        progress.start("form factors", patches as u64);
+        let done = AtomicU64::new(0);
+        let computed: Vec<(Vec<(u32, f32)>, u64)> = (0..patches)
+            .into_par_iter()
+            .map(|q| {
+                let mut rays = 0u64;
+                let column = (0..n)
+                    .filter_map(|v| {
+                        let (f, r) = self.coupling(v, q);
+                        rays += r as u64;
+                        (f > 0.0).then_some((v as u32, f as f32))
+                    })
+                    .collect();
+                progress.set(done.fetch_add(1, Ordering::Relaxed) + 1);
+                (column, rays)
+            })
+            .collect();
+        progress.finish();
+        let rays = computed.iter().map(|c| c.1).sum();
+        Ok((computed.into_iter().map(|c| c.0).collect(), rays))
+    }
+
+    /// The columns from a hemicube at every receiver (each gives a row), transposed.
+    fn hemicube_columns(
+        &self,
+        resolution: usize,
+        progress: &dyn Progress,
+    ) -> Result<Vec<Vec<(u32, f32)>>, SolveError> {
+        let disc = self.disc;
+        let (n, patches) = (disc.receiver_count(), disc.patches.len());
+        let template = Hemicube::new(resolution)?;
+        // The eye moves into its surface like the rays of the other methods (a vertex on a
+        // junction sees the one-sided limit), and everything nearer than a quarter of that is cut.
+        let offset = self.visibility.junction_offset();
+        let near = 0.25 * offset;
+        let tol = self.visibility.contact_distance();
+        progress.start("hemicubes", n as u64);
+        let done = AtomicU64::new(0);
+        let rows: Vec<Vec<(u32, f32)>> = (0..n)
+            .into_par_iter()
+            .map_init(
+                || (template.clone(), vec![0.0; patches]),
+                |(cube, row), v| {
+                    let x = &disc.receivers[v];
+                    let surface = disc.receiver_surface[v];
+                    let eye = x.point + x.inward * offset;
+                    let triangles = disc
+                        .patches
+                        .iter()
+                        .enumerate()
+                        .filter(|(_, p)| {
+                            p.surface != surface
+                                && p.corners.iter().any(|&c| x.normal.dot(c - eye) > 0.0)
+                        })
+                        .flat_map(|(q, p)| {
+                            // A patch seen from behind hides what is behind it, and that is all.
+                            let id = if x.in_front_of(p.origin, p.normal, tol) {
+                                q as u32
+                            } else {
+                                OCCLUDER
+                            };
+                            p.triangles.iter().map(move |&t| (t, id))
+                        });
+                    cube.render(eye, x.normal, near, triangles);
+                    row.fill(0.0);
+                    cube.accumulate(row);
+                    progress.set(done.fetch_add(1, Ordering::Relaxed) + 1);
+                    row.iter()
+                        .enumerate()
+                        .filter(|(_, f)| **f > 0.0)
+                        .map(|(q, &f)| (q as u32, f as f32))
+                        .collect()
+                },
+            )
+            .collect();
+        progress.finish();
+        let mut columns = vec![Vec::new(); patches];
+        for (v, row) in rows.into_iter().enumerate() {
+            for (q, f) in row {
+                columns[q as usize].push((v as u32, f));
+            }
+        }
+        Ok(columns)
     }
 }
 

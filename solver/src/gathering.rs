@@ -88,7 +88,7 @@ impl PatchSystem {
         visibility: &Visibility,
         options: &SolverOptions,
         progress: &dyn Progress,
-    ) -> PatchSystem {
+    ) -> Result<PatchSystem, SolveError> {
         let disc = Discretization::new(scene, mesh, options.elements_per_patch);
         let started = Instant::now();
         let direct = direct_irradiance(scene, &disc, visibility, progress);
@@ -103,26 +103,7 @@ impl PatchSystem {
             seed: options.seed,
             method: options.form_factors,
         };
-        progress.start("form factors", patches as u64);
-        let done = std::sync::atomic::AtomicU64::new(0);
-        let computed: Vec<(Vec<(u32, f32)>, u64)> = (0..patches)
-            .into_par_iter()
-            .map(|q| {
-                let mut rays = 0u64;
-                let column = (0..n)
-                    .filter_map(|v| {
-                        let (f, r) = coupling.coupling(v, q);
-                        rays += r as u64;
-                        (f > 0.0).then_some((v as u32, f as f32))
-                    })
-                    .collect();
-                progress.set(done.fetch_add(1, std::sync::atomic::Ordering::Relaxed));
-                (column, rays)
-            })
-            .collect();
-        progress.finish();
-        let rays_cast = computed.iter().map(|c| c.1).sum();
-        let columns: Vec<Vec<(u32, f32)>> = computed.into_iter().map(|c| c.0).collect();
+        let (columns, rays_cast) = coupling.columns(progress)?;
 
         // A(p, v): vertex v's weight in patch p's area mean (a third of each element around it).
         let mut weights: Vec<Vec<(usize, f64)>> = vec![Vec::new(); n];
@@ -156,7 +137,7 @@ impl PatchSystem {
                 }
             }
         }
-        PatchSystem {
+        Ok(PatchSystem {
             disc,
             direct,
             columns,
@@ -165,7 +146,7 @@ impl PatchSystem {
             rays_cast,
             direct_seconds,
             assembly_seconds: started.elapsed().as_secs_f64(),
-        }
+        })
     }
 
     pub fn patches(&self) -> usize {
@@ -334,7 +315,7 @@ pub fn solve_gathering(
 ) -> Result<(Solution, Vec<ConvergencePoint>), SolveError> {
     options.validate()?;
     let started = Instant::now();
-    let system = PatchSystem::assemble(scene, mesh, visibility, options, progress);
+    let system = PatchSystem::assemble(scene, mesh, visibility, options, progress)?;
     let SystemSolution {
         patch_radiosity: b,
         history,

@@ -24,6 +24,7 @@ pub mod elements;
 pub mod error;
 pub mod estimate;
 pub mod gathering;
+pub mod hemicube;
 pub mod lambert;
 pub mod measure;
 pub mod path_trace;

@@ -26,7 +26,7 @@ use penumbra_scenes::{Rgb, Scene, SurfaceId, Visibility};
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::coupling::{Coupler, FormFactorMethod};
+use crate::coupling::{Coupler, FormFactorMethod, PatchCoupling};
 use crate::direct::DirectLight;
 use crate::elements::{Discretization, Patch};
 use crate::error::SolveError;
@@ -89,6 +89,9 @@ impl SolverOptions {
         }
         if self.form_factors == (FormFactorMethod::MonteCarlo { samples: 0 }) {
             return bad("form-factor samples", "must be at least 1");
+        }
+        if let FormFactorMethod::Hemicube { resolution } = self.form_factors {
+            crate::hemicube::Hemicube::new(resolution)?;
         }
         Ok(())
     }
@@ -243,6 +246,8 @@ pub struct ProgressiveSolver<'a> {
     /// Per patch of the current discretization: its shooter, once it has shot.
     patch_shooter: Vec<Option<usize>>,
     cache: HashMap<usize, Vec<f32>>,
+    /// Every patch's column at once, for methods that give rows (the hemicube).
+    columns: Option<Vec<Vec<(u32, f32)>>>,
     shot_power: Rgb,
     escaped: Rgb,
     stop: StopReason,
@@ -272,6 +277,19 @@ impl<'a> ProgressiveSolver<'a> {
         let direct_irradiance = direct_irradiance(scene, &disc, visibility, progress);
         let direct_seconds = started.elapsed().as_secs_f64();
         let received = disc.integrate(&direct_irradiance, |_| Rgb::splat(1.0));
+        // Methods that give whole rows compute every form factor up front.
+        let columns = if options.form_factors.by_rows() && !options.direct_only {
+            let coupling = PatchCoupling {
+                disc: &disc,
+                visibility,
+                rays: options.visibility_rays,
+                seed: options.seed,
+                method: options.form_factors,
+            };
+            Some(coupling.columns(progress)?.0)
+        } else {
+            None
+        };
         Ok(ProgressiveSolver {
             scene,
             visibility,
@@ -285,6 +303,7 @@ impl<'a> ProgressiveSolver<'a> {
             disc,
             shooters: Vec::new(),
             cache: HashMap::new(),
+            columns,
             shot_power: Rgb::ZERO,
             escaped: scene.emitted_power() - received,
             stop: if options.direct_only {
@@ -405,32 +424,7 @@ impl<'a> ProgressiveSolver<'a> {
                 }
             };
             let shot_radiosity = power / self.disc.patches[p].area;
-            let column = match self.cache.get(&p) {
-                Some(c) => c.clone(),
-                None => {
-                    let coupler = self.coupler();
-                    let disc = &self.disc;
-                    let patch = &disc.patches[p];
-                    let computed: Vec<(f32, u32)> = (0..n)
-                        .into_par_iter()
-                        .map(|v| {
-                            let (f, r) = coupler.coupling(
-                                &disc.receivers[v],
-                                disc.receiver_surface[v],
-                                patch,
-                                [v as u64, self.shooters[k].key],
-                            );
-                            (f as f32, r)
-                        })
-                        .collect();
-                    self.rays_cast += computed.iter().map(|&(_, r)| r as u64).sum::<u64>();
-                    let column: Vec<f32> = computed.into_iter().map(|(f, _)| f).collect();
-                    if self.cache.len() < cache_limit {
-                        self.cache.insert(p, column.clone());
-                    }
-                    column
-                }
-            };
+            let column = self.column(p, k, cache_limit);
             let delta: Vec<Rgb> = column.iter().map(|&f| shot_radiosity * f as f64).collect();
             for (h, d) in self.irradiance.iter_mut().zip(&delta) {
                 *h += *d;
@@ -446,6 +440,45 @@ impl<'a> ProgressiveSolver<'a> {
         progress.finish();
         self.shooting_seconds += started.elapsed().as_secs_f64();
         self.stop
+    }
+
+    /// Patch `p`'s form factors to every vertex (`k` is its shooter), from the cache when they
+    /// are there.
+    fn column(&mut self, p: usize, k: usize, cache_limit: usize) -> Vec<f32> {
+        if let Some(c) = self.cache.get(&p) {
+            return c.clone();
+        }
+        let n = self.disc.receiver_count();
+        if self.options.form_factors.by_rows() {
+            // Filled by `new` for these methods.
+            let columns = self.columns.as_deref().unwrap_or_default();
+            let mut column = vec![0.0; n];
+            for &(v, f) in columns.get(p).map_or(&[][..], Vec::as_slice) {
+                column[v as usize] = f;
+            }
+            return column;
+        }
+        let coupler = self.coupler();
+        let disc = &self.disc;
+        let patch = &disc.patches[p];
+        let computed: Vec<(f32, u32)> = (0..n)
+            .into_par_iter()
+            .map(|v| {
+                let (f, r) = coupler.coupling(
+                    &disc.receivers[v],
+                    disc.receiver_surface[v],
+                    patch,
+                    [v as u64, self.shooters[k].key],
+                );
+                (f as f32, r)
+            })
+            .collect();
+        self.rays_cast += computed.iter().map(|&(_, r)| r as u64).sum::<u64>();
+        let column: Vec<f32> = computed.into_iter().map(|(f, _)| f).collect();
+        if self.cache.len() < cache_limit {
+            self.cache.insert(p, column.clone());
+        }
+        column
     }
 
     /// Irradiance at `x` (on `surface`) from everything shot so far, less the direct light.
@@ -470,6 +503,13 @@ impl<'a> ProgressiveSolver<'a> {
     /// area. Shooting then goes on from where it was.
     pub fn remesh(&mut self, mesh: &SceneMesh, progress: &dyn Progress) -> Result<(), SolveError> {
         check_mesh(self.scene, mesh)?;
+        if self.options.form_factors.by_rows() {
+            // New vertices gather from shooters of older meshes, one pair at a time.
+            return Err(SolveError::InvalidOption {
+                option: "form factors",
+                reason: "the hemicube gives the rows of a fixed mesh; refining needs analytic or monte-carlo",
+            });
+        }
         let disc = Discretization::new(self.scene, mesh, self.options.elements_per_patch);
 
         // What each element has shot, as a density over its surface, moved to the new triangles.
