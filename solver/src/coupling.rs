@@ -209,6 +209,9 @@ fn kernel(x: &ReceivingPoint, origin: DVec3, patch: &Patch, y: DVec3) -> f64 {
     x.normal.dot(d) * -patch.normal.dot(d) / d.length_squared().powi(2)
 }
 
+/// Per patch, the receivers that see it and their form factors.
+pub type Columns = Vec<Vec<(u32, f32)>>;
+
 /// Form factors from the receivers (mesh vertices) of a discretization to its patches.
 #[derive(Debug)]
 pub struct PatchCoupling<'a> {
@@ -251,10 +254,7 @@ impl PatchCoupling<'_> {
 
     /// Every patch's column of form factors: the receivers that see it, with their factors; and
     /// the rays cast for them.
-    pub fn columns(
-        &self,
-        progress: &dyn Progress,
-    ) -> Result<(Vec<Vec<(u32, f32)>>, u64), SolveError> {
+    pub fn columns(&self, progress: &dyn Progress) -> Result<(Columns, u64), SolveError> {
         if let FormFactorMethod::Hemicube { resolution } = self.method {
             return Ok((self.hemicube_columns(resolution, progress)?, 0));
         }
@@ -286,7 +286,7 @@ impl PatchCoupling<'_> {
         &self,
         resolution: usize,
         progress: &dyn Progress,
-    ) -> Result<Vec<Vec<(u32, f32)>>, SolveError> {
+    ) -> Result<Columns, SolveError> {
         let disc = self.disc;
         let (n, patches) = (disc.receiver_count(), disc.patches.len());
         let template = Hemicube::new(resolution)?;

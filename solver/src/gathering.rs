@@ -71,7 +71,7 @@ pub struct PatchSystem {
     /// Direct irradiance at every vertex.
     pub direct: Vec<Rgb>,
     /// Per patch, the vertices that see it and their form factors.
-    pub columns: Vec<Vec<(u32, f32)>>,
+    pub columns: crate::coupling::Columns,
     /// c and K, one per channel: `k[channel][p * patches + q]`.
     pub c: [Vec<f64>; 3],
     pub k: [Vec<f64>; 3],

@@ -50,7 +50,7 @@ impl Hemicube {
     /// A hemicube with `resolution` pixels across its top face (even: the side faces are half
     /// as tall).
     pub fn new(resolution: usize) -> Result<Hemicube, SolveError> {
-        if resolution < 2 || resolution % 2 != 0 || resolution > MAX_RESOLUTION {
+        if resolution < 2 || !resolution.is_multiple_of(2) || resolution > MAX_RESOLUTION {
             return Err(SolveError::InvalidOption {
                 option: "hemicube resolution",
                 reason: "must be an even number from 2 to 2048",
@@ -293,7 +293,7 @@ mod tests {
     #[test]
     fn deltas_sum_to_one_as_pixels_shrink() {
         let errors: Vec<f64> = [16, 64, 256]
-            .map(|n| (Hemicube::new(n).unwrap().delta_sum() - 1.0).abs())
+            .map(|n| (Hemicube::new(n).expect("valid").delta_sum() - 1.0).abs())
             .to_vec();
         // Midpoint rule: second order in the pixel size.
         assert!(errors[0] < 1e-2 && errors[1] < errors[0] / 10.0 && errors[2] < errors[1] / 10.0);
@@ -302,7 +302,7 @@ mod tests {
     #[test]
     fn a_plane_covering_the_hemisphere_gets_the_delta_sum() {
         // A huge square just above the eye covers the whole top face and nearly all the sides.
-        let mut cube = Hemicube::new(64).unwrap();
+        let mut cube = Hemicube::new(64).expect("valid");
         let f = form_factor(&mut cube, &square(1e-3, [-1e4, -1e4], [1e4, 1e4]));
         assert!((f - cube.delta_sum()).abs() < 1e-6, "{f}");
     }
@@ -313,7 +313,7 @@ mod tests {
         let exact = 0.138531605994893;
         let errors: Vec<f64> = [32, 128, 512]
             .map(|n| {
-                let mut cube = Hemicube::new(n).unwrap();
+                let mut cube = Hemicube::new(n).expect("valid");
                 (form_factor(&mut cube, &square(1.0, [0.0, 0.0], [1.0, 1.0])) - exact).abs()
             })
             .to_vec();
@@ -323,7 +323,7 @@ mod tests {
 
     #[test]
     fn the_nearer_patch_hides_the_farther() {
-        let mut cube = Hemicube::new(64).unwrap();
+        let mut cube = Hemicube::new(64).expect("valid");
         let near = square(1.0, [-10.0, -10.0], [10.0, 10.0]);
         let far = square(2.0, [-10.0, -10.0], [10.0, 10.0]);
         // Drawn far first then near, and the other way round: the near one wins both times.

@@ -247,7 +247,7 @@ pub struct ProgressiveSolver<'a> {
     patch_shooter: Vec<Option<usize>>,
     cache: HashMap<usize, Vec<f32>>,
     /// Every patch's column at once, for methods that give rows (the hemicube).
-    columns: Option<Vec<Vec<(u32, f32)>>>,
+    columns: Option<crate::coupling::Columns>,
     shot_power: Rgb,
     escaped: Rgb,
     stop: StopReason,

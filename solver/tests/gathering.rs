@@ -90,7 +90,8 @@ fn gathering_slows_as_reflectance_nears_one() {
             max_shots: 1_000_000,
             ..SolverOptions::default()
         };
-        let system = PatchSystem::assemble(&scene, &mesh, &vis, &options, &NoProgress).unwrap();
+        let system =
+            PatchSystem::assemble(&scene, &mesh, &vis, &options, &NoProgress).expect("assembles");
         let mut iterations = [0usize; 2];
         for (k, method) in [SolverMethod::Jacobi, SolverMethod::GaussSeidel]
             .into_iter()
