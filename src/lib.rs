@@ -5,6 +5,7 @@
 //! thin command line around it.
 
 pub mod adaptive;
+pub mod form_factor_study;
 pub mod outputs;
 pub mod pipeline;
 pub mod progress_bar;

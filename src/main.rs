@@ -31,6 +31,10 @@ enum Command {
     /// ladder of element budgets and score each against a reference; write sweep.csv and
     /// sweep.json.
     Sweep(SweepArgs),
+    /// Measure every form-factor method (analytic, Monte Carlo, hemicube) against closed forms:
+    /// error against cost, point by point, the hemicube's aliasing, the 1 x 2 x 3 box's face
+    /// factors and dense solutions of a unit cube; write form-factors.json and print the tables.
+    FormFactors(FormFactorArgs),
     /// List the built-in scenes.
     Scenes,
     /// Load and validate a scene, reporting every problem at once.
@@ -142,7 +146,7 @@ struct RunArgs {
     ff_samples: usize,
     /// With --form-factors hemicube: pixels across the hemicube's top face (even; the side
     /// faces are half as tall).
-    #[arg(long, default_value_t = 256)]
+    #[arg(long, default_value_t = 128)]
     hemicube_resolution: usize,
     /// Also write the solver's residual against iterations and against time: convergence.csv,
     /// convergence-iterations.svg/.png and convergence-time.svg/.png.
@@ -241,6 +245,28 @@ struct SweepArgs {
     quiet: bool,
 }
 
+#[derive(clap::Args, Debug)]
+struct FormFactorArgs {
+    /// Output directory (created if missing).
+    #[arg(long, default_value = "out/form-factors")]
+    out: PathBuf,
+    /// Rays per point–patch pair for the analytic method's visibility fraction.
+    #[arg(long, default_value_t = SolverOptions::default().visibility_rays)]
+    rays: usize,
+    /// Monte Carlo sample counts to measure (comma-separated).
+    #[arg(long, value_delimiter = ',', default_values_t = [64, 256, 4096])]
+    samples: Vec<usize>,
+    /// Hemicube resolutions to measure (comma-separated, even).
+    #[arg(long, value_delimiter = ',', default_values_t = [32, 64, 128, 256, 512])]
+    resolutions: Vec<usize>,
+    /// Independent random streams the stochastic methods' errors are averaged over.
+    #[arg(long, default_value_t = 16)]
+    streams: usize,
+    /// Triangles of the unit cube's mesh.
+    #[arg(long, default_value_t = 2400)]
+    cube_elements: usize,
+}
+
 /// A failure, and whether it was the user's input (exit 2) or the run (exit 1).
 struct Failure {
     error: anyhow::Error,
@@ -294,7 +320,31 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
         Command::Check { scene } => check(&scene),
         Command::Run(args) => run(&args),
         Command::Sweep(args) => sweep(&args),
+        Command::FormFactors(args) => form_factors(&args),
     }
+}
+
+fn form_factors(args: &FormFactorArgs) -> Result<(), Failure> {
+    let options = penumbra::form_factor_study::StudyOptions {
+        rays: args.rays,
+        samples: args.samples.clone(),
+        resolutions: args.resolutions.clone(),
+        streams: args.streams,
+        cube_elements: args.cube_elements,
+    };
+    let study = penumbra::form_factor_study::run_study(&options).map_err(usage)?;
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    let path = args.out.join("form-factors.json");
+    let json = serde_json::to_vec_pretty(&study)?;
+    penumbra::outputs::write_atomic(&path, &json)
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    #[allow(clippy::print_stdout)] // the tables are this command's output
+    {
+        println!("{}", study.markdown());
+    }
+    eprintln!("wrote {}", path.display());
+    Ok(())
 }
 
 fn sweep(args: &SweepArgs) -> Result<(), Failure> {

@@ -580,3 +580,49 @@ fn sweeps_compare_solvers() {
     );
     assert!(svg.contains("discontinuity (gauss-seidel)"));
 }
+
+/// `--form-factors hemicube` solves the same system as the analytic form factors, to within the
+/// pixel grid's error; it gives rows of a fixed mesh, so adaptive refinement refuses it.
+#[test]
+fn hemicube_form_factors_run_and_refuse_refinement() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut absorbed = Vec::new();
+    for ff in ["analytic", "hemicube"] {
+        let out = dir.path().join(ff);
+        run_quietly(
+            "cornell",
+            &out,
+            &["--max-elements", "1500", "--form-factors", ff],
+        );
+        check_radiosity(&json(&out.join("solution.json")));
+        let report = json(&out.join("report.json"));
+        absorbed.push(
+            report["energy"]["absorbed_fraction"]
+                .as_f64()
+                .expect("absorbed"),
+        );
+    }
+    assert!((absorbed[0] - absorbed[1]).abs() < 1e-3, "{absorbed:?}");
+    for bad in [
+        vec!["--form-factors", "hemicube", "--refine-tol", "0.01"],
+        vec!["--form-factors", "hemicube", "--hemicube-resolution", "7"],
+    ] {
+        let out = dir.path().join("x");
+        let mut args = vec![
+            "run",
+            "textbook",
+            "--out",
+            out.to_str().expect("utf-8"),
+            "--quiet",
+        ];
+        args.extend(bad);
+        let o = penumbra(&args);
+        assert_eq!(
+            o.status.code(),
+            Some(2),
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert!(String::from_utf8_lossy(&o.stderr).contains("hemicube"));
+    }
+}

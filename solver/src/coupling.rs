@@ -290,11 +290,6 @@ impl PatchCoupling<'_> {
         let disc = self.disc;
         let (n, patches) = (disc.receiver_count(), disc.patches.len());
         let template = Hemicube::new(resolution)?;
-        // The eye moves into its surface like the rays of the other methods (a vertex on a
-        // junction sees the one-sided limit), and everything nearer than a quarter of that is cut.
-        let offset = self.visibility.junction_offset();
-        let near = 0.25 * offset;
-        let tol = self.visibility.contact_distance();
         progress.start("hemicubes", n as u64);
         let done = AtomicU64::new(0);
         let rows: Vec<Vec<(u32, f32)>> = (0..n)
@@ -302,29 +297,15 @@ impl PatchCoupling<'_> {
             .map_init(
                 || (template.clone(), vec![0.0; patches]),
                 |(cube, row), v| {
-                    let x = &disc.receivers[v];
-                    let surface = disc.receiver_surface[v];
-                    let eye = x.point + x.inward * offset;
-                    let triangles = disc
-                        .patches
-                        .iter()
-                        .enumerate()
-                        .filter(|(_, p)| {
-                            p.surface != surface
-                                && p.corners.iter().any(|&c| x.normal.dot(c - eye) > 0.0)
-                        })
-                        .flat_map(|(q, p)| {
-                            // A patch seen from behind hides what is behind it, and that is all.
-                            let id = if x.in_front_of(p.origin, p.normal, tol) {
-                                q as u32
-                            } else {
-                                OCCLUDER
-                            };
-                            p.triangles.iter().map(move |&t| (t, id))
-                        });
-                    cube.render(eye, x.normal, near, triangles);
                     row.fill(0.0);
-                    cube.accumulate(row);
+                    hemicube_row(
+                        cube,
+                        disc,
+                        self.visibility,
+                        &disc.receivers[v],
+                        disc.receiver_surface[v],
+                        row,
+                    );
                     progress.set(done.fetch_add(1, Ordering::Relaxed) + 1);
                     row.iter()
                         .enumerate()
@@ -343,6 +324,42 @@ impl PatchCoupling<'_> {
         }
         Ok(columns)
     }
+}
+
+/// The hemicube's form factors from `x` (on `surface`) to every patch of `disc`, added to `row`
+/// (one slot per patch). Every patch is drawn: the patches tile the scene, so they are its
+/// occluders too.
+pub fn hemicube_row(
+    cube: &mut Hemicube,
+    disc: &Discretization,
+    visibility: &Visibility,
+    x: &ReceivingPoint,
+    surface: SurfaceId,
+    row: &mut [f64],
+) {
+    // The eye moves into its surface like the rays of the other methods (a vertex on a junction
+    // sees the one-sided limit), and everything nearer than a quarter of that is cut away.
+    let offset = visibility.junction_offset();
+    let tol = visibility.contact_distance();
+    let eye = x.point + x.inward * offset;
+    let triangles = disc
+        .patches
+        .iter()
+        .enumerate()
+        .filter(|(_, p)| {
+            p.surface != surface && p.corners.iter().any(|&c| x.normal.dot(c - eye) > 0.0)
+        })
+        .flat_map(|(q, p)| {
+            // A patch seen from behind hides what is behind it, and that is all.
+            let id = if x.in_front_of(p.origin, p.normal, tol) {
+                q as u32
+            } else {
+                OCCLUDER
+            };
+            p.triangles.iter().map(move |&t| (t, id))
+        });
+    cube.render(eye, x.normal, 0.25 * offset, triangles);
+    cube.accumulate(row);
 }
 
 /// Lambert's formula over a patch: over its outline when the patch lies wholly in front of x,

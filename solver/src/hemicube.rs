@@ -207,8 +207,12 @@ impl Hemicube {
                 .min(count as f64 - 1.0);
             (first as usize, last)
         };
-        let (i0, i1) = span(lo[0], hi[0], -1.0, n);
-        let (j0, j1) = span(lo[1], hi[1], y0, rows);
+        // A pixel centre on an edge shared by two triangles (seams through the eye's own
+        // projection do pass through centres) must not be lost to rounding in both, so spans
+        // get a millionth of a pixel of slack; a centre covered twice goes to the nearer.
+        let slack = 1e-6 * self.pixel;
+        let (i0, i1) = span(lo[0] - slack, hi[0] + slack, -1.0, n);
+        let (j0, j1) = span(lo[1] - slack, hi[1] + slack, y0, rows);
         if i1 < i0 as f64 || j1 < j0 as f64 {
             return;
         }
@@ -221,14 +225,14 @@ impl Hemicube {
         for j in j0..=j1 {
             let b = y0 + (j as f64 + 0.5) * self.pixel;
             // The row's covered span: each edge bounds a from one side.
-            let (mut a_lo, mut a_hi) = (lo[0], hi[0]);
+            let (mut a_lo, mut a_hi) = (lo[0] - slack, hi[0] + slack);
             for e in edges {
                 let c = e[1] * b + e[2];
                 if e[0] > 0.0 {
-                    a_lo = a_lo.max(-c / e[0]);
+                    a_lo = a_lo.max(-c / e[0] - slack);
                 } else if e[0] < 0.0 {
-                    a_hi = a_hi.min(-c / e[0]);
-                } else if c < 0.0 {
+                    a_hi = a_hi.min(-c / e[0] + slack);
+                } else if c < -slack * e[1].abs() {
                     a_hi = f64::NEG_INFINITY;
                 }
             }
