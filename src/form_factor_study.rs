@@ -147,6 +147,14 @@ pub struct Study {
     pub cube: Vec<CubeRow>,
 }
 
+/// A point of the `receiver` surface, and the `target` surface it looks at.
+#[derive(Clone, Copy, Debug)]
+struct Probe {
+    point: DVec3,
+    receiver: SurfaceId,
+    target: SurfaceId,
+}
+
 /// A scene prepared for point evaluations: one patch per surface.
 struct Setup {
     scene: Scene,
@@ -174,18 +182,20 @@ impl Setup {
             .unwrap_or(0)
     }
 
-    /// The form factor from `point` on `receiver` to `target` by `method`; `stream` picks the
-    /// random stream.
+    /// The form factor of `probe` by `method`; `stream` picks the random stream.
     fn evaluate(
         &self,
         cube: Option<&mut Hemicube>,
         method: FormFactorMethod,
         rays: usize,
-        point: DVec3,
-        receiver: SurfaceId,
-        target: SurfaceId,
+        probe: Probe,
         stream: u64,
     ) -> f64 {
+        let Probe {
+            point,
+            receiver,
+            target,
+        } = probe;
         let normal = self.scene.surfaces[receiver].normal();
         let x = ReceivingPoint::interior(point, normal);
         let patch = self.patch_of(target);
@@ -392,13 +402,16 @@ pub fn run_study(options: &StudyOptions) -> Result<Study, StudyError> {
         for ((_, point, receiver, target, case), setup) in cases.iter().zip(&setups) {
             let mut sum2 = 0.0;
             for stream in 0..streams {
+                let probe = Probe {
+                    point: *point,
+                    receiver: *receiver,
+                    target: *target,
+                };
                 let f = setup.evaluate(
                     cube.as_mut(),
                     config.method,
                     options.rays,
-                    *point,
-                    *receiver,
-                    *target,
+                    probe,
                     stream as u64,
                 );
                 sum2 += ((f - case.exact) / case.exact).powi(2);
@@ -490,16 +503,18 @@ fn aliasing(options: &StudyOptions, streams: usize) -> Result<Vec<AliasingRow>, 
                     0.2 + pixel * (k % 7) as f64 / 7.0,
                 );
                 let setup = Setup::new(small_square(side, dx, dy))?;
-                let exact =
-                    setup.evaluate(None, FormFactorMethod::Analytic, 1, DVec3::ZERO, 0, 1, 0);
+                let probe = Probe {
+                    point: DVec3::ZERO,
+                    receiver: 0,
+                    target: 1,
+                };
+                let exact = setup.evaluate(None, FormFactorMethod::Analytic, 1, probe, 0);
                 let stream = if config.stochastic() { k % streams } else { 0 };
                 let f = setup.evaluate(
                     cube.as_mut(),
                     config.method,
                     options.rays,
-                    DVec3::ZERO,
-                    0,
-                    1,
+                    probe,
                     stream as u64,
                 );
                 lo = lo.min(f / exact);
