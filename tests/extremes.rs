@@ -330,3 +330,63 @@ fn wedge_lines_a_billionth_apart_mesh_sanely() {
         solve(scene, false);
     }
 }
+
+/// Light edges parallel to blocker edges (the analytic notes' section 3, blocker side 1.2): the
+/// EV wedges of an edge's two ends coincide with its EE wedge. They merge into one line each,
+/// no line drawn twice: the floor gets exactly the eight lines |x| or |y| = 0.65 (umbra) and
+/// 1.15 (penumbra), each from -1.15 to 1.15, all D1. The direct light is D1 there in fact: zero
+/// at x_u with slope 0 inside and 0.0691146221 outside (the notes' closed form).
+#[test]
+fn parallel_edges_give_single_d1_lines() {
+    let scene = extremes::parallel_edges(1.2);
+    let vis = Visibility::build(&scene);
+    let found =
+        penumbra_meshing::discontinuity::find_discontinuities(&scene, &vis, &Default::default());
+    let floor = scene.surface_id("floor").expect("floor");
+    let (x_u, x_p) = (0.65, 1.15);
+    // Covered length per line: (axis, signed offset).
+    let mut covered: std::collections::BTreeMap<(usize, i64), f64> = Default::default();
+    for s in &found.segments[floor] {
+        assert_eq!(s.order, 1, "{s:?}");
+        let d = s.to - s.from;
+        let axis = if d.x.abs() < 1e-12 { 0 } else { 1 }; // the coordinate that is constant
+        let at = if axis == 0 { s.from.x } else { s.from.y };
+        assert!(
+            [x_u, x_p].iter().any(|&l| (at.abs() - l).abs() < 1e-12),
+            "a segment off the eight lines: {s:?}"
+        );
+        for p in [s.from, s.to] {
+            let along = if axis == 0 { p.y } else { p.x };
+            assert!(along.abs() <= x_p + 1e-12, "{s:?}");
+        }
+        *covered
+            .entry((axis, (at * 1e6).round() as i64))
+            .or_default() += d.length();
+    }
+    assert_eq!(covered.len(), 8, "{covered:?}");
+    for (line, length) in &covered {
+        assert!(
+            (length - 2.0 * x_p).abs() < 1e-9,
+            "line {line:?} covered {length}"
+        );
+    }
+    let direct = DirectLight::new(&scene, &vis);
+    let at = |x: f64| {
+        direct
+            .irradiance(
+                &ReceivingPoint::interior(DVec3::new(x, 0.0, 0.0), DVec3::Z),
+                floor,
+            )
+            .r
+    };
+    let h = 1e-6;
+    assert!(at(x_u).abs() < 1e-12 && at(x_u - h).abs() < 1e-12);
+    let slope = (at(x_u + h) - at(x_u)) / h;
+    assert!((slope - 0.0691146221).abs() < 1e-6, "{slope}");
+    let result = solve(scene, false);
+    let m = &result.mesh.surfaces[floor];
+    let on_line = (0..m.vertex_count())
+        .filter(|&v| (m.points3[v].x - x_u).abs() < 1e-9 && m.points3[v].y.abs() < x_p)
+        .count();
+    assert!(on_line >= 3, "{on_line} mesh vertices on the umbra line");
+}

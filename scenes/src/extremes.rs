@@ -104,6 +104,27 @@ pub fn tiny_light(side: f64) -> Scene {
     )
 }
 
+/// Every blocker edge parallel to a light edge: a unit light at height 3 over a square blocker
+/// of side `side` at height 1 and a floor (section 3 of the analytic notes). Each light edge and
+/// the parallel blocker edge span one plane, so the EV wedges of both ends of an edge coincide
+/// with its EE wedge (degenerate wedges); they must merge into one line each, on which the light
+/// is D1 (its slope jumps). With `side` 1.2 the umbra ends at |x| = 0.65 and the penumbra at
+/// 1.15.
+pub fn parallel_edges(side: f64) -> Scene {
+    scene(
+        "parallel_edges",
+        vec![
+            light(DVec3::new(0.0, 0.0, 3.0), 0.5),
+            Surface::new(
+                "blocker",
+                square(DVec3::new(0.0, 0.0, 1.0), side / 2.0),
+                Rgb::splat(0.5),
+            ),
+            Surface::new("floor", square(DVec3::ZERO, 3.0), Rgb::splat(0.7)),
+        ],
+    )
+}
+
 /// A light at height 1 facing up, away from a blocker and a floor below it: nothing but the
 /// light itself may have any radiosity.
 pub fn light_facing_away() -> Scene {
