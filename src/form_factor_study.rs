@@ -283,22 +283,33 @@ fn point_scene(target: Surface, half: f64) -> Scene {
     }
 }
 
-/// The point cases: scene, receiving point, receiver and target surfaces, and the case.
-fn point_cases() -> Vec<(Scene, DVec3, SurfaceId, SurfaceId, PointCase)> {
+/// The origin of [`point_scene`]'s receiver, looking at its target.
+const AT_ORIGIN: Probe = Probe {
+    point: DVec3::ZERO,
+    receiver: 0,
+    target: 1,
+};
+
+/// The point cases: scene, probe, and the case.
+fn point_cases() -> Vec<(Scene, Probe, PointCase)> {
     let origin = DVec3::ZERO;
-    let floor_point = |x: f64| v(x, 0.0, 0.0);
     let textbook = builtin::textbook();
-    let light = textbook.surface_id("light").unwrap_or(0);
-    let floor = textbook.surface_id("floor").unwrap_or(2);
+    let (floor, light) = (
+        textbook.surface_id("floor").unwrap_or(2),
+        textbook.surface_id("light").unwrap_or(0),
+    );
+    let on_floor = |x: f64| Probe {
+        point: v(x, 0.0, 0.0),
+        receiver: floor,
+        target: light,
+    };
     vec![
         (
             point_scene(
                 rectangle("target", 2, 1.0, [0.0, 0.0], [1.0, 1.0], origin),
                 0.1,
             ),
-            origin,
-            0,
-            1,
+            AT_ORIGIN,
             PointCase {
                 name: "parallel square, corner on the normal",
                 source: "1.1, a = b = c = 1",
@@ -310,9 +321,7 @@ fn point_cases() -> Vec<(Scene, DVec3, SurfaceId, SurfaceId, PointCase)> {
                 rectangle("target", 2, 2.0, [0.0, 0.0], [0.5, 0.25], origin),
                 0.1,
             ),
-            origin,
-            0,
-            1,
+            AT_ORIGIN,
             PointCase {
                 name: "small distant rectangle",
                 source: "1.1, a = 0.5, b = 0.25, c = 2",
@@ -324,9 +333,7 @@ fn point_cases() -> Vec<(Scene, DVec3, SurfaceId, SurfaceId, PointCase)> {
                 rectangle("target", 0, 1.0, [0.0, 0.0], [1.0, 1.0], origin),
                 0.1,
             ),
-            origin,
-            0,
-            1,
+            AT_ORIGIN,
             PointCase {
                 name: "perpendicular square",
                 source: "1.2, a = b = c = 1",
@@ -338,9 +345,7 @@ fn point_cases() -> Vec<(Scene, DVec3, SurfaceId, SurfaceId, PointCase)> {
                 rectangle("target", 0, 1.0, [-1.0, -1.0], [1.0, 1.0], origin),
                 0.1,
             ),
-            origin,
-            0,
-            1,
+            AT_ORIGIN,
             PointCase {
                 name: "square straddling the tangent plane",
                 source: "1.6 D",
@@ -349,9 +354,7 @@ fn point_cases() -> Vec<(Scene, DVec3, SurfaceId, SurfaceId, PointCase)> {
         ),
         (
             textbook.clone(),
-            floor_point(0.75),
-            floor,
-            light,
+            on_floor(0.75),
             PointCase {
                 name: "light through a blocker, penumbra x = 0.75",
                 source: "3.2",
@@ -360,9 +363,7 @@ fn point_cases() -> Vec<(Scene, DVec3, SurfaceId, SurfaceId, PointCase)> {
         ),
         (
             textbook,
-            floor_point(0.6),
-            floor,
-            light,
+            on_floor(0.6),
             PointCase {
                 name: "light through a blocker, penumbra x = 0.6",
                 source: "3.2",
@@ -399,19 +400,14 @@ pub fn run_study(options: &StudyOptions) -> Result<Study, StudyError> {
         let mut errors = Vec::new();
         let started = Instant::now();
         let mut evaluations = 0usize;
-        for ((_, point, receiver, target, case), setup) in cases.iter().zip(&setups) {
+        for ((_, probe, case), setup) in cases.iter().zip(&setups) {
             let mut sum2 = 0.0;
             for stream in 0..streams {
-                let probe = Probe {
-                    point: *point,
-                    receiver: *receiver,
-                    target: *target,
-                };
                 let f = setup.evaluate(
                     cube.as_mut(),
                     config.method,
                     options.rays,
-                    probe,
+                    *probe,
                     stream as u64,
                 );
                 sum2 += ((f - case.exact) / case.exact).powi(2);
@@ -436,7 +432,7 @@ pub fn run_study(options: &StudyOptions) -> Result<Study, StudyError> {
         .map(|c| cube_solution(c, options))
         .collect::<Result<Vec<_>, _>>()?;
     Ok(Study {
-        cases: cases.into_iter().map(|c| c.4).collect(),
+        cases: cases.into_iter().map(|c| c.2).collect(),
         points,
         aliasing,
         box_factors,
@@ -503,18 +499,13 @@ fn aliasing(options: &StudyOptions, streams: usize) -> Result<Vec<AliasingRow>, 
                     0.2 + pixel * (k % 7) as f64 / 7.0,
                 );
                 let setup = Setup::new(small_square(side, dx, dy))?;
-                let probe = Probe {
-                    point: DVec3::ZERO,
-                    receiver: 0,
-                    target: 1,
-                };
-                let exact = setup.evaluate(None, FormFactorMethod::Analytic, 1, probe, 0);
+                let exact = setup.evaluate(None, FormFactorMethod::Analytic, 1, AT_ORIGIN, 0);
                 let stream = if config.stochastic() { k % streams } else { 0 };
                 let f = setup.evaluate(
                     cube.as_mut(),
                     config.method,
                     options.rays,
-                    probe,
+                    AT_ORIGIN,
                     stream as u64,
                 );
                 lo = lo.min(f / exact);
@@ -550,7 +541,7 @@ fn box_factors(config: &MethodConfig, rays: usize) -> Result<BoxRow, StudyError>
         method: config.method,
     }
     .columns(&NoProgress)?;
-    let f = patch_matrix(&disc, &columns);
+    let f = disc.patch_factors(&columns);
     let seconds = started.elapsed().as_secs_f64();
     let (mut worst_error, mut worst_row_sum) = (0.0f64, 0.0f64);
     for (i, row) in f.iter().enumerate() {
@@ -569,41 +560,6 @@ fn box_factors(config: &MethodConfig, rays: usize) -> Result<BoxRow, StudyError>
         worst_row_sum,
         seconds,
     })
-}
-
-/// Patch-to-patch factors: each patch's area mean of its vertices' form factors (linear over
-/// each element, the solvers' own quadrature).
-fn patch_matrix(disc: &Discretization, columns: &[Vec<(u32, f32)>]) -> Vec<Vec<f64>> {
-    let n = disc.receiver_count();
-    let dense: Vec<Vec<f64>> = columns
-        .iter()
-        .map(|c| {
-            let mut d = vec![0.0; n];
-            for &(v, f) in c {
-                d[v as usize] = f as f64;
-            }
-            d
-        })
-        .collect();
-    disc.patches
-        .iter()
-        .map(|patch| {
-            dense
-                .iter()
-                .map(|column| {
-                    patch
-                        .elements
-                        .iter()
-                        .map(|&e| {
-                            let el = &disc.elements[e];
-                            el.area * el.vertices.iter().map(|&v| column[v]).sum::<f64>() / 3.0
-                        })
-                        .sum::<f64>()
-                        / patch.area
-                })
-                .collect()
-        })
-        .collect()
 }
 
 /// Section 2.1 of the analytic notes: the closed-form factor from face `i` to face `j` of the

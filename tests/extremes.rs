@@ -47,6 +47,16 @@ fn assert_physical(result: &RunResult) {
     );
 }
 
+/// The direct light at (x, 0, 0) on the floor (normal +z).
+fn floor_light(direct: &DirectLight, floor: usize, x: f64) -> f64 {
+    direct
+        .irradiance(
+            &ReceivingPoint::interior(DVec3::new(x, 0.0, 0.0), DVec3::Z),
+            floor,
+        )
+        .r
+}
+
 fn surface_values(result: &RunResult, name: &str) -> Vec<f64> {
     let s = result.loaded.scene.surface_id(name).expect("surface");
     result.solution.radiosity[s]
@@ -227,14 +237,7 @@ fn a_touching_blocker_makes_the_light_jump() {
         }
     }
     let direct = DirectLight::new(&scene, &vis);
-    let at = |x: f64| {
-        direct
-            .irradiance(
-                &ReceivingPoint::interior(DVec3::new(x, 0.0, 0.0), DVec3::Z),
-                floor,
-            )
-            .r
-    };
+    let at = |x: f64| floor_light(&direct, floor, x);
     // Just inside, nothing but rounding (measured 3.5e-13 against 0.03 outside: a sliver of the
     // light narrower than the scene's tolerance).
     let eps = 1e-6;
@@ -371,14 +374,7 @@ fn parallel_edges_give_single_d1_lines() {
         );
     }
     let direct = DirectLight::new(&scene, &vis);
-    let at = |x: f64| {
-        direct
-            .irradiance(
-                &ReceivingPoint::interior(DVec3::new(x, 0.0, 0.0), DVec3::Z),
-                floor,
-            )
-            .r
-    };
+    let at = |x: f64| floor_light(&direct, floor, x);
     let h = 1e-6;
     assert!(at(x_u).abs() < 1e-12 && at(x_u - h).abs() < 1e-12);
     let slope = (at(x_u + h) - at(x_u)) / h;

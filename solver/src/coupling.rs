@@ -223,7 +223,22 @@ pub struct PatchCoupling<'a> {
     pub method: FormFactorMethod,
 }
 
-impl PatchCoupling<'_> {
+impl<'a> PatchCoupling<'a> {
+    /// The coupling a solve with `options` uses.
+    pub fn new(
+        disc: &'a Discretization,
+        visibility: &'a Visibility,
+        options: &crate::progressive::SolverOptions,
+    ) -> PatchCoupling<'a> {
+        PatchCoupling {
+            disc,
+            visibility,
+            rays: options.visibility_rays,
+            seed: options.seed,
+            method: options.form_factors,
+        }
+    }
+
     fn coupler(&self) -> Coupler<'_> {
         Coupler {
             visibility: self.visibility,

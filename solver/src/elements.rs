@@ -170,6 +170,25 @@ impl Discretization {
             .collect()
     }
 
+    /// Patch-to-patch form factors from vertex-to-patch columns (per patch, the vertices that see
+    /// it): F(p, q) is the area mean over patch p of the vertex form factors to q, linear over
+    /// each element, the solvers' own quadrature. Dense, patches²: for small systems and checks.
+    pub fn patch_factors(&self, columns: &[Vec<(u32, f32)>]) -> Vec<Vec<f64>> {
+        let n = self.patches.len();
+        let mut f = vec![vec![0.0; n]; n];
+        for (q, column) in columns.iter().enumerate().take(n) {
+            let mut dense = vec![0.0; self.receiver_count()];
+            for &(v, value) in column {
+                dense[v as usize] = value as f64;
+            }
+            for e in &self.elements {
+                let mean = e.vertices.iter().map(|&v| dense[v]).sum::<f64>() / 3.0;
+                f[e.patch][q] += e.area * mean / self.patches[e.patch].area;
+            }
+        }
+        f
+    }
+
     /// ∫ over each element of a linearly interpolated per-receiver quantity, summed: the power
     /// that quantity carries (for radiosity or irradiance values).
     pub fn integrate(&self, values: &[Rgb], weight: impl Fn(&Element) -> Rgb) -> Rgb {

@@ -96,13 +96,7 @@ impl PatchSystem {
         let started = Instant::now();
         let n = disc.receiver_count();
         let patches = disc.patches.len();
-        let coupling = PatchCoupling {
-            disc: &disc,
-            visibility,
-            rays: options.visibility_rays,
-            seed: options.seed,
-            method: options.form_factors,
-        };
+        let coupling = PatchCoupling::new(&disc, visibility, options);
         let (columns, rays_cast) = coupling.columns(progress)?;
 
         // A(p, v): vertex v's weight in patch p's area mean (a third of each element around it).

@@ -279,14 +279,11 @@ impl<'a> ProgressiveSolver<'a> {
         let received = disc.integrate(&direct_irradiance, |_| Rgb::splat(1.0));
         // Methods that give whole rows compute every form factor up front.
         let columns = if options.form_factors.by_rows() && !options.direct_only {
-            let coupling = PatchCoupling {
-                disc: &disc,
-                visibility,
-                rays: options.visibility_rays,
-                seed: options.seed,
-                method: options.form_factors,
-            };
-            Some(coupling.columns(progress)?.0)
+            Some(
+                PatchCoupling::new(&disc, visibility, options)
+                    .columns(progress)?
+                    .0,
+            )
         } else {
             None
         };

@@ -18,32 +18,17 @@ fn unoccluded_coupling<'a>(disc: &'a Discretization, vis: &'a Visibility) -> Pat
     }
 }
 
-/// Patch-to-patch form factors F_ij: the area average over patch i of the vertex form factors
-/// (linear interpolation over each element, the solver's own quadrature).
+/// Patch-to-patch form factors F_ij from the pairwise couplings.
 fn patch_matrix(disc: &Discretization, coupling: &PatchCoupling) -> Vec<Vec<f64>> {
     let n = disc.receiver_count();
-    let p = disc.patches.len();
-    let columns: Vec<Vec<f64>> = (0..p)
-        .map(|j| (0..n).map(|v| coupling.coupling(v, j).0).collect())
-        .collect();
-    (0..p)
-        .map(|i| {
-            let patch = &disc.patches[i];
-            (0..p)
-                .map(|j| {
-                    patch
-                        .elements
-                        .iter()
-                        .map(|&e| {
-                            let el = &disc.elements[e];
-                            el.area * el.vertices.iter().map(|&v| columns[j][v]).sum::<f64>() / 3.0
-                        })
-                        .sum::<f64>()
-                        / patch.area
-                })
+    let columns: Vec<Vec<(u32, f32)>> = (0..disc.patches.len())
+        .map(|j| {
+            (0..n)
+                .map(|v| (v as u32, coupling.coupling(v, j).0 as f32))
                 .collect()
         })
-        .collect()
+        .collect();
+    disc.patch_factors(&columns)
 }
 
 #[test]
@@ -267,36 +252,7 @@ fn patch_matrix_of(
     }
     .columns(&NoProgress)
     .expect("valid method");
-    let n = disc.receiver_count();
-    let dense: Vec<Vec<f64>> = columns
-        .iter()
-        .map(|c| {
-            let mut d = vec![0.0; n];
-            for &(v, f) in c {
-                d[v as usize] = f as f64;
-            }
-            d
-        })
-        .collect();
-    disc.patches
-        .iter()
-        .map(|patch| {
-            dense
-                .iter()
-                .map(|column| {
-                    patch
-                        .elements
-                        .iter()
-                        .map(|&e| {
-                            let el = &disc.elements[e];
-                            el.area * el.vertices.iter().map(|&v| column[v]).sum::<f64>() / 3.0
-                        })
-                        .sum::<f64>()
-                        / patch.area
-                })
-                .collect()
-        })
-        .collect()
+    disc.patch_factors(&columns)
 }
 
 /// The hemicube's face-to-face factors of the 1 x 2 x 3 box converge to Lambert's on the same
