@@ -7,7 +7,7 @@ use crate::model::{Camera, Scene, Surface};
 use crate::polygon;
 
 /// Names and one-line descriptions of the built-in scenes.
-pub const NAMES: [(&str, &str); 5] = [
+pub const NAMES: [(&str, &str); 8] = [
     (
         "cornell",
         "the measured Cornell box (mm): red and green walls, two white blocks, ceiling light",
@@ -28,6 +28,18 @@ pub const NAMES: [(&str, &str); 5] = [
         "bars",
         "two thin bars crossing at two heights under a square light, turned against its edges: EEE events",
     ),
+    (
+        "cie-5.3",
+        "CIE 171:2006 test case 5.3: a 1 m square source in the ceiling of a black 4 x 4 x 3 m room",
+    ),
+    (
+        "cie-5.6",
+        "CIE 171:2006 test case 5.6: a uniformly lit diffuse floor lighting black walls and ceiling",
+    ),
+    (
+        "cie-5.8",
+        "CIE 171:2006 test case 5.8: a 4 m cube reflecting 0.5, a 10,000 lm source at its centre",
+    ),
 ];
 
 /// The built-in scene called `name`.
@@ -38,6 +50,9 @@ pub fn builtin(name: &str) -> Option<Scene> {
         "furnace" => Some(furnace(1.0, 0.5)),
         "boxworld" => Some(boxworld(100, 1)),
         "bars" => Some(crossed_bars()),
+        "cie-5.3" => Some(crate::cie::area_source()),
+        "cie-5.6" => Some(crate::cie::floor_reflection()),
+        "cie-5.8" => Some(crate::cie::reflecting_cube(0.5)),
         _ => None,
     }
 }

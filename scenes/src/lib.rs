@@ -17,6 +17,7 @@
 //! ```
 
 pub mod builtin;
+pub mod cie;
 pub mod color;
 pub mod error;
 pub mod extremes;

@@ -24,15 +24,21 @@ pub struct LoadedScene {
 /// validates it. Every problem is reported at once.
 pub fn load_scene(spec: &str) -> Result<LoadedScene, SceneError> {
     let path = Path::new(spec);
-    let looks_like_path = path.exists()
-        || spec.contains(std::path::MAIN_SEPARATOR)
+    // A file that exists wins; then a built-in name (some have dots: "cie-5.3"); then anything
+    // that looks like a path is read as one, for its error.
+    let looks_like_path = spec.contains(std::path::MAIN_SEPARATOR)
         || spec.contains('/')
         || path.extension().is_some();
-    let (scene, source, warnings) = if looks_like_path {
+    let builtin_scene = if path.exists() {
+        None
+    } else {
+        builtin::builtin(spec)
+    };
+    let (scene, source, warnings) = if let Some(scene) = builtin_scene {
+        (scene, format!("builtin:{spec}"), Vec::new())
+    } else if path.exists() || looks_like_path {
         let (scene, warnings) = read_scene_file(path)?;
         (scene, path.display().to_string(), warnings)
-    } else if let Some(scene) = builtin::builtin(spec) {
-        (scene, format!("builtin:{spec}"), Vec::new())
     } else {
         return Err(SceneError::UnknownScene {
             name: spec.to_string(),
