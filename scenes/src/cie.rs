@@ -129,49 +129,20 @@ pub fn reflecting_cube(reflectance: f64) -> Scene {
     let (lo, hi) = (size / 2.0 - SOURCE_BOX / 2.0, size / 2.0 + SOURCE_BOX / 2.0);
     let exitance = CUBE_FLUX / (6.0 * SOURCE_BOX * SOURCE_BOX);
     let centre = size / 2.0;
-    // Each face of the small box faces away from its centre: a point just outside it.
-    let faces = [
-        (
-            "source_z0",
-            v(lo.x, lo.y, lo.z),
-            v(hi.x, hi.y, lo.z),
-            v(0.0, 0.0, -1.0),
-        ),
-        (
-            "source_z1",
-            v(lo.x, lo.y, hi.z),
-            v(hi.x, hi.y, hi.z),
-            v(0.0, 0.0, 1.0),
-        ),
-        (
-            "source_x0",
-            v(lo.x, lo.y, lo.z),
-            v(lo.x, hi.y, hi.z),
-            v(-1.0, 0.0, 0.0),
-        ),
-        (
-            "source_x1",
-            v(hi.x, lo.y, lo.z),
-            v(hi.x, hi.y, hi.z),
-            v(1.0, 0.0, 0.0),
-        ),
-        (
-            "source_y0",
-            v(lo.x, lo.y, lo.z),
-            v(hi.x, lo.y, hi.z),
-            v(0.0, -1.0, 0.0),
-        ),
-        (
-            "source_y1",
-            v(lo.x, hi.y, lo.z),
-            v(hi.x, hi.y, hi.z),
-            v(0.0, 1.0, 0.0),
-        ),
-    ];
-    for (name, a, b, out) in faces {
-        surfaces.push(
-            rect(name, a, b, centre + out * SOURCE_BOX, 0.0).with_emission(Rgb::splat(exitance)),
-        );
+    // Each face of the small box faces away from its centre: toward a point just outside it.
+    for axis in 0..3 {
+        for (side, sign) in [(0, -1.0), (1, 1.0)] {
+            let (mut a, mut b) = (lo, hi);
+            a[axis] = if side == 0 { lo[axis] } else { hi[axis] };
+            b[axis] = a[axis];
+            let mut out = DVec3::ZERO;
+            out[axis] = sign;
+            let name = format!("source_{}{side}", ["x", "y", "z"][axis]);
+            surfaces.push(
+                rect(&name, a, b, centre + out * SOURCE_BOX, 0.0)
+                    .with_emission(Rgb::splat(exitance)),
+            );
+        }
     }
     Scene {
         name: "cie-5.8".into(),
