@@ -42,6 +42,8 @@ pub enum RefineStop {
     Rounds,
     /// The time budget ran out.
     TimeBudget,
+    /// The run was interrupted (Ctrl-C, SIGTERM).
+    Interrupted,
 }
 
 /// The fraction of the element budget adaptive runs start from, by default: the estimate, not a
@@ -128,12 +130,13 @@ pub fn refine_adaptively(
             rounds.push(this);
             break;
         }
-        if solver_options
-            .deadline
-            .is_some_and(|d| std::time::Instant::now() >= d)
-        {
+        if let Some(reason) = solver_options.stop_now() {
             rounds.push(this);
-            stop = RefineStop::TimeBudget;
+            stop = if reason == penumbra_solver::StopReason::Interrupted {
+                RefineStop::Interrupted
+            } else {
+                RefineStop::TimeBudget
+            };
             break;
         }
         // Only triangles worse than the mesh's typical (RMS) residual are split: refinement

@@ -5,6 +5,8 @@
 
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 use anyhow::Context;
 use clap::{Parser, Subcommand, ValueEnum};
@@ -13,8 +15,8 @@ use penumbra::progress_bar::Bars;
 use penumbra::{DEFAULT_MAX_ELEMENTS, MeshMethod, RunOptions};
 use penumbra_meshing::grading::DEFAULT_PENUMBRA_DENSITY;
 use penumbra_scenes::{builtin, load_scene};
-use penumbra_solver::SolverOptions;
 use penumbra_solver::progressive::DEFAULT_EPSILON;
+use penumbra_solver::{Interrupt, SolverOptions};
 
 #[derive(Parser, Debug)]
 #[command(version, about = "Radiosity meshes that respect where shadows change")]
@@ -301,7 +303,7 @@ fn usage(error: impl Into<anyhow::Error>) -> Failure {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match dispatch(cli) {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(code) => code,
         Err(f) => {
             eprintln!("error: {:#}", f.error);
             ExitCode::from(if f.usage { 2 } else { 1 })
@@ -309,19 +311,34 @@ fn main() -> ExitCode {
     }
 }
 
-fn dispatch(cli: Cli) -> Result<(), Failure> {
+fn dispatch(cli: Cli) -> Result<ExitCode, Failure> {
     match cli.command {
         Command::Scenes => {
             for (name, description) in builtin::NAMES {
                 println!("{name:<10} {description}");
             }
-            Ok(())
         }
-        Command::Check { scene } => check(&scene),
-        Command::Run(args) => run(&args),
-        Command::Sweep(args) => sweep(&args),
-        Command::FormFactors(args) => form_factors(&args),
+        Command::Check { scene } => check(&scene)?,
+        Command::Run(args) => return run(&args),
+        Command::Sweep(args) => sweep(&args)?,
+        Command::FormFactors(args) => form_factors(&args)?,
     }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Ctrl-C (SIGINT) and SIGTERM set `interrupt`, so that the run stops shooting and writes what
+/// it has; a second one ends the process at once. Returns the cell that records which signal
+/// came.
+fn catch_interrupts(interrupt: &Interrupt) -> std::io::Result<Arc<AtomicUsize>> {
+    use signal_hook::consts::{SIGINT, SIGTERM};
+    let received = Arc::new(AtomicUsize::new(0));
+    for signal in [SIGINT, SIGTERM] {
+        // Registered first, so it sees the flag as it was before this signal set it.
+        signal_hook::flag::register_conditional_shutdown(signal, 128 + signal, interrupt.flag())?;
+        signal_hook::flag::register(signal, interrupt.flag())?;
+        signal_hook::flag::register_usize(signal, Arc::clone(&received), signal as usize)?;
+    }
+    Ok(received)
 }
 
 fn form_factors(args: &FormFactorArgs) -> Result<(), Failure> {
@@ -563,7 +580,7 @@ fn check(spec: &str) -> Result<(), Failure> {
     Ok(())
 }
 
-fn run(args: &RunArgs) -> Result<(), Failure> {
+fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
     if let Some(n) = args.threads {
         if n == 0 {
             return Err(usage(anyhow::anyhow!("--threads must be at least 1")));
@@ -610,6 +627,8 @@ fn run(args: &RunArgs) -> Result<(), Failure> {
             eprintln!("warning: {w}");
         }
     }
+    let interrupt = Interrupt::default();
+    let received = catch_interrupts(&interrupt).context("cannot catch Ctrl-C")?;
     let options = RunOptions {
         method: args.solver.into(),
         mesh: match args.mesh {
@@ -652,6 +671,7 @@ fn run(args: &RunArgs) -> Result<(), Failure> {
             elements_per_patch: args.elements_per_patch,
             direct_only: args.direct_only,
             seed: args.seed,
+            interrupt: Some(interrupt.clone()),
             ..SolverOptions::default()
         },
         render: penumbra_viz::RenderOptions {
@@ -693,5 +713,15 @@ fn run(args: &RunArgs) -> Result<(), Failure> {
         );
         println!("wrote {} files to {}", written.len(), args.out.display());
     }
-    Ok(())
+    if interrupt.is_set() {
+        // The conventional status of a process ended by the signal: 130 for SIGINT, 143 for
+        // SIGTERM.
+        let signal = received.load(Ordering::Relaxed);
+        eprintln!(
+            "interrupted: wrote the solution so far to {}, marked partial in report.json",
+            args.out.display()
+        );
+        return Ok(ExitCode::from(128 + signal.min(127) as u8));
+    }
+    Ok(ExitCode::SUCCESS)
 }

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use penumbra_meshing::MeshQuality;
 use penumbra_scenes::Rgb;
 use penumbra_solver::SolveStats;
-use penumbra_solver::SolverMethod;
+use penumbra_solver::{SolverMethod, StopReason};
 use serde::Serialize;
 
 use crate::pipeline::{RunResult, StageTimes};
@@ -77,6 +77,9 @@ pub fn solution_json(result: &RunResult) -> String {
 #[derive(Serialize)]
 struct Report<'a> {
     format: &'static str,
+    /// The run was cut short (interrupted, or its time budget spent): the solution is the best
+    /// so far, not a converged one.
+    partial: bool,
     scene: SceneSummary<'a>,
     warnings: &'a [String],
     method: Method,
@@ -159,6 +162,7 @@ pub fn report_json(result: &RunResult) -> String {
     let fraction = |p: Rgb| p.mean() / stats.emitted.mean().max(f64::MIN_POSITIVE);
     let report = Report {
         format: REPORT_FORMAT,
+        partial: matches!(stats.stop, StopReason::Interrupted | StopReason::TimeBudget),
         scene: SceneSummary {
             name: &scene.name,
             source: &result.loaded.source,

@@ -221,7 +221,7 @@ fn cie_5_8_inter_reflection() {
         let system = PatchSystem::assemble(&scene, &mesh, &visibility, &options, &NoProgress)
             .expect("assembles");
         let solved = system
-            .solve(SolverMethod::Direct, 1e-12, 1, None)
+            .solve(SolverMethod::Direct, 1e-12, 1, &|| None)
             .expect("solves");
         let total = system.irradiance(&solved.patch_radiosity);
         let reflected: Vec<Rgb> = total

@@ -626,3 +626,48 @@ fn hemicube_form_factors_run_and_refuse_refinement() {
         assert!(String::from_utf8_lossy(&o.stderr).contains("hemicube"));
     }
 }
+
+/// A real SIGINT or SIGTERM to a real run: it stops shooting, writes its solution so far (valid,
+/// marked partial, stop "interrupted") and exits 130 or 143, the statuses of the signals.
+#[test]
+fn interrupted_runs_write_their_partial_solution() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    for (signal, code) in [("INT", 130), ("TERM", 143)] {
+        let out = dir.path().join(signal);
+        // Converging this far takes minutes; the signal comes after two seconds.
+        let child = Command::new(env!("CARGO_BIN_EXE_penumbra"))
+            .args([
+                "run",
+                "cornell",
+                "--max-elements",
+                "20000",
+                "--epsilon",
+                "1e-9",
+                "--quiet",
+                "--out",
+                out.to_str().expect("utf-8"),
+            ])
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .expect("the penumbra binary runs");
+        std::thread::sleep(std::time::Duration::from_secs(2));
+        let sent = Command::new("kill")
+            .args([format!("-{signal}"), child.id().to_string()])
+            .status()
+            .expect("kill runs");
+        assert!(sent.success());
+        let o = child.wait_with_output().expect("the run ends");
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(code), "{stderr}");
+        assert!(stderr.contains("interrupted"), "{stderr}");
+        let report = json(&out.join("report.json"));
+        assert_eq!(report["partial"], true);
+        assert_eq!(report["solver"]["stop"], "interrupted");
+        assert!(check_radiosity(&json(&out.join("solution.json"))) > 0);
+        assert!(out.join("render.png").exists());
+    }
+    // A run left alone is not partial.
+    let out = dir.path().join("whole");
+    run_quietly("textbook", &out, &["--max-elements", "500"]);
+    assert_eq!(json(&out.join("report.json"))["partial"], false);
+}

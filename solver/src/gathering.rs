@@ -166,13 +166,14 @@ impl PatchSystem {
     }
 
     /// Solves for B̄ with `method` (not progressive) to a relative residual of `tolerance`, at
-    /// most `max_iterations` sweeps; returns B̄ per channel and the convergence history.
+    /// most `max_iterations` sweeps, or until `stop_now` gives a reason after a sweep; returns
+    /// B̄ per channel and the convergence history.
     pub fn solve(
         &self,
         method: SolverMethod,
         tolerance: f64,
         max_iterations: usize,
-        deadline: Option<Instant>,
+        stop_now: &dyn Fn() -> Option<StopReason>,
     ) -> Result<SystemSolution, SolveError> {
         let n = self.patches();
         let started = Instant::now();
@@ -236,8 +237,8 @@ impl PatchSystem {
                 stop = StopReason::Converged;
                 break;
             }
-            if deadline.is_some_and(|d| Instant::now() >= d) {
-                stop = StopReason::TimeBudget;
+            if let Some(reason) = stop_now() {
+                stop = reason;
                 break;
             }
         }
@@ -314,7 +315,9 @@ pub fn solve_gathering(
         patch_radiosity: b,
         history,
         stop,
-    } = system.solve(method, options.epsilon, options.max_shots, options.deadline)?;
+    } = system.solve(method, options.epsilon, options.max_shots, &|| {
+        options.stop_now()
+    })?;
     let disc = &system.disc;
     let h = system.irradiance(&b);
     let radiosity: Vec<Rgb> = (0..disc.receiver_count())

@@ -38,6 +38,6 @@ pub use gathering::{SolverMethod, solve_gathering};
 pub use lambert::{ReceivingPoint, form_factor};
 pub use progress::{NoProgress, Progress};
 pub use progressive::{
-    ConvergencePoint, ProgressiveSolver, Solution, SolveStats, SolverOptions, StopReason,
-    solve_progressive,
+    ConvergencePoint, Interrupt, ProgressiveSolver, Solution, SolveStats, SolverOptions,
+    StopReason, solve_progressive,
 };

@@ -18,6 +18,8 @@
 //! sum is taken in a fixed order.
 
 use std::collections::HashMap;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use penumbra_meshing::locate::{TriangleLocator, transfer_density};
@@ -51,6 +53,9 @@ pub struct SolverOptions {
     pub cache_bytes: usize,
     /// Stop shooting at this moment, converged or not (an anytime solve).
     pub deadline: Option<Instant>,
+    /// Stop shooting as soon as this is set (from a signal handler: Ctrl-C), keeping the
+    /// solution so far.
+    pub interrupt: Option<Interrupt>,
     /// How vertex-to-patch form factors are computed.
     pub form_factors: FormFactorMethod,
 }
@@ -68,12 +73,24 @@ impl Default for SolverOptions {
             seed: 0x5EED,
             cache_bytes: 1 << 30,
             deadline: None,
+            interrupt: None,
             form_factors: FormFactorMethod::Analytic,
         }
     }
 }
 
 impl SolverOptions {
+    /// Whether long work must stop now, and why: an interrupt, or the deadline passed.
+    pub fn stop_now(&self) -> Option<StopReason> {
+        if self.interrupt.as_ref().is_some_and(Interrupt::is_set) {
+            return Some(StopReason::Interrupted);
+        }
+        if self.deadline.is_some_and(|d| Instant::now() >= d) {
+            return Some(StopReason::TimeBudget);
+        }
+        None
+    }
+
     pub fn validate(&self) -> Result<(), SolveError> {
         let bad = |option: &'static str, reason: &'static str| {
             Err(SolveError::InvalidOption { option, reason })
@@ -97,6 +114,33 @@ impl SolverOptions {
     }
 }
 
+/// A flag that asks long work to stop, shared by its clones; a signal handler sets it through
+/// [`Interrupt::flag`].
+#[derive(Clone, Debug, Default)]
+pub struct Interrupt(Arc<AtomicBool>);
+
+impl Interrupt {
+    /// The flag itself, for a signal handler to set.
+    pub fn flag(&self) -> Arc<AtomicBool> {
+        Arc::clone(&self.0)
+    }
+
+    pub fn set(&self) {
+        self.0.store(true, Ordering::Relaxed);
+    }
+
+    pub fn is_set(&self) -> bool {
+        self.0.load(Ordering::Relaxed)
+    }
+}
+
+/// Two interrupts are the same when they share their flag.
+impl PartialEq for Interrupt {
+    fn eq(&self, other: &Self) -> bool {
+        Arc::ptr_eq(&self.0, &other.0)
+    }
+}
+
 /// Why the solver stopped.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -109,6 +153,8 @@ pub enum StopReason {
     DirectOnly,
     /// The time budget ran out: the solution is the best so far.
     TimeBudget,
+    /// The run was interrupted (Ctrl-C, SIGTERM): the solution is the best so far.
+    Interrupted,
 }
 
 /// Figures of a solve. Powers are in W per channel (radiosity times area in scene units).
@@ -194,7 +240,7 @@ fn irradiance_at(
         .par_iter()
         .map(|&v| {
             let h = f(v);
-            let d = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            let d = done.fetch_add(1, Ordering::Relaxed);
             if d.is_multiple_of(256) {
                 progress.set(d);
             }
@@ -390,8 +436,8 @@ impl<'a> ProgressiveSolver<'a> {
             if self.shots >= self.options.max_shots {
                 break StopReason::ShotLimit;
             }
-            if self.options.deadline.is_some_and(|d| Instant::now() >= d) {
-                break StopReason::TimeBudget;
+            if let Some(reason) = self.options.stop_now() {
+                break reason;
             }
             // The patch with the most unshot power (ties: the lowest index). After a remesh a
             // patch may have shot more than its finer elements now reflect: it shoots the
@@ -587,7 +633,7 @@ impl<'a> ProgressiveSolver<'a> {
         } else {
             irradiance_at(&fresh, "gathering", progress, |v| {
                 let (h, r) = self.gather(&disc.receivers[v], disc.receiver_surface[v], v as u64);
-                rays.fetch_add(r, std::sync::atomic::Ordering::Relaxed);
+                rays.fetch_add(r, Ordering::Relaxed);
                 h
             })
         };

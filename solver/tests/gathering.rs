@@ -97,7 +97,9 @@ fn gathering_slows_as_reflectance_nears_one() {
             .into_iter()
             .enumerate()
         {
-            let solved = system.solve(method, 1e-8, 1_000_000, None).expect("solves");
+            let solved = system
+                .solve(method, 1e-8, 1_000_000, &|| None)
+                .expect("solves");
             iterations[k] = solved.history.len() - 1;
             let expected = rho / (1.0 - rho); // reflected radiosity of a furnace with E = 1
             for &x in &solved.patch_radiosity[0] {
