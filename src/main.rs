@@ -682,15 +682,12 @@ fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
     };
     let bars = Bars::new(args.quiet);
     let result = penumbra::run(loaded, &options, &bars).map_err(run_failure)?;
-    let mut written = write_outputs(&result, &args.out)?;
-    if args.convergence {
-        for (name, bytes) in penumbra::outputs::convergence_files(&result)? {
-            let path = args.out.join(name);
-            penumbra::outputs::write_atomic(&path, &bytes)
-                .with_context(|| format!("cannot write {}", path.display()))?;
-            written.push(path);
-        }
-    }
+    let extra = if args.convergence {
+        penumbra::outputs::convergence_files(&result)?
+    } else {
+        Vec::new()
+    };
+    let written = write_outputs(&result, &args.out, extra)?;
     if !args.quiet {
         let stats = &result.solution.stats;
         println!(

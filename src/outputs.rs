@@ -245,14 +245,19 @@ pub fn svg_name(index: usize, name: &str) -> String {
     format!("{index:03}-{clean}.svg")
 }
 
-/// Writes `bytes` to `path` atomically: a temporary file in the same directory, then a rename.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+/// A temporary file name in the same directory as `path` (so that renaming it is atomic).
+fn temporary_beside(path: &Path) -> PathBuf {
     let dir = path.parent().unwrap_or(Path::new("."));
     let file_name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let tmp = dir.join(format!(".{file_name}.tmp-{}", std::process::id()));
+    dir.join(format!(".{file_name}.tmp-{}", std::process::id()))
+}
+
+/// Writes `bytes` to `path` atomically: a temporary file in the same directory, then a rename.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let tmp = temporary_beside(path);
     let result = (|| {
         let mut f = std::fs::File::create(&tmp)?;
         f.write_all(bytes)?;
@@ -317,8 +322,51 @@ fn report_solver_name(result: &RunResult) -> &'static str {
     }
 }
 
-/// Writes every output of a run into `dir` (created if needed); returns the paths written.
-pub fn write_outputs(result: &RunResult, dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
+/// Writes a set of files all or nothing, as far as the file system allows: every file goes to a
+/// temporary beside it first, and only when all are written are they renamed into place. If any
+/// fails, the temporaries are removed and the old files are left as they were.
+pub fn write_all_atomic(files: &[(PathBuf, Vec<u8>)]) -> anyhow::Result<()> {
+    use anyhow::Context;
+    // A directory in a file's place would fail its rename after others were done.
+    if let Some((path, _)) = files.iter().find(|(p, _)| p.is_dir()) {
+        anyhow::bail!("cannot write {}: a directory is in the way", path.display());
+    }
+    let mut staged: Vec<(PathBuf, &Path)> = Vec::with_capacity(files.len());
+    let cleanup = |staged: &[(PathBuf, &Path)]| {
+        for (tmp, _) in staged {
+            let _ = std::fs::remove_file(tmp);
+        }
+    };
+    for (path, bytes) in files {
+        let tmp = temporary_beside(path);
+        let written = (|| {
+            let mut f = std::fs::File::create(&tmp)?;
+            f.write_all(bytes)?;
+            f.sync_all()
+        })();
+        if let Err(e) = written {
+            let _ = std::fs::remove_file(&tmp);
+            cleanup(&staged);
+            return Err(e).with_context(|| format!("cannot write {}", path.display()));
+        }
+        staged.push((tmp, path));
+    }
+    for (i, (tmp, path)) in staged.iter().enumerate() {
+        if let Err(e) = std::fs::rename(tmp, path) {
+            cleanup(&staged[i..]);
+            return Err(e).with_context(|| format!("cannot write {}", path.display()));
+        }
+    }
+    Ok(())
+}
+
+/// Writes every output of a run into `dir` (created if needed), with `extra` files (name and
+/// bytes) beside them, all or nothing (see [`write_all_atomic`]); returns the paths written.
+pub fn write_outputs(
+    result: &RunResult,
+    dir: &Path,
+    extra: Vec<(String, Vec<u8>)>,
+) -> anyhow::Result<Vec<PathBuf>> {
     use anyhow::Context;
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let svg_dir = dir.join("surfaces");
@@ -343,8 +391,56 @@ pub fn write_outputs(result: &RunResult, dir: &Path) -> anyhow::Result<Vec<PathB
         );
         files.push((svg_dir.join(svg_name(i, &s.name)), svg.into_bytes()));
     }
-    for (path, bytes) in &files {
-        write_atomic(path, bytes).with_context(|| format!("cannot write {}", path.display()))?;
-    }
+    files.extend(
+        extra
+            .into_iter()
+            .map(|(name, bytes)| (dir.join(name), bytes)),
+    );
+    write_all_atomic(&files)?;
     Ok(files.into_iter().map(|(p, _)| p).collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn contents(dir: &Path) -> Vec<(String, Vec<u8>)> {
+        let mut all: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
+            .expect("readable")
+            .map(|e| {
+                let e = e.expect("entry");
+                let bytes = std::fs::read(e.path()).unwrap_or_default();
+                (e.file_name().to_string_lossy().into_owned(), bytes)
+            })
+            .collect();
+        all.sort();
+        all
+    }
+
+    /// A set of files whose last one cannot be written (its directory is missing, or a directory
+    /// stands in its place) changes nothing, and leaves no temporary behind.
+    #[test]
+    fn a_failed_write_leaves_the_old_files() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let d = dir.path();
+        std::fs::write(d.join("a.json"), b"old a").expect("writes");
+        std::fs::write(d.join("b.json"), b"old b").expect("writes");
+        std::fs::create_dir(d.join("c.png")).expect("mkdir");
+        let before = contents(d);
+        for last in [d.join("missing").join("c.png"), d.join("c.png")] {
+            let files = vec![
+                (d.join("a.json"), b"new a".to_vec()),
+                (d.join("b.json"), b"new b".to_vec()),
+                (last, b"new c".to_vec()),
+            ];
+            assert!(write_all_atomic(&files).is_err());
+            assert_eq!(contents(d), before);
+        }
+        let files = vec![
+            (d.join("a.json"), b"new a".to_vec()),
+            (d.join("b.json"), b"new b".to_vec()),
+        ];
+        write_all_atomic(&files).expect("writes");
+        assert_eq!(std::fs::read(d.join("a.json")).expect("reads"), b"new a");
+    }
 }
