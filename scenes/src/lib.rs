@@ -22,6 +22,7 @@ pub mod color;
 pub mod error;
 pub mod extremes;
 pub mod frame;
+pub mod fuzzing;
 pub mod load;
 pub mod model;
 pub mod obj;

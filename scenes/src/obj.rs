@@ -17,23 +17,56 @@ use crate::validate::{MIN_THINNESS, PLANARITY_TOLERANCE};
 /// Reflectance of faces without a material.
 pub const DEFAULT_REFLECTANCE: f64 = 0.5;
 
+/// Reads an OBJ file and the MTL files it names (beside it).
 pub fn read_obj(path: &Path) -> Result<(Scene, Vec<String>), SceneError> {
+    let file = std::fs::File::open(path).map_err(|source| SceneError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+    parse_obj(&mut std::io::BufReader::new(file), path, |mtl| {
+        let text = std::fs::read(dir.join(mtl)).map_err(|_| tobj::LoadError::OpenFileFailed)?;
+        load_mtl(&String::from_utf8_lossy(&text))
+    })
+}
+
+/// Parses MTL text. tobj panics on a colour with fewer than three numbers, so such lines are
+/// refused here first.
+fn load_mtl(text: &str) -> tobj::MTLLoadResult {
+    for line in text.lines() {
+        let mut words = line.split_whitespace();
+        if matches!(words.next(), Some("Ka" | "Kd" | "Ks" | "Ke")) && words.count() < 3 {
+            return Err(tobj::LoadError::MaterialParseError);
+        }
+    }
+    tobj::load_mtl_buf(&mut text.as_bytes())
+}
+
+/// Parses OBJ text; every `mtllib` it names reads as `mtl`. `path` only names the source.
+pub fn parse_obj_text(
+    obj: &str,
+    mtl: &str,
+    path: &Path,
+) -> Result<(Scene, Vec<String>), SceneError> {
+    parse_obj(&mut obj.as_bytes(), path, |_| load_mtl(mtl))
+}
+
+fn parse_obj(
+    reader: &mut impl std::io::BufRead,
+    path: &Path,
+    load_mtl: impl Fn(&Path) -> tobj::MTLLoadResult,
+) -> Result<(Scene, Vec<String>), SceneError> {
     let options = tobj::LoadOptions {
         triangulate: false,
         single_index: true,
         ignore_points: true,
         ignore_lines: true,
     };
-    let (models, materials) = tobj::load_obj(path, &options).map_err(|e| match e {
-        tobj::LoadError::OpenFileFailed => SceneError::Io {
+    let (models, materials) =
+        tobj::load_obj_buf(reader, &options, load_mtl).map_err(|e| SceneError::Obj {
             path: path.to_path_buf(),
-            source: std::io::Error::new(std::io::ErrorKind::NotFound, "cannot open the file"),
-        },
-        other => SceneError::Obj {
-            path: path.to_path_buf(),
-            message: format!("{other}; check the file is a valid OBJ"),
-        },
-    })?;
+            message: format!("{e}; check the file is a valid OBJ"),
+        })?;
     let mut warnings = Vec::new();
     let materials = materials.unwrap_or_else(|e| {
         warnings.push(format!(
