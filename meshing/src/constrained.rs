@@ -289,6 +289,11 @@ fn snap_t_junctions(
         let inner = t * len2.sqrt() > tol && (1.0 - t) * len2.sqrt() > tol;
         (inner && p.distance(q) <= tol).then_some((t, q))
     };
+    // Only the segments passing near an end can take it: a grid finds them.
+    let mut grid = SegmentGrid::new(boundary, segments.len(), tol);
+    for (j, s) in segments.iter().enumerate() {
+        grid.add(j, s.0);
+    }
     let mut i = 0;
     while i < segments.len() {
         for end in 0..2 {
@@ -300,13 +305,20 @@ fn snap_t_junctions(
                 splits[k].push((t, q));
                 continue;
             }
-            let hit = (0..segments.len())
+            // The first segment in order that passes within `tol`, as a scan of all would find.
+            let hit = grid
+                .near(p)
+                .iter()
+                .copied()
                 .filter(|&j| j != i)
-                .find_map(|j| onto(p, segments[j].0[0], segments[j].0[1]).map(|(_, q)| (j, q)));
+                .filter_map(|j| onto(p, segments[j].0[0], segments[j].0[1]).map(|(_, q)| (j, q)))
+                .min_by_key(|&(j, _)| j);
             if let Some((j, q)) = hit {
                 segments[i].0[end] = q;
                 let ([a, b], splits_d0) = segments[j];
+                // The first piece stays within the cells of the whole segment.
                 segments[j].0 = [a, q];
+                grid.add(segments.len(), [q, b]);
                 segments.push(([q, b], splits_d0));
             }
         }
@@ -352,6 +364,84 @@ fn snap_t_junctions(
         })
         .collect();
     (segments, splits)
+}
+
+/// Segments filed under the cells of a square grid over a polygon's bounding box that they pass
+/// within `tol` of; points outside the box belong to its nearest cell.
+struct SegmentGrid {
+    origin: DVec2,
+    cell: DVec2,
+    side: usize,
+    tol: f64,
+    cells: Vec<Vec<usize>>,
+}
+
+impl SegmentGrid {
+    /// About one cell per segment, at most 1024 a side.
+    fn new(boundary: &[DVec2], segments: usize, tol: f64) -> SegmentGrid {
+        let (lo, hi) = boundary
+            .iter()
+            .fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), &p| {
+                (lo.min(p), hi.max(p))
+            });
+        let side = ((segments as f64).sqrt().ceil() as usize).clamp(1, 1024);
+        let extent = (hi - lo).max(DVec2::splat(tol));
+        SegmentGrid {
+            origin: lo,
+            cell: extent / side as f64,
+            side,
+            tol,
+            cells: vec![Vec::new(); side * side],
+        }
+    }
+
+    /// The column or row of coordinate `x` along axis `axis`, clamped to the grid.
+    fn index(&self, x: f64, axis: usize) -> usize {
+        let t = ((x - self.origin[axis]) / self.cell[axis]).floor();
+        if t.is_nan() {
+            0
+        } else {
+            t.clamp(0.0, (self.side - 1) as f64) as usize
+        }
+    }
+
+    fn add(&mut self, j: usize, [a, b]: [DVec2; 2]) {
+        let tol = self.tol;
+        let (y0, y1) = (a.y.min(b.y) - tol, a.y.max(b.y) + tol);
+        for row in self.index(y0, 1)..=self.index(y1, 1) {
+            // The part of the segment within `tol` of this row's band, in x.
+            // The first and last rows also hold everything beyond the box.
+            let band_lo = match row {
+                0 => f64::NEG_INFINITY,
+                _ => self.origin.y + row as f64 * self.cell.y - tol,
+            };
+            let band_hi = match row + 1 == self.side {
+                true => f64::INFINITY,
+                false => self.origin.y + (row + 1) as f64 * self.cell.y + tol,
+            };
+            let (lo_y, hi_y) = (band_lo.max(y0), band_hi.min(y1));
+            let x_at = |y: f64| {
+                if b.y == a.y {
+                    None
+                } else {
+                    Some(a.x + (b.x - a.x) * ((y - a.y) / (b.y - a.y)).clamp(0.0, 1.0))
+                }
+            };
+            let (x0, x1) = match (x_at(lo_y), x_at(hi_y)) {
+                (Some(p), Some(q)) => (p.min(q), p.max(q)),
+                _ => (a.x.min(b.x), a.x.max(b.x)),
+            };
+            let (first, last) = (self.index(x0 - tol, 0), self.index(x1 + tol, 0));
+            for column in first..=last {
+                self.cells[row * self.side + column].push(j);
+            }
+        }
+    }
+
+    /// The segments that may pass within `tol` of `p`.
+    fn near(&self, p: DVec2) -> &[usize] {
+        &self.cells[self.index(p.y, 1) * self.side + self.index(p.x, 0)]
+    }
 }
 
 /// Points within a distance of an earlier point are replaced by it (a hash grid of that size).

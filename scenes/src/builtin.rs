@@ -22,7 +22,7 @@ pub const NAMES: [(&str, &str); 8] = [
     ),
     (
         "boxworld",
-        "100 boxes of random size and turn standing on a floor under a square light (seed 1)",
+        "100 boxes of random size and turn standing on a floor under a square light (seed 1); boxworld-N for N boxes",
     ),
     (
         "bars",
@@ -53,8 +53,23 @@ pub fn builtin(name: &str) -> Option<Scene> {
         "cie-5.3" => Some(crate::cie::area_source()),
         "cie-5.6" => Some(crate::cie::floor_reflection()),
         "cie-5.8" => Some(crate::cie::reflecting_cube(0.5)),
-        _ => None,
+        _ => boxworld_count(name).map(|count| boxworld(count, 1)),
     }
+}
+
+/// Most boxes a `boxworld-N` name may ask for (five million polygons).
+pub const MAX_BOXWORLD: usize = 1_000_000;
+
+/// `N` from `boxworld-N`, for 1 ≤ N ≤ [`MAX_BOXWORLD`].
+fn boxworld_count(name: &str) -> Option<usize> {
+    let digits = name.strip_prefix("boxworld-")?;
+    if digits.is_empty() || !digits.bytes().all(|b| b.is_ascii_digit()) {
+        return None;
+    }
+    digits
+        .parse()
+        .ok()
+        .filter(|n| (1..=MAX_BOXWORLD).contains(n))
 }
 
 fn v(x: f64, y: f64, z: f64) -> DVec3 {
@@ -441,6 +456,17 @@ mod tests {
         for (name, _) in NAMES {
             let scene = builtin(name).expect("every listed name is built in");
             assert_eq!(validate(&scene), vec![], "{name}");
+        }
+    }
+
+    #[test]
+    fn boxworld_names_carry_their_count() {
+        let scene = builtin("boxworld-7").expect("a count is a built-in name");
+        assert_eq!(scene.surfaces.len(), 2 + 5 * 7);
+        assert_eq!(scene.name, "boxworld-7");
+        assert_eq!(builtin("boxworld-100"), Some(boxworld(100, 1)));
+        for bad in ["boxworld-", "boxworld-0", "boxworld--3", "boxworld-+3", "boxworld-1000001"] {
+            assert_eq!(builtin(bad), None, "{bad}");
         }
     }
 
