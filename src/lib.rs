@@ -7,6 +7,7 @@
 pub mod adaptive;
 pub mod form_factor_study;
 pub mod fuzzing;
+pub mod memory;
 pub mod outputs;
 pub mod pipeline;
 pub mod progress_bar;

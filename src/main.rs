@@ -182,6 +182,10 @@ struct RunArgs {
     /// Worker threads (default: one per core).
     #[arg(long)]
     threads: Option<usize>,
+    /// Memory the run may use, in MiB (default: what the machine has available). A run that
+    /// would need more stops before it starts, with the largest --max-elements that fits.
+    #[arg(long)]
+    memory_limit: Option<f64>,
     /// Render width in pixels.
     #[arg(long, default_value_t = 640)]
     width: u32,
@@ -616,6 +620,13 @@ fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
             "--refine-tol must be a positive number, not {tol}"
         )));
     }
+    if let Some(mib) = args.memory_limit
+        && !(mib > 0.0 && mib.is_finite())
+    {
+        return Err(usage(anyhow::anyhow!(
+            "--memory-limit must be a positive number of MiB, not {mib}"
+        )));
+    }
     if args.width == 0 || args.height == 0 {
         return Err(usage(anyhow::anyhow!(
             "--width and --height must be at least 1"
@@ -679,6 +690,7 @@ fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
             height: args.height,
             ..Default::default()
         },
+        memory_limit: args.memory_limit.map(|mib| (mib * 1024.0 * 1024.0) as u64),
     };
     let bars = Bars::new(args.quiet);
     let result = penumbra::run(loaded, &options, &bars).map_err(run_failure)?;

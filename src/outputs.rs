@@ -89,6 +89,8 @@ struct Report<'a> {
     #[serde(skip_serializing_if = "Option::is_none")]
     refinement: Option<&'a crate::adaptive::RefineReport>,
     times_seconds: &'a StageTimes,
+    /// Estimated need, the limit it was checked against, and the peak after each stage.
+    memory: &'a crate::pipeline::MemoryReport,
     solver: &'a SolveStats,
     energy: Energy,
     mesh_quality: MeshQuality,
@@ -202,6 +204,7 @@ pub fn report_json(result: &RunResult) -> String {
         discontinuities: result.mesh.discontinuity_stats.as_ref(),
         refinement: result.refinement.as_ref(),
         times_seconds: &result.times,
+        memory: &result.memory,
         solver: stats,
         energy: Energy {
             emitted: stats.emitted,

@@ -4,6 +4,7 @@
 use std::time::Instant;
 
 use crate::adaptive::{RefineOptions, RefineReport, refine_adaptively};
+use crate::memory::{self, MeshCounts};
 use penumbra_meshing::discontinuity::{DiscontinuityOptions, find_discontinuities};
 use penumbra_meshing::grading::DEFAULT_PENUMBRA_DENSITY;
 use penumbra_meshing::{MeshError, SceneMesh, mesh_scene_discontinuity, mesh_scene_uniform};
@@ -45,6 +46,8 @@ pub struct RunOptions {
     /// How the radiosity system is solved (progressive refinement unless asked otherwise).
     pub method: SolverMethod,
     pub render: RenderOptions,
+    /// Bytes the run may use (default: what the machine has available when it starts).
+    pub memory_limit: Option<u64>,
 }
 
 impl Default for RunOptions {
@@ -59,6 +62,7 @@ impl Default for RunOptions {
             solver: SolverOptions::default(),
             method: SolverMethod::Progressive,
             render: RenderOptions::default(),
+            memory_limit: None,
         }
     }
 }
@@ -79,6 +83,30 @@ pub struct StageTimes {
     pub total: f64,
 }
 
+/// The most memory the process had held by the end of each stage (bytes; absent where the
+/// system does not say).
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct StagePeaks {
+    pub visibility: Option<u64>,
+    pub discontinuities: Option<u64>,
+    pub mesh: Option<u64>,
+    pub solve: Option<u64>,
+    pub render: Option<u64>,
+}
+
+/// What the run was expected to need, what it could have, and what it used.
+#[derive(Clone, Debug, Serialize)]
+pub struct MemoryReport {
+    /// Bytes the run could use: `--memory-limit`, or what the machine had available.
+    pub limit_bytes: Option<u64>,
+    /// Estimated from the mesh that was built.
+    pub estimate_bytes: u64,
+    pub estimate: memory::MemoryEstimate,
+    /// The progressive solver's form-factor cache, as capped to fit.
+    pub cache_bytes: usize,
+    pub peak_bytes: StagePeaks,
+}
+
 /// Everything a run computes.
 #[derive(Debug)]
 pub struct RunResult {
@@ -89,6 +117,7 @@ pub struct RunResult {
     pub solution: Solution,
     pub render: Render,
     pub times: StageTimes,
+    pub memory: MemoryReport,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -100,6 +129,30 @@ pub enum RunError {
     Solve(#[from] SolveError),
     #[error(transparent)]
     Render(#[from] VizError),
+    #[error("{}", memory_message(.needed, .limit, .suggestion))]
+    Memory {
+        /// Estimated bytes.
+        needed: u64,
+        /// Bytes the run may use.
+        limit: u64,
+        /// The largest `--max-elements` that would fit, if any.
+        suggestion: Option<usize>,
+    },
+}
+
+fn memory_message(needed: &u64, limit: &u64, suggestion: &Option<usize>) -> String {
+    let head = format!(
+        "this run would need about {} of memory, and {} is available",
+        memory::human(*needed),
+        memory::human(*limit)
+    );
+    match suggestion {
+        Some(n) => format!("{head}; use --max-elements {n} or fewer (or --memory-limit, if more is free)"),
+        None => format!(
+            "{head}; even the coarsest mesh of this scene does not fit (options: --direct-only, \
+             --solver progressive, smaller --width/--height, or a machine with more memory)"
+        ),
+    }
 }
 
 impl RunError {
@@ -109,6 +162,7 @@ impl RunError {
             self,
             RunError::Mesh(MeshError::BudgetTooSmall { .. })
                 | RunError::Solve(SolveError::InvalidOption { .. })
+                | RunError::Memory { .. }
         )
     }
 }
@@ -144,11 +198,32 @@ pub fn run(
         ..options.solver.clone()
     };
     let mut times = StageTimes::default();
+    let mut peaks = StagePeaks::default();
     let scene = &loaded.scene;
+
+    // Refuse at once what cannot fit, rather than be killed later.
+    let limit = options.memory_limit.or_else(memory::available_bytes);
+    let check = |counts: MeshCounts| -> Result<memory::MemoryEstimate, RunError> {
+        let estimate = memory::estimate(scene, options, counts);
+        match limit {
+            Some(limit) if estimate.total() > limit => Err(RunError::Memory {
+                needed: estimate.total(),
+                limit,
+                suggestion: memory::largest_fitting_budget(scene, options, limit),
+            }),
+            _ => Ok(estimate),
+        }
+    };
+    check(MeshCounts::predicted(
+        scene,
+        options.max_elements,
+        options.solver.elements_per_patch,
+    ))?;
 
     let t = Instant::now();
     let visibility = Visibility::build(scene);
     times.visibility = t.elapsed().as_secs_f64();
+    peaks.visibility = memory::peak_resident_bytes();
 
     let t = Instant::now();
     let found = match options.mesh {
@@ -160,6 +235,7 @@ pub fn run(
         )),
     };
     times.discontinuities = t.elapsed().as_secs_f64();
+    peaks.discontinuities = memory::peak_resident_bytes();
 
     let t = Instant::now();
     progress.start("meshing", 1);
@@ -174,6 +250,20 @@ pub fn run(
     };
     progress.finish();
     times.mesh = t.elapsed().as_secs_f64();
+    peaks.mesh = memory::peak_resident_bytes();
+
+    // Again with the real counts, before the solver allocates; the column cache gets what is
+    // left.
+    let estimate = check(MeshCounts::of_mesh(
+        &mesh,
+        options.solver.elements_per_patch,
+    ))?;
+    let solver = SolverOptions {
+        cache_bytes: limit.map_or(solver.cache_bytes, |limit| {
+            memory::cache_bytes(solver.cache_bytes, estimate.total(), limit)
+        }),
+        ..solver
+    };
 
     let t = Instant::now();
     let (refinement, solution) = match &options.refine {
@@ -198,6 +288,7 @@ pub fn run(
             solve_gathering(scene, &mesh, &visibility, &solver, options.method, progress)?.0,
         ),
     };
+    peaks.solve = memory::peak_resident_bytes();
     let stats = &solution.stats;
     times.direct = stats.direct_seconds;
     times.shooting = stats.shooting_seconds;
@@ -227,6 +318,7 @@ pub fn run(
     let render = penumbra_viz::render(scene, &mesh, &display, &options.render)?;
     times.render = t.elapsed().as_secs_f64();
     times.total = started.elapsed().as_secs_f64();
+    peaks.render = memory::peak_resident_bytes();
 
     Ok(RunResult {
         loaded,
@@ -236,5 +328,12 @@ pub fn run(
         solution,
         render,
         times,
+        memory: MemoryReport {
+            limit_bytes: limit,
+            estimate_bytes: estimate.total(),
+            estimate,
+            cache_bytes: solver.cache_bytes,
+            peak_bytes: peaks,
+        },
     })
 }

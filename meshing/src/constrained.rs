@@ -290,9 +290,9 @@ fn snap_t_junctions(
         (inner && p.distance(q) <= tol).then_some((t, q))
     };
     // Only the segments passing near an end can take it: a grid finds them.
-    let mut grid = SegmentGrid::new(boundary, segments.len(), tol);
+    let mut grid = SegmentGrid::new(boundary.iter().copied(), segments.len());
     for (j, s) in segments.iter().enumerate() {
-        grid.add(j, s.0);
+        grid.add(j, s.0, tol);
     }
     let mut i = 0;
     while i < segments.len() {
@@ -318,7 +318,7 @@ fn snap_t_junctions(
                 let ([a, b], splits_d0) = segments[j];
                 // The first piece stays within the cells of the whole segment.
                 segments[j].0 = [a, q];
-                grid.add(segments.len(), [q, b]);
+                grid.add(segments.len(), [q, b], tol);
                 segments.push(([q, b], splits_d0));
             }
         }
@@ -366,31 +366,33 @@ fn snap_t_junctions(
     (segments, splits)
 }
 
-/// Segments filed under the cells of a square grid over a polygon's bounding box that they pass
-/// within `tol` of; points outside the box belong to its nearest cell.
+/// Segments filed under the cells of a square grid over a bounding box that they pass within a
+/// distance of; points outside the box belong to its nearest cell. It finds the few segments
+/// near a point among many (the contact lines of thousands of blockers on one floor).
 struct SegmentGrid {
     origin: DVec2,
     cell: DVec2,
     side: usize,
-    tol: f64,
     cells: Vec<Vec<usize>>,
 }
 
 impl SegmentGrid {
-    /// About one cell per segment, at most 1024 a side.
-    fn new(boundary: &[DVec2], segments: usize, tol: f64) -> SegmentGrid {
-        let (lo, hi) = boundary
-            .iter()
-            .fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), &p| {
-                (lo.min(p), hi.max(p))
-            });
+    /// A grid over the box of `points`, about one cell per segment, at most 1024 a side.
+    fn new(points: impl Iterator<Item = DVec2>, segments: usize) -> SegmentGrid {
+        let (lo, hi) = points.fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), p| {
+            (lo.min(p), hi.max(p))
+        });
         let side = ((segments as f64).sqrt().ceil() as usize).clamp(1, 1024);
-        let extent = (hi - lo).max(DVec2::splat(tol));
+        let (lo, hi) = if lo.is_finite() && hi.is_finite() {
+            (lo, hi)
+        } else {
+            (DVec2::ZERO, DVec2::ONE)
+        };
+        let extent = (hi - lo).max(DVec2::splat(f64::MIN_POSITIVE * side as f64));
         SegmentGrid {
             origin: lo,
             cell: extent / side as f64,
             side,
-            tol,
             cells: vec![Vec::new(); side * side],
         }
     }
@@ -405,8 +407,8 @@ impl SegmentGrid {
         }
     }
 
-    fn add(&mut self, j: usize, [a, b]: [DVec2; 2]) {
-        let tol = self.tol;
+    /// Files segment `j` under every cell it passes within `tol` of.
+    fn add(&mut self, j: usize, [a, b]: [DVec2; 2], tol: f64) {
         let (y0, y1) = (a.y.min(b.y) - tol, a.y.max(b.y) + tol);
         for row in self.index(y0, 1)..=self.index(y1, 1) {
             // The part of the segment within `tol` of this row's band, in x.
@@ -438,7 +440,7 @@ impl SegmentGrid {
         }
     }
 
-    /// The segments that may pass within `tol` of `p`.
+    /// The segments that may pass within their distance of `p`, each once.
     fn near(&self, p: DVec2) -> &[usize] {
         &self.cells[self.index(p.y, 1) * self.side + self.index(p.x, 0)]
     }
@@ -497,20 +499,45 @@ fn split_along(mesh: &mut SurfaceMesh, jumps: &[[DVec2; 2]], lines: &[[DVec2; 2]
         d.perp_dot(p - a).abs() <= ON_SEGMENT_TOLERANCE * len.max(1.0)
             && (-1e-12..=1.0 + 1e-12).contains(&t)
     };
+    // The lines near a point, through grids: a floor may carry thousands.
+    let index = |lines: &[[DVec2; 2]]| {
+        let mut grid = SegmentGrid::new(mesh.local.iter().copied(), lines.len());
+        for (j, &[a, b]) in lines.iter().enumerate() {
+            let len = a.distance(b);
+            if len > 0.0 {
+                // As far off a line as `on_line` accepts, across and along.
+                let reach = ON_SEGMENT_TOLERANCE * len.max(1.0) / len + 1e-12 * len;
+                grid.add(j, [a, b], 2.0 * reach);
+            }
+        }
+        grid
+    };
+    let (jump_grid, line_grid) = (index(jumps), index(lines));
+    let jumps_at = |p: DVec2| {
+        jump_grid
+            .near(p)
+            .iter()
+            .map(|&j| jumps[j])
+            .filter(move |&l| on_line(p, l))
+    };
     let n = mesh.local.len();
     let touched: Vec<bool> = mesh
         .local
         .iter()
-        .map(|&p| jumps.iter().any(|&l| on_line(p, l)))
+        .map(|&p| jumps_at(p).next().is_some())
         .collect();
     let is_cut = |u: u32, v: u32| {
         let (p, q) = (mesh.local[u as usize], mesh.local[v as usize]);
-        jumps.iter().any(|&l| on_line(p, l) && on_line(q, l))
+        jumps_at(p).any(|l| on_line(q, l))
     };
     // A junction: the end of a jump, or a point a jump shares with another line.
     let is_junction = |p: DVec2| {
-        let ends_jump = jumps.iter().any(|&[a, b]| a == p || b == p);
-        let through = lines.iter().filter(|&&l| on_line(p, l)).count();
+        let ends_jump = jumps_at(p).any(|[a, b]| a == p || b == p);
+        let through = line_grid
+            .near(p)
+            .iter()
+            .filter(|&&j| on_line(p, lines[j]))
+            .count();
         ends_jump || through >= 2
     };
     let mut around: Vec<Vec<usize>> = vec![Vec::new(); n];

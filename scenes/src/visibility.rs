@@ -294,7 +294,33 @@ impl Visibility {
     }
 }
 
+/// Slices a shaft is cut into along its length for box queries.
+const SHAFT_SLICES: usize = 8;
+
 impl Visibility {
+    /// Calls `visit` with every triangle whose box overlaps the shaft from `apex` to the convex
+    /// polygon `base` (a triangle may come more than once). The shaft is queried as
+    /// [`SHAFT_SLICES`] boxes along its length, each around the slab between two cross-sections:
+    /// one box around a long shaft would hold most of a large scene.
+    pub fn triangles_overlapping_shaft(
+        &self,
+        apex: DVec3,
+        base: &[DVec3],
+        mut visit: impl FnMut(usize),
+    ) {
+        let section = |t: f64| base.iter().map(move |&p| apex.lerp(p, t));
+        for i in 0..SHAFT_SLICES {
+            let (t0, t1) = (
+                i as f64 / SHAFT_SLICES as f64,
+                (i + 1) as f64 / SHAFT_SLICES as f64,
+            );
+            let bounds = section(t0)
+                .chain(section(t1))
+                .fold(Bounds::EMPTY, Bounds::including);
+            self.triangles_overlapping(bounds, &mut visit);
+        }
+    }
+
     /// Whether some triangle whose box overlaps `bounds` satisfies `pred`; stops at the first.
     pub fn any_triangle_overlapping(
         &self,

@@ -64,11 +64,12 @@ impl Discretization {
         let mut receiver_surface = Vec::new();
         let mut elements = Vec::new();
         let mut patches = Vec::new();
+        let lift_limit = 1e-9 * scene.diagonal();
         for m in &mesh.surfaces {
             let offset = receivers.len();
             offsets.push(offset);
             let normal = m.frame.normal;
-            let lifts = hover_lifts(m, &mesh.hovering[m.surface], 1e-9 * scene.diagonal());
+            let lifts = hover_lifts(m, &mesh.hovering[m.surface], lift_limit);
             for ((p, inward), lift) in m.points3.iter().zip(m.interior_directions()).zip(lifts) {
                 receivers.push(ReceivingPoint {
                     point: *p + inward * lift,
