@@ -25,7 +25,7 @@ const BYTES_PER_POLYGON: u64 = 4 << 10;
 /// solver's per-vertex and per-element state.
 const BYTES_PER_TRIANGLE: u64 = 3 << 10;
 /// Per rendered pixel: colour, depth and surface buffers.
-const BYTES_PER_PIXEL: u64 = 48;
+const BYTES_PER_PIXEL: u64 = 64;
 
 /// How big a mesh is, for the estimate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -243,14 +243,14 @@ mod tests {
         };
         let best = largest_fitting_budget(&scene, &options, limit).expect("a mesh fits in 2 GiB");
         assert!(fits(best) && !fits(best * 11 / 10), "{best}");
-        // The dense matrix grows as the square of the patches: gathering fits far fewer
-        // elements than shooting.
+        // Gathering keeps every vertex-patch factor, which grows as the square of the mesh:
+        // it fits far fewer elements than shooting.
         let shooting = RunOptions {
             method: SolverMethod::Progressive,
             ..options.clone()
         };
         let most = largest_fitting_budget(&scene, &shooting, limit).expect("fits");
-        assert!(most > 20 * best, "{most} vs {best}");
+        assert!(most > 5 * best, "{most} vs {best}");
         assert_eq!(largest_fitting_budget(&scene, &options, 1 << 20), None);
     }
 }

@@ -2,6 +2,7 @@
 //! Each file is written to a temporary name in the output directory and renamed into place, so
 //! a reader never sees half a file.
 
+use rayon::prelude::*;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -325,23 +326,24 @@ fn report_solver_name(result: &RunResult) -> &'static str {
     }
 }
 
-/// Writes a set of files all or nothing, as far as the file system allows: every file goes to a
-/// temporary beside it first, and only when all are written are they renamed into place. If any
-/// fails, the temporaries are removed and the old files are left as they were.
-pub fn write_all_atomic(files: &[(PathBuf, Vec<u8>)]) -> anyhow::Result<()> {
-    use anyhow::Context;
-    // A directory in a file's place would fail its rename after others were done.
-    if let Some((path, _)) = files.iter().find(|(p, _)| p.is_dir()) {
-        anyhow::bail!("cannot write {}: a directory is in the way", path.display());
-    }
-    let mut staged: Vec<(PathBuf, &Path)> = Vec::with_capacity(files.len());
-    let cleanup = |staged: &[(PathBuf, &Path)]| {
-        for (tmp, _) in staged {
-            let _ = std::fs::remove_file(tmp);
+/// Files written all or nothing, as far as the file system allows: each is staged as a
+/// temporary beside its place, and only [`Staging::commit`] renames them into place. Dropped
+/// before that (a later file failed), it removes its temporaries and the old files stay as they
+/// were.
+#[derive(Debug, Default)]
+pub struct Staging {
+    /// (temporary, place) of every file staged.
+    staged: Vec<(PathBuf, PathBuf)>,
+}
+
+impl Staging {
+    pub fn stage(&mut self, path: PathBuf, bytes: &[u8]) -> anyhow::Result<()> {
+        use anyhow::Context;
+        // A directory in the file's place would fail its rename after others were done.
+        if path.is_dir() {
+            anyhow::bail!("cannot write {}: a directory is in the way", path.display());
         }
-    };
-    for (path, bytes) in files {
-        let tmp = temporary_beside(path);
+        let tmp = temporary_beside(&path);
         let written = (|| {
             let mut f = std::fs::File::create(&tmp)?;
             f.write_all(bytes)?;
@@ -349,22 +351,52 @@ pub fn write_all_atomic(files: &[(PathBuf, Vec<u8>)]) -> anyhow::Result<()> {
         })();
         if let Err(e) = written {
             let _ = std::fs::remove_file(&tmp);
-            cleanup(&staged);
             return Err(e).with_context(|| format!("cannot write {}", path.display()));
         }
-        staged.push((tmp, path));
+        self.staged.push((tmp, path));
+        Ok(())
     }
-    for (i, (tmp, path)) in staged.iter().enumerate() {
-        if let Err(e) = std::fs::rename(tmp, path) {
-            cleanup(&staged[i..]);
-            return Err(e).with_context(|| format!("cannot write {}", path.display()));
+
+    /// Renames every staged file into place; returns their places.
+    pub fn commit(mut self) -> anyhow::Result<Vec<PathBuf>> {
+        use anyhow::Context;
+        let staged = std::mem::take(&mut self.staged);
+        let mut places = Vec::with_capacity(staged.len());
+        for (i, (tmp, path)) in staged.iter().enumerate() {
+            if let Err(e) = std::fs::rename(tmp, path) {
+                // What was not renamed yet is dropped with the rest.
+                self.staged = staged[i..].to_vec();
+                return Err(e).with_context(|| format!("cannot write {}", path.display()));
+            }
+            places.push(path.clone());
         }
+        Ok(places)
     }
-    Ok(())
 }
 
+impl Drop for Staging {
+    fn drop(&mut self) {
+        for (tmp, _) in &self.staged {
+            let _ = std::fs::remove_file(tmp);
+        }
+    }
+}
+
+/// Writes a set of files all or nothing (see [`Staging`]).
+pub fn write_all_atomic(files: &[(PathBuf, Vec<u8>)]) -> anyhow::Result<()> {
+    let mut staging = Staging::default();
+    for (path, bytes) in files {
+        staging.stage(path.clone(), bytes)?;
+    }
+    staging.commit().map(|_| ())
+}
+
+/// Surface SVGs made at once, then written: a bound on the memory they hold (a scene may have
+/// tens of thousands of surfaces).
+const SVG_BATCH: usize = 256;
+
 /// Writes every output of a run into `dir` (created if needed), with `extra` files (name and
-/// bytes) beside them, all or nothing (see [`write_all_atomic`]); returns the paths written.
+/// bytes) beside them, all or nothing (see [`Staging`]); returns the paths written.
 pub fn write_outputs(
     result: &RunResult,
     dir: &Path,
@@ -375,32 +407,36 @@ pub fn write_outputs(
     let svg_dir = dir.join("surfaces");
     std::fs::create_dir_all(&svg_dir)
         .with_context(|| format!("cannot create {}", svg_dir.display()))?;
-    let png = penumbra_viz::encode_png(&result.render.image)?;
-    let mut files: Vec<(PathBuf, Vec<u8>)> = vec![
-        (
-            dir.join("solution.json"),
-            solution_json(result).into_bytes(),
-        ),
-        (dir.join("report.json"), report_json(result).into_bytes()),
-        (dir.join("render.png"), png),
-    ];
+    let mut staging = Staging::default();
+    staging.stage(dir.join("solution.json"), solution_json(result).as_bytes())?;
+    staging.stage(dir.join("report.json"), report_json(result).as_bytes())?;
+    staging.stage(
+        dir.join("render.png"),
+        &penumbra_viz::encode_png(&result.render.image)?,
+    )?;
     let scene = &result.loaded.scene;
-    for (i, (s, m)) in scene.surfaces.iter().zip(&result.mesh.surfaces).enumerate() {
-        let svg = penumbra_viz::surface_svg(
-            scene,
-            m,
-            Some(&result.solution.radiosity[i]),
-            &result.mesh.discontinuities[i],
-        );
-        files.push((svg_dir.join(svg_name(i, &s.name)), svg.into_bytes()));
+    let surfaces: Vec<usize> = (0..scene.surfaces.len()).collect();
+    for batch in surfaces.chunks(SVG_BATCH) {
+        let svgs: Vec<String> = batch
+            .par_iter()
+            .map(|&i| {
+                penumbra_viz::surface_svg(
+                    scene,
+                    &result.mesh.surfaces[i],
+                    Some(&result.solution.radiosity[i]),
+                    &result.mesh.discontinuities[i],
+                )
+            })
+            .collect();
+        for (&i, svg) in batch.iter().zip(svgs) {
+            let name = svg_name(i, &scene.surfaces[i].name);
+            staging.stage(svg_dir.join(name), svg.as_bytes())?;
+        }
     }
-    files.extend(
-        extra
-            .into_iter()
-            .map(|(name, bytes)| (dir.join(name), bytes)),
-    );
-    write_all_atomic(&files)?;
-    Ok(files.into_iter().map(|(p, _)| p).collect())
+    for (name, bytes) in extra {
+        staging.stage(dir.join(name), &bytes)?;
+    }
+    staging.commit()
 }
 
 #[cfg(test)]

@@ -168,7 +168,7 @@ impl ConstrainedSurface {
         surface: &Surface,
         target: usize,
         penumbra_density: f64,
-        varies: &dyn Fn(&[DVec3]) -> bool,
+        varies: &(dyn Fn(&[DVec3]) -> bool + Sync),
     ) -> SurfaceMesh {
         self.into_refinable(target, penumbra_density, varies)
             .mesh(surface)
@@ -180,7 +180,7 @@ impl ConstrainedSurface {
         self,
         target: usize,
         penumbra_density: f64,
-        varies: &dyn Fn(&[DVec3]) -> bool,
+        varies: &(dyn Fn(&[DVec3]) -> bool + Sync),
     ) -> RefinableSurface {
         let triangulation = if self.segments.is_empty() || penumbra_density <= 1.0 {
             self.triangulation

@@ -14,6 +14,7 @@
 //! thin penumbra at the foot of a blocker, cost more triangles than it saved error on the Cornell
 //! box's floor.)
 
+use rayon::prelude::*;
 use glam::{DVec2, DVec3};
 use spade::{PositionInTriangulation, Triangulation as _};
 
@@ -54,7 +55,7 @@ impl Density {
         triangulation: &SurfaceTriangulation,
         target: usize,
         factor: f64,
-        varies: &dyn Fn(&[DVec3]) -> bool,
+        varies: &(dyn Fn(&[DVec3]) -> bool + Sync),
     ) -> Density {
         let pilot_target = ((target as f64 * PILOT_SHARE) as usize).max(1);
         let pilot_area = triangulation.area_for(pilot_target);
@@ -68,21 +69,30 @@ impl Density {
         let coords = &triangulation.coords;
         let mut factors = vec![1.0; pilot.num_all_faces()];
         let factor = factor.max(1.0);
-        for face in pilot.inner_faces() {
-            let corners = face.positions().map(|p| DVec2::new(p.x, p.y));
-            let centroid = (corners[0] + corners[1] + corners[2]) / 3.0;
-            if !crate::planar::inside_polygon(centroid, &coords.boundary) {
-                continue;
-            }
-            let mut points = vec![to_3d(coords, centroid)];
-            points.extend(
-                corners
-                    .iter()
-                    .map(|&c| to_3d(coords, c.lerp(centroid, CORNER_PULL))),
-            );
-            if varies(&points) {
-                factors[face.fix().index()] = factor;
-            }
+        let probes: Vec<(usize, Vec<DVec3>)> = pilot
+            .inner_faces()
+            .filter_map(|face| {
+                let corners = face.positions().map(|p| DVec2::new(p.x, p.y));
+                let centroid = (corners[0] + corners[1] + corners[2]) / 3.0;
+                if !crate::planar::inside_polygon(centroid, &coords.boundary) {
+                    return None;
+                }
+                let mut points = vec![to_3d(coords, centroid)];
+                points.extend(
+                    corners
+                        .iter()
+                        .map(|&c| to_3d(coords, c.lerp(centroid, CORNER_PULL))),
+                );
+                Some((face.fix().index(), points))
+            })
+            .collect();
+        let marked: Vec<usize> = probes
+            .par_iter()
+            .filter(|(_, points)| varies(points))
+            .map(|&(face, _)| face)
+            .collect();
+        for face in marked {
+            factors[face] = factor;
         }
         Density {
             pilot,

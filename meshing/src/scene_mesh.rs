@@ -2,6 +2,8 @@
 
 use std::collections::BTreeSet;
 
+use rayon::prelude::*;
+
 use glam::DVec3;
 use penumbra_scenes::{PlaneFrame, Scene, SurfaceId, Visibility};
 
@@ -161,7 +163,7 @@ pub fn mesh_scene_discontinuity(
 ) -> Result<SceneMesh, MeshError> {
     let constrained = scene
         .surfaces
-        .iter()
+        .par_iter()
         .enumerate()
         .map(|(id, s)| {
             let segments = found.segments.get(id).map(Vec::as_slice).unwrap_or(&[]);
@@ -190,7 +192,7 @@ pub fn mesh_scene_discontinuity(
         .collect();
     let targets = spread_by_area(&areas, &minimum, max_elements)?;
     let refinable: Vec<RefinableSurface> = constrained
-        .into_iter()
+        .into_par_iter()
         .zip(targets)
         .enumerate()
         .map(|(id, (c, target))| {
@@ -222,7 +224,7 @@ pub fn mesh_scene_discontinuity(
         })
         .collect();
     let surfaces = refinable
-        .iter()
+        .par_iter()
         .zip(&scene.surfaces)
         .map(|(r, s)| r.mesh(s))
         .collect();

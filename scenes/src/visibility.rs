@@ -298,26 +298,27 @@ impl Visibility {
 const SHAFT_SLICES: usize = 8;
 
 impl Visibility {
-    /// Calls `visit` with every triangle whose box overlaps the shaft from `apex` to the convex
-    /// polygon `base` (a triangle may come more than once). The shaft is queried as
-    /// [`SHAFT_SLICES`] boxes along its length, each around the slab between two cross-sections:
-    /// one box around a long shaft would hold most of a large scene.
-    pub fn triangles_overlapping_shaft(
+    /// Calls `visit` with every triangle whose box overlaps the shaft between two boxes, the
+    /// convex hull of `from` and `to` (a triangle may come more than once). Every point of the
+    /// hull is `(1 - t) a + t b` for some `a` in `from`, `b` in `to`, so the boxes `(1 - t) from
+    /// + t to` over [`SHAFT_SLICES`] ranges of `t` cover it; one box around a long shaft would
+    /// hold most of a large scene.
+    pub fn triangles_overlapping_between(
         &self,
-        apex: DVec3,
-        base: &[DVec3],
+        from: Bounds,
+        to: Bounds,
         mut visit: impl FnMut(usize),
     ) {
-        let section = |t: f64| base.iter().map(move |&p| apex.lerp(p, t));
+        let section = |t: f64| Bounds {
+            min: from.min.lerp(to.min, t),
+            max: from.max.lerp(to.max, t),
+        };
         for i in 0..SHAFT_SLICES {
             let (t0, t1) = (
                 i as f64 / SHAFT_SLICES as f64,
                 (i + 1) as f64 / SHAFT_SLICES as f64,
             );
-            let bounds = section(t0)
-                .chain(section(t1))
-                .fold(Bounds::EMPTY, Bounds::including);
-            self.triangles_overlapping(bounds, &mut visit);
+            self.triangles_overlapping(section(t0).union(section(t1)), &mut visit);
         }
     }
 

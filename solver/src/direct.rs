@@ -14,7 +14,7 @@ use std::f64::consts::PI;
 
 use glam::{DVec2, DVec3};
 use penumbra_scenes::polygon::{is_convex_ccw, triangulate_ccw};
-use penumbra_scenes::{PlaneFrame, Rgb, Scene, SurfaceId, Visibility};
+use penumbra_scenes::{Bounds, PlaneFrame, Rgb, Scene, SurfaceId, Visibility};
 
 use crate::clip::{
     HalfPlane, area_2d, clip_polygon_3d, merge_close_vertices, subtract_convex,
@@ -232,10 +232,11 @@ impl<'a> DirectLight<'a> {
             .collect();
 
         let mut candidates = Vec::new();
-        self.visibility
-            .triangles_overlapping_shaft(x.point, front, |t| {
-                candidates.push(self.piece_of_triangle[t]);
-            });
+        self.visibility.triangles_overlapping_between(
+            Bounds::from_points([&x.point]),
+            Bounds::from_points(front),
+            |t| candidates.push(self.piece_of_triangle[t]),
+        );
         candidates.sort_unstable();
         candidates.dedup();
 

@@ -77,6 +77,9 @@ struct Transversal {
     receiver: DVec3,
 }
 
+/// Shafts with at most this many blockers test them one by one rather than query the BVH.
+const FEW_BLOCKERS: usize = 64;
+
 impl EeeSearch<'_> {
     /// The EEE curves of emitter edges `emitter_edges` with the blocker edges `edges` (welded
     /// vertex pairs) of the surfaces `blockers`, and what it took.
@@ -112,6 +115,16 @@ impl EeeSearch<'_> {
                 (s, ids)
             })
             .collect();
+        // A small receiver's shaft holds few blockers: their boxes are tested directly. The
+        // region beyond an edge can reach far along a receiver's plane (light grazing it), and
+        // the scene's triangles in its box would then be most of a large scene.
+        let few: Option<Vec<(SurfaceId, Bounds)>> = (blockers.len() <= FEW_BLOCKERS).then(|| {
+            blockers
+                .iter()
+                .map(|&s| (s, Bounds::from_points(t.loops[s].iter().map(|&v| &t.points[v]))))
+                .collect()
+        });
+        let mut near: Vec<SurfaceId> = Vec::new();
         // Surfaces and edges already taken for the current first edge, stamped to skip repeats.
         let mut surface_stamp = vec![usize::MAX; t.loops.len()];
         let mut edge_stamp = vec![usize::MAX; list.len()];
@@ -157,25 +170,41 @@ impl EeeSearch<'_> {
                         take(i, &mut partners);
                     }
                 }
-                self.visibility
-                    .triangles_overlapping(Bounds::from_points(corners.iter()), |k| {
-                        let s = self.visibility.triangles()[k].surface;
-                        if surface_stamp[s] == round {
-                            return;
-                        }
-                        surface_stamp[s] = round;
-                        let Some(ids) = along_surface.get(&s) else {
-                            return;
+                let region = Bounds::from_points(corners.iter());
+                near.clear();
+                match &few {
+                    Some(few) => {
+                        let padded = Bounds {
+                            min: region.min - self.tol,
+                            max: region.max + self.tol,
                         };
-                        polygon.clear();
-                        polygon.extend(t.loops[s].iter().map(|&v| t.points[v]));
-                        if outside(&polygon) {
-                            return;
+                        near.extend(
+                            few.iter()
+                                .filter(|(_, b)| b.overlaps(&padded))
+                                .map(|&(s, _)| s),
+                        );
+                    }
+                    None => self.visibility.triangles_overlapping(region, |k| {
+                        let s = self.visibility.triangles()[k].surface;
+                        if surface_stamp[s] != round {
+                            surface_stamp[s] = round;
+                            near.push(s);
                         }
-                        for &i in ids {
-                            take(i, &mut partners);
-                        }
-                    });
+                    }),
+                }
+                for &s in &near {
+                    let Some(ids) = along_surface.get(&s) else {
+                        continue;
+                    };
+                    polygon.clear();
+                    polygon.extend(t.loops[s].iter().map(|&v| t.points[v]));
+                    if outside(&polygon) {
+                        continue;
+                    }
+                    for &i in ids {
+                        take(i, &mut partners);
+                    }
+                }
                 partners.sort_unstable();
                 for &i2 in &partners {
                     let second = list[i2];

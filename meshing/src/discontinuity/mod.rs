@@ -165,7 +165,7 @@ pub fn find_discontinuities(
             let shaft = hull::hull_planes(&ends, tol);
             let blockers = shaft_blockers(
                 visibility,
-                emitter.bounds().union(receiver.bounds()),
+                [emitter.bounds(), receiver.bounds()],
                 e,
                 r,
                 |s| {
@@ -353,11 +353,12 @@ pub fn find_discontinuities(
 
     // Contact lines, for every receiver that something touches.
     let mut hovering = vec![Vec::new(); scene.surfaces.len()];
+    let emitters: Vec<SurfaceId> = scene.emitters().map(|(e, _)| e).collect();
     for (r, contacts) in contact::contact_lines(scene, &frames, visibility) {
         stats.contact_segments += contacts.len();
         hovering[r].extend(contacts.iter().copied().filter(|c| c.2 > 0.0));
         for (from, to, _) in contacts {
-            for (e, _) in scene.emitters() {
+            for &e in &emitters {
                 raw[r].push(DiscontinuitySegment {
                     surface: r,
                     emitter: e,
@@ -403,16 +404,17 @@ pub fn find_discontinuities(
     }
 }
 
-/// Surfaces other than `e` and `r` with a triangle in `bounds` for which `keep` holds, sorted.
+/// Surfaces other than `e` and `r` with a triangle in the shaft between two boxes for which
+/// `keep` holds, sorted.
 fn shaft_blockers(
     visibility: &Visibility,
-    bounds: Bounds,
+    [from, to]: [Bounds; 2],
     e: SurfaceId,
     r: SurfaceId,
     keep: impl Fn(SurfaceId) -> bool,
 ) -> Vec<SurfaceId> {
     let mut found = BTreeSet::new();
-    visibility.triangles_overlapping(bounds, |t| {
+    visibility.triangles_overlapping_between(from, to, |t| {
         let s = visibility.triangles()[t].surface;
         if s != e && s != r {
             found.insert(s);
