@@ -539,6 +539,7 @@ fn box_factors(config: &MethodConfig, rays: usize) -> Result<BoxRow, StudyError>
         rays,
         seed: 3,
         method: config.method,
+        interrupt: None,
     }
     .columns(&NoProgress)?;
     let f = disc.patch_factors(&columns);

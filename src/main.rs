@@ -693,7 +693,20 @@ fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
         memory_limit: args.memory_limit.map(|mib| (mib * 1024.0 * 1024.0) as u64),
     };
     let bars = Bars::new(args.quiet);
-    let result = penumbra::run(loaded, &options, &bars).map_err(run_failure)?;
+    // The conventional status of a process ended by a signal: 130 for SIGINT, 143 for SIGTERM.
+    let signal_status = || ExitCode::from(128 + received.load(Ordering::Relaxed).min(127) as u8);
+    let result = match penumbra::run(loaded, &options, &bars) {
+        Ok(result) => result,
+        Err(penumbra::RunError::Solve(penumbra_solver::SolveError::Interrupted)) => {
+            drop(bars);
+            eprintln!(
+                "interrupted before a solution existed: nothing written, {} left as it was",
+                args.out.display()
+            );
+            return Ok(signal_status());
+        }
+        Err(e) => return Err(run_failure(e)),
+    };
     let extra = if args.convergence {
         penumbra::outputs::convergence_files(&result)?
     } else {
@@ -723,14 +736,11 @@ fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
         println!("wrote {} files to {}", written.len(), args.out.display());
     }
     if interrupt.is_set() {
-        // The conventional status of a process ended by the signal: 130 for SIGINT, 143 for
-        // SIGTERM.
-        let signal = received.load(Ordering::Relaxed);
         eprintln!(
             "interrupted: wrote the solution so far to {}, marked partial in report.json",
             args.out.display()
         );
-        return Ok(ExitCode::from(128 + signal.min(127) as u8));
+        return Ok(signal_status());
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -65,7 +65,11 @@ impl MeshCounts {
             patches: mesh
                 .surfaces
                 .iter()
-                .map(|m| m.triangle_count().div_ceil(elements_per_patch.max(1)).max(1) as u64)
+                .map(|m| {
+                    m.triangle_count()
+                        .div_ceil(elements_per_patch.max(1))
+                        .max(1) as u64
+                })
                 .sum(),
         }
     }
@@ -181,13 +185,21 @@ pub fn available_bytes() -> Option<u64> {
 
 /// The most memory this process has held so far (its peak resident set), if the system says.
 pub fn peak_resident_bytes() -> Option<u64> {
-    kib_field(&std::fs::read_to_string("/proc/self/status").ok()?, "VmHWM:")
+    kib_field(
+        &std::fs::read_to_string("/proc/self/status").ok()?,
+        "VmHWM:",
+    )
 }
 
 /// A `NAME: <n> kB` line of a /proc file, in bytes.
 fn kib_field(text: &str, name: &str) -> Option<u64> {
     let line = text.lines().find(|l| l.starts_with(name))?;
-    let kib: u64 = line[name.len()..].trim().trim_end_matches("kB").trim().parse().ok()?;
+    let kib: u64 = line[name.len()..]
+        .trim()
+        .trim_end_matches("kB")
+        .trim()
+        .parse()
+        .ok()?;
     kib.checked_mul(1024)
 }
 

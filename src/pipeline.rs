@@ -147,7 +147,9 @@ fn memory_message(needed: &u64, limit: &u64, suggestion: &Option<usize>) -> Stri
         memory::human(*limit)
     );
     match suggestion {
-        Some(n) => format!("{head}; use --max-elements {n} or fewer (or --memory-limit, if more is free)"),
+        Some(n) => {
+            format!("{head}; use --max-elements {n} or fewer (or --memory-limit, if more is free)")
+        }
         None => format!(
             "{head}; even the coarsest mesh of this scene does not fit (options: --direct-only, \
              --solver progressive, smaller --width/--height, or a machine with more memory)"
@@ -220,6 +222,13 @@ pub fn run(
         options.solver.elements_per_patch,
     ))?;
 
+    // Before a solution exists an interrupt ends the run between stages (and within the
+    // direct light and form factors), with nothing to write.
+    let interrupted = || match &options.solver.interrupt {
+        Some(i) if i.is_set() => Err(RunError::Solve(SolveError::Interrupted)),
+        _ => Ok(()),
+    };
+
     let t = Instant::now();
     let visibility = Visibility::build(scene);
     times.visibility = t.elapsed().as_secs_f64();
@@ -236,6 +245,7 @@ pub fn run(
     };
     times.discontinuities = t.elapsed().as_secs_f64();
     peaks.discontinuities = memory::peak_resident_bytes();
+    interrupted()?;
 
     let t = Instant::now();
     progress.start("meshing", 1);
@@ -251,6 +261,7 @@ pub fn run(
     progress.finish();
     times.mesh = t.elapsed().as_secs_f64();
     peaks.mesh = memory::peak_resident_bytes();
+    interrupted()?;
 
     // Again with the real counts, before the solver allocates; the column cache gets what is
     // left.

@@ -671,3 +671,87 @@ fn interrupted_runs_write_their_partial_solution() {
     run_quietly("textbook", &out, &["--max-elements", "500"]);
     assert_eq!(json(&out.join("report.json"))["partial"], false);
 }
+
+/// A signal before any solution exists (while the discontinuities, the mesh or the direct light
+/// of a large scene are computed) ends the run with the signal's status and writes nothing: the
+/// old contents of `--out` stay.
+#[test]
+fn runs_interrupted_before_a_solution_leave_the_output_alone() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("out");
+    std::fs::create_dir(&out).expect("mkdir");
+    std::fs::write(out.join("report.json"), b"old").expect("writes");
+    // Finding and meshing the shadows of 3,000 boxes takes seconds; the signal comes at one.
+    let child = Command::new(env!("CARGO_BIN_EXE_penumbra"))
+        .args(["run", "boxworld-3000", "--max-elements", "200000"])
+        .args(["--quiet", "--out", out.to_str().expect("utf-8")])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("the penumbra binary runs");
+    std::thread::sleep(std::time::Duration::from_secs(1));
+    let sent = Command::new("kill")
+        .args(["-INT".to_owned(), child.id().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(sent.success());
+    let o = child.wait_with_output().expect("the run ends");
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(130), "{stderr}");
+    assert!(stderr.contains("before a solution existed"), "{stderr}");
+    let left: Vec<_> = std::fs::read_dir(&out)
+        .expect("readable")
+        .map(|e| e.expect("entry").file_name())
+        .collect();
+    assert_eq!(left, vec![std::ffi::OsString::from("report.json")]);
+    assert_eq!(
+        std::fs::read(out.join("report.json")).expect("reads"),
+        b"old"
+    );
+}
+
+/// A run that would need more memory than it may use stops before it starts (exit 2), and
+/// names a --max-elements that fits; with that budget the same limit is enough, and the peak
+/// the run reports stays under it.
+#[test]
+fn runs_too_large_for_memory_are_refused_with_a_budget_that_fits() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("out");
+    let o = penumbra(&["run", "cornell", "--memory-limit", "60", "--quiet"]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    let suggested: usize = stderr
+        .split("--max-elements ")
+        .nth(1)
+        .and_then(|rest| rest.split_whitespace().next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no --max-elements in: {stderr}"));
+    assert!((500..10_000).contains(&suggested), "{suggested}");
+    assert!(!out.exists());
+    let budget = suggested.to_string();
+    run_quietly(
+        "cornell",
+        &out,
+        &["--memory-limit", "60", "--max-elements", &budget],
+    );
+    let report = json(&out.join("report.json"));
+    let memory = &report["memory"];
+    assert_eq!(memory["limit_bytes"], 60 << 20);
+    let estimate = memory["estimate_bytes"].as_u64().expect("bytes");
+    assert!(estimate <= 60 << 20, "{estimate}");
+    if let Some(peak) = memory["peak_bytes"]["render"].as_u64() {
+        assert!(peak <= estimate, "peak {peak} over the estimate {estimate}");
+    }
+    // Far beyond any machine: a dense gathering matrix of a hundred million elements.
+    let o = penumbra(&[
+        "run",
+        "cornell",
+        "--solver",
+        "gauss-seidel",
+        "--max-elements",
+        "100000000",
+        "--quiet",
+    ]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("TiB"), "{stderr}");
+}

@@ -14,8 +14,8 @@
 //! thin penumbra at the foot of a blocker, cost more triangles than it saved error on the Cornell
 //! box's floor.)
 
-use rayon::prelude::*;
 use glam::{DVec2, DVec3};
+use rayon::prelude::*;
 use spade::{PositionInTriangulation, Triangulation as _};
 
 use crate::uniform::{Cdt, MeshCoordinates, SurfaceTriangulation};

@@ -465,7 +465,13 @@ mod tests {
         assert_eq!(scene.surfaces.len(), 2 + 5 * 7);
         assert_eq!(scene.name, "boxworld-7");
         assert_eq!(builtin("boxworld-100"), Some(boxworld(100, 1)));
-        for bad in ["boxworld-", "boxworld-0", "boxworld--3", "boxworld-+3", "boxworld-1000001"] {
+        for bad in [
+            "boxworld-",
+            "boxworld-0",
+            "boxworld--3",
+            "boxworld-+3",
+            "boxworld-1000001",
+        ] {
             assert_eq!(builtin(bad), None, "{bad}");
         }
     }

@@ -300,9 +300,9 @@ const SHAFT_SLICES: usize = 8;
 impl Visibility {
     /// Calls `visit` with every triangle whose box overlaps the shaft between two boxes, the
     /// convex hull of `from` and `to` (a triangle may come more than once). Every point of the
-    /// hull is `(1 - t) a + t b` for some `a` in `from`, `b` in `to`, so the boxes `(1 - t) from
-    /// + t to` over [`SHAFT_SLICES`] ranges of `t` cover it; one box around a long shaft would
-    /// hold most of a large scene.
+    /// hull is `(1 - t) a + t b` for some `a` in `from` and `b` in `to`, so the boxes between
+    /// the sections at the ends of [`SHAFT_SLICES`] ranges of `t` cover it; one box around a
+    /// long shaft would hold most of a large scene.
     pub fn triangles_overlapping_between(
         &self,
         from: Bounds,

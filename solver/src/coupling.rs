@@ -17,6 +17,7 @@ use crate::error::SolveError;
 use crate::hemicube::{Hemicube, OCCLUDER};
 use crate::lambert::{ReceivingPoint, edge_term, form_factor};
 use crate::progress::Progress;
+use crate::progressive::Interrupt;
 use penumbra_scenes::rng::SplitMix64;
 
 /// How point-to-patch form factors are computed.
@@ -221,6 +222,8 @@ pub struct PatchCoupling<'a> {
     pub rays: usize,
     pub seed: u64,
     pub method: FormFactorMethod,
+    /// Computing columns stops early, with [`SolveError::Interrupted`], once this is set.
+    pub interrupt: Option<Interrupt>,
 }
 
 impl<'a> PatchCoupling<'a> {
@@ -236,7 +239,12 @@ impl<'a> PatchCoupling<'a> {
             rays: options.visibility_rays,
             seed: options.seed,
             method: options.form_factors,
+            interrupt: options.interrupt.clone(),
         }
+    }
+
+    fn interrupted(&self) -> bool {
+        self.interrupt.as_ref().is_some_and(Interrupt::is_set)
     }
 
     fn coupler(&self) -> Coupler<'_> {
@@ -280,6 +288,9 @@ impl<'a> PatchCoupling<'a> {
             .into_par_iter()
             .map(|q| {
                 let mut rays = 0u64;
+                if self.interrupted() {
+                    return (Vec::new(), rays);
+                }
                 let column = (0..n)
                     .filter_map(|v| {
                         let (f, r) = self.coupling(v, q);
@@ -292,6 +303,9 @@ impl<'a> PatchCoupling<'a> {
             })
             .collect();
         progress.finish();
+        if self.interrupted() {
+            return Err(SolveError::Interrupted);
+        }
         let rays = computed.iter().map(|c| c.1).sum();
         Ok((computed.into_iter().map(|c| c.0).collect(), rays))
     }
@@ -312,6 +326,9 @@ impl<'a> PatchCoupling<'a> {
             .map_init(
                 || (template.clone(), vec![0.0; patches]),
                 |(cube, row), v| {
+                    if self.interrupted() {
+                        return Vec::new();
+                    }
                     row.fill(0.0);
                     hemicube_row(
                         cube,
@@ -331,6 +348,9 @@ impl<'a> PatchCoupling<'a> {
             )
             .collect();
         progress.finish();
+        if self.interrupted() {
+            return Err(SolveError::Interrupted);
+        }
         let mut columns = vec![Vec::new(); patches];
         for (v, row) in rows.into_iter().enumerate() {
             for (q, f) in row {

@@ -14,4 +14,6 @@ pub enum SolveError {
         "the radiosity system is singular (a closed scene with reflectance 1 has no steady state)"
     )]
     Singular,
+    #[error("interrupted before a solution existed")]
+    Interrupted,
 }

@@ -218,27 +218,34 @@ pub fn direct_irradiance(
     scene: &Scene,
     disc: &Discretization,
     visibility: &Visibility,
+    interrupt: Option<&Interrupt>,
     progress: &dyn Progress,
-) -> Vec<Rgb> {
+) -> Result<Vec<Rgb>, SolveError> {
     let direct = DirectLight::new(scene, visibility);
     let all: Vec<usize> = (0..disc.receiver_count()).collect();
-    irradiance_at(&all, "direct light", progress, |v| {
+    irradiance_at(&all, "direct light", interrupt, progress, |v| {
         direct.irradiance(&disc.receivers[v], disc.receiver_surface[v])
     })
 }
 
-/// `f` at each of `receivers`, in parallel, with a progress bar.
+/// `f` at each of `receivers`, in parallel, with a progress bar; stops early, with
+/// [`SolveError::Interrupted`], once `interrupt` is set.
 fn irradiance_at(
     receivers: &[usize],
     stage: &str,
+    interrupt: Option<&Interrupt>,
     progress: &dyn Progress,
     f: impl Fn(usize) -> Rgb + Sync,
-) -> Vec<Rgb> {
+) -> Result<Vec<Rgb>, SolveError> {
+    let interrupted = || interrupt.is_some_and(Interrupt::is_set);
     progress.start(stage, receivers.len() as u64);
     let done = std::sync::atomic::AtomicU64::new(0);
     let out = receivers
         .par_iter()
         .map(|&v| {
+            if interrupted() {
+                return Rgb::ZERO;
+            }
             let h = f(v);
             let d = done.fetch_add(1, Ordering::Relaxed);
             if d.is_multiple_of(256) {
@@ -248,7 +255,10 @@ fn irradiance_at(
         })
         .collect();
     progress.finish();
-    out
+    if interrupted() {
+        return Err(SolveError::Interrupted);
+    }
+    Ok(out)
 }
 
 /// Solves a meshed scene by progressive refinement.
@@ -320,7 +330,13 @@ impl<'a> ProgressiveSolver<'a> {
         check_mesh(scene, mesh)?;
         let disc = Discretization::new(scene, mesh, options.elements_per_patch);
         let started = Instant::now();
-        let direct_irradiance = direct_irradiance(scene, &disc, visibility, progress);
+        let direct_irradiance = direct_irradiance(
+            scene,
+            &disc,
+            visibility,
+            options.interrupt.as_ref(),
+            progress,
+        )?;
         let direct_seconds = started.elapsed().as_secs_f64();
         let received = disc.integrate(&direct_irradiance, |_| Rgb::splat(1.0));
         // Methods that give whole rows compute every form factor up front.
@@ -621,21 +637,23 @@ impl<'a> ProgressiveSolver<'a> {
             }
         }
         let t = Instant::now();
-        let new_direct = irradiance_at(&fresh, "direct light", progress, |v| {
+        // Remeshing runs to its end: the refinement loop checks for interrupts between rounds,
+        // and stopping here would lose the solution it has.
+        let new_direct = irradiance_at(&fresh, "direct light", None, progress, |v| {
             self.direct
                 .irradiance(&disc.receivers[v], disc.receiver_surface[v])
-        });
+        })?;
         self.direct_seconds += t.elapsed().as_secs_f64();
         let t = Instant::now();
         let rays = std::sync::atomic::AtomicU64::new(0);
         let gathered = if self.shooters.is_empty() {
             vec![Rgb::ZERO; fresh.len()]
         } else {
-            irradiance_at(&fresh, "gathering", progress, |v| {
+            irradiance_at(&fresh, "gathering", None, progress, |v| {
                 let (h, r) = self.gather(&disc.receivers[v], disc.receiver_surface[v], v as u64);
                 rays.fetch_add(r, Ordering::Relaxed);
                 h
-            })
+            })?
         };
         self.gather_seconds += t.elapsed().as_secs_f64();
         self.rays_cast += rays.into_inner();

@@ -15,6 +15,7 @@ fn unoccluded_coupling<'a>(disc: &'a Discretization, vis: &'a Visibility) -> Pat
         rays: 4,
         seed: 1,
         method: Default::default(),
+        interrupt: None,
     }
 }
 
@@ -209,6 +210,7 @@ fn monte_carlo_form_factors_match_the_closed_forms() {
         rays: 16,
         seed: 3,
         method,
+        interrupt: None,
     };
     let monte_carlo = patch_matrix(
         &disc,
@@ -249,6 +251,7 @@ fn patch_matrix_of(
         rays: 16,
         seed: 3,
         method,
+        interrupt: None,
     }
     .columns(&NoProgress)
     .expect("valid method");

@@ -121,7 +121,12 @@ impl EeeSearch<'_> {
         let few: Option<Vec<(SurfaceId, Bounds)>> = (blockers.len() <= FEW_BLOCKERS).then(|| {
             blockers
                 .iter()
-                .map(|&s| (s, Bounds::from_points(t.loops[s].iter().map(|&v| &t.points[v]))))
+                .map(|&s| {
+                    (
+                        s,
+                        Bounds::from_points(t.loops[s].iter().map(|&v| &t.points[v])),
+                    )
+                })
                 .collect()
         });
         let mut near: Vec<SurfaceId> = Vec::new();
