@@ -91,13 +91,7 @@ impl PatchSystem {
     ) -> Result<PatchSystem, SolveError> {
         let disc = Discretization::new(scene, mesh, options.elements_per_patch);
         let started = Instant::now();
-        let direct = direct_irradiance(
-            scene,
-            &disc,
-            visibility,
-            options.interrupt.as_ref(),
-            progress,
-        )?;
+        let direct = direct_irradiance(scene, &disc, visibility, options, progress)?;
         let direct_seconds = started.elapsed().as_secs_f64();
         let started = Instant::now();
         let n = disc.receiver_count();

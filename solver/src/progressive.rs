@@ -213,16 +213,18 @@ pub struct Solution {
     pub convergence: Vec<ConvergencePoint>,
 }
 
-/// Direct irradiance at every vertex from the exact evaluator.
+/// Direct irradiance at every vertex from the exact evaluator; stops early, with
+/// [`SolveError::Interrupted`], once `options.interrupt` is set.
 pub fn direct_irradiance(
     scene: &Scene,
     disc: &Discretization,
     visibility: &Visibility,
-    interrupt: Option<&Interrupt>,
+    options: &SolverOptions,
     progress: &dyn Progress,
 ) -> Result<Vec<Rgb>, SolveError> {
     let direct = DirectLight::new(scene, visibility);
     let all: Vec<usize> = (0..disc.receiver_count()).collect();
+    let interrupt = options.interrupt.as_ref();
     irradiance_at(&all, "direct light", interrupt, progress, |v| {
         direct.irradiance(&disc.receivers[v], disc.receiver_surface[v])
     })
@@ -330,13 +332,7 @@ impl<'a> ProgressiveSolver<'a> {
         check_mesh(scene, mesh)?;
         let disc = Discretization::new(scene, mesh, options.elements_per_patch);
         let started = Instant::now();
-        let direct_irradiance = direct_irradiance(
-            scene,
-            &disc,
-            visibility,
-            options.interrupt.as_ref(),
-            progress,
-        )?;
+        let direct_irradiance = direct_irradiance(scene, &disc, visibility, options, progress)?;
         let direct_seconds = started.elapsed().as_secs_f64();
         let received = disc.integrate(&direct_irradiance, |_| Rgb::splat(1.0));
         // Methods that give whole rows compute every form factor up front.
