@@ -23,7 +23,7 @@ const BASE_BYTES: u64 = 32 << 20;
 const BYTES_PER_POLYGON: u64 = 4 << 10;
 /// Per mesh triangle, with its share of vertices: the constrained triangulation, the mesh, the
 /// solver's per-vertex and per-element state.
-const BYTES_PER_TRIANGLE: u64 = 3 << 10;
+const BYTES_PER_TRIANGLE: u64 = 2 << 10;
 /// Per rendered pixel: colour, depth and surface buffers.
 const BYTES_PER_PIXEL: u64 = 64;
 
