@@ -216,7 +216,7 @@ pub fn run(
             _ => Ok(estimate),
         }
     };
-    check(MeshCounts::predicted(
+    let planned = check(MeshCounts::predicted(
         scene,
         options.max_elements,
         options.solver.elements_per_patch,
@@ -265,10 +265,15 @@ pub fn run(
 
     // Again with the real counts, before the solver allocates; the column cache gets what is
     // left.
-    let estimate = check(MeshCounts::of_mesh(
+    let built = check(MeshCounts::of_mesh(
         &mesh,
         options.solver.elements_per_patch,
     ))?;
+    // Adaptive refinement grows the mesh up to the budget: the plan still holds for it.
+    let estimate = match options.refine {
+        Some(_) if planned.total() > built.total() => planned,
+        _ => built,
+    };
     let solver = SolverOptions {
         cache_bytes: limit.map_or(solver.cache_bytes, |limit| {
             memory::cache_bytes(solver.cache_bytes, estimate.total(), limit)
