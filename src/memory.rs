@@ -5,7 +5,7 @@
 //! estimate is checked twice: from the scene and the budget before anything is built, then from
 //! the mesh's real counts before the solver allocates its form factors.
 //!
-//! The per-item costs are measured peaks (README, "Memory"), rounded up; the form-factor terms
+//! The per-item costs are measured peaks (README, "Large scenes"), rounded up; the form-factor terms
 //! are upper bounds from the data structures (every vertex seeing every patch).
 
 use penumbra_meshing::SceneMesh;
@@ -36,7 +36,7 @@ pub struct MeshCounts {
 }
 
 impl MeshCounts {
-    /// What a mesh of `max_elements` triangles over `scene` will about be, before it is built:
+    /// Roughly the mesh of `max_elements` triangles over `scene`, before it is built:
     /// every polygon gets at least its own triangles, and split vertices along contact lines
     /// can make vertices outnumber triangles.
     pub fn predicted(scene: &Scene, max_elements: usize, elements_per_patch: usize) -> MeshCounts {
@@ -53,9 +53,7 @@ impl MeshCounts {
             patches: triangles / elements_per_patch.max(1) as u64 + polygons,
         }
     }
-}
 
-impl MeshCounts {
     /// The counts of a built mesh; patches as the solver groups triangles, before the rare
     /// extra patches where a group falls apart along a contact line.
     pub fn of_mesh(mesh: &SceneMesh, elements_per_patch: usize) -> MeshCounts {
