@@ -5,8 +5,8 @@
 //! estimate is checked twice: from the scene and the budget before anything is built, then from
 //! the mesh's real counts before the solver allocates its form factors.
 //!
-//! The per-item costs are measured peaks (README, "Large scenes"), rounded up; the form-factor terms
-//! are upper bounds from the data structures (every vertex seeing every patch).
+//! The per-item costs are measured peaks (README, "Large scenes"), rounded up; the form-factor
+//! terms are upper bounds from the data structures (every vertex seeing every patch).
 
 use penumbra_meshing::SceneMesh;
 use penumbra_scenes::Scene;
