@@ -2,9 +2,10 @@
 //! Each file is written to a temporary name in the output directory and renamed into place, so
 //! a reader never sees half a file.
 
-use rayon::prelude::*;
 use std::io::Write;
 use std::path::{Path, PathBuf};
+
+use rayon::prelude::*;
 
 use penumbra_meshing::MeshQuality;
 use penumbra_scenes::Rgb;
