@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use crate::adaptive::{RefineOptions, RefineReport, refine_adaptively};
 use crate::memory::{self, MeshCounts};
-use penumbra_meshing::discontinuity::{DiscontinuityOptions, find_discontinuities};
+use penumbra_meshing::discontinuity::{DiscontinuityOptions, find_discontinuities_reporting};
 use penumbra_meshing::grading::DEFAULT_PENUMBRA_DENSITY;
 use penumbra_meshing::{MeshError, SceneMesh, mesh_scene_discontinuity, mesh_scene_uniform};
 use penumbra_scenes::{LoadedScene, Rgb, Visibility};
@@ -237,10 +237,15 @@ pub fn run(
     let t = Instant::now();
     let found = match options.mesh {
         MeshMethod::Uniform => None,
-        MeshMethod::Discontinuity | MeshMethod::Auto => Some(find_discontinuities(
+        MeshMethod::Discontinuity | MeshMethod::Auto => Some(find_discontinuities_reporting(
             scene,
             &visibility,
-            &options.discontinuity,
+            &DiscontinuityOptions {
+                deadline: solver.deadline,
+                interrupt: options.solver.interrupt.clone(),
+                ..options.discontinuity.clone()
+            },
+            progress,
         )),
     };
     times.discontinuities = t.elapsed().as_secs_f64();

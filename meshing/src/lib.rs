@@ -19,6 +19,7 @@ pub mod grading;
 pub mod locate;
 pub mod mesh;
 pub mod planar;
+pub mod progress;
 pub mod scene_mesh;
 pub mod uniform;
 

@@ -18,8 +18,7 @@
 //! sum is taken in a fixed order.
 
 use std::collections::HashMap;
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::Ordering;
 use std::time::Instant;
 
 use penumbra_meshing::locate::{TriangleLocator, transfer_density};
@@ -33,6 +32,7 @@ use crate::direct::DirectLight;
 use crate::elements::{Discretization, Patch};
 use crate::error::SolveError;
 use crate::lambert::ReceivingPoint;
+pub use crate::progress::Interrupt;
 use crate::progress::Progress;
 
 /// Options of the progressive solver; every field is checked by [`SolverOptions::validate`].
@@ -111,33 +111,6 @@ impl SolverOptions {
             crate::hemicube::Hemicube::new(resolution)?;
         }
         Ok(())
-    }
-}
-
-/// A flag that asks long work to stop, shared by its clones; a signal handler sets it through
-/// [`Interrupt::flag`].
-#[derive(Clone, Debug, Default)]
-pub struct Interrupt(Arc<AtomicBool>);
-
-impl Interrupt {
-    /// The flag itself, for a signal handler to set.
-    pub fn flag(&self) -> Arc<AtomicBool> {
-        Arc::clone(&self.0)
-    }
-
-    pub fn set(&self) {
-        self.0.store(true, Ordering::Relaxed);
-    }
-
-    pub fn is_set(&self) -> bool {
-        self.0.load(Ordering::Relaxed)
-    }
-}
-
-/// Two interrupts are the same when they share their flag.
-impl PartialEq for Interrupt {
-    fn eq(&self, other: &Self) -> bool {
-        Arc::ptr_eq(&self.0, &other.0)
     }
 }
 

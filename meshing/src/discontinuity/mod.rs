@@ -12,19 +12,22 @@ pub mod contact;
 pub mod eee;
 pub mod hull;
 pub mod merge;
+mod shaft;
 pub mod topology;
 pub mod trim;
 pub mod wedge;
 
-use std::collections::BTreeSet;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
 use glam::{DVec2, DVec3};
-use penumbra_scenes::{Bounds, PlaneFrame, Scene, SurfaceId, Visibility};
+use penumbra_scenes::{PlaneFrame, Scene, SurfaceId, Visibility};
+use rayon::prelude::*;
 use serde::Serialize;
 
+use crate::progress::{Interrupt, NoProgress, Progress};
 use merge::{FlatSegment, merge_collinear};
-use topology::Topology;
+use shaft::{PairEvents, SearchContext};
 pub use wedge::{Event, Wedge};
 
 /// What a discontinuity line bounds.
@@ -72,6 +75,17 @@ pub struct DiscontinuityOptions {
     pub eee: bool,
     /// EEE curves become polylines within this fraction of the receiver's diameter.
     pub eee_tolerance: f64,
+    /// When to stop starting new emitter–receiver pairs (a run's time budget).
+    pub deadline: Option<Instant>,
+    /// Stops the search early when set (Ctrl-C).
+    pub interrupt: Option<Interrupt>,
+}
+
+impl DiscontinuityOptions {
+    fn should_stop(&self) -> bool {
+        self.interrupt.as_ref().is_some_and(Interrupt::is_set)
+            || self.deadline.is_some_and(|d| Instant::now() >= d)
+    }
 }
 
 impl Default for DiscontinuityOptions {
@@ -81,6 +95,8 @@ impl Default for DiscontinuityOptions {
             trim_tolerance: 1e-9,
             eee: true,
             eee_tolerance: 1e-4,
+            deadline: None,
+            interrupt: None,
         }
     }
 }
@@ -92,6 +108,9 @@ pub struct DiscontinuityStats {
     pub pairs: usize,
     /// Pairs whose shaft holds no blocker: nothing to do for them.
     pub pairs_without_blockers: usize,
+    /// Pairs not searched because the time budget ran out or the run was interrupted: their
+    /// receivers lack those pairs' events.
+    pub pairs_skipped: usize,
     /// Blocker surfaces found in shafts, summed over pairs.
     pub blockers_in_shafts: usize,
     /// Feature pairs that could form a wedge (in front of both emitter and receiver).
@@ -115,6 +134,25 @@ pub struct DiscontinuityStats {
     pub seconds: f64,
 }
 
+impl DiscontinuityStats {
+    /// Adds the counts of another part of the search (times excepted).
+    fn add(&mut self, other: &DiscontinuityStats) {
+        self.pairs += other.pairs;
+        self.pairs_without_blockers += other.pairs_without_blockers;
+        self.pairs_skipped += other.pairs_skipped;
+        self.blockers_in_shafts += other.blockers_in_shafts;
+        self.wedges_considered += other.wedges_considered;
+        self.wedges_culled += other.wedges_culled;
+        self.wedges_kept += other.wedges_kept;
+        self.segments_trimmed += other.segments_trimmed;
+        self.segments_hidden += other.segments_hidden;
+        self.contact_segments += other.contact_segments;
+        self.eee_considered += other.eee_considered;
+        self.eee_events += other.eee_events;
+        self.segments += other.segments;
+    }
+}
+
 /// Every receiver's discontinuity segments (indexed by surface), and the figures of the search.
 #[derive(Clone, Debug, Default)]
 pub struct Discontinuities {
@@ -131,230 +169,54 @@ pub fn find_discontinuities(
     visibility: &Visibility,
     options: &DiscontinuityOptions,
 ) -> Discontinuities {
+    find_discontinuities_reporting(scene, visibility, options, &NoProgress)
+}
+
+/// [`find_discontinuities`], reporting each emitter–receiver pair done to `progress`. Pairs run
+/// in parallel and are collected in order, so the result does not depend on the thread count.
+/// Once `options.deadline` passes or `options.interrupt` is set, the pairs not yet started are
+/// skipped (counted in [`DiscontinuityStats::pairs_skipped`]).
+pub fn find_discontinuities_reporting(
+    scene: &Scene,
+    visibility: &Visibility,
+    options: &DiscontinuityOptions,
+    progress: &dyn Progress,
+) -> Discontinuities {
     let started = Instant::now();
-    let tol = visibility.contact_distance();
-    let topology = Topology::new(scene, tol);
-    let reach = 4.0 * scene.diagonal();
+    let context = SearchContext::new(scene, visibility, options);
+    let pairs = context.facing_pairs();
+    progress.start("discontinuities", pairs.len() as u64);
+    let done = AtomicU64::new(0);
+    let found: Vec<Option<PairEvents>> = pairs
+        .par_iter()
+        .map(|&(e, r)| {
+            if options.should_stop() {
+                return None;
+            }
+            let events = context.pair_events(e, r);
+            progress.set(done.fetch_add(1, Ordering::Relaxed) + 1);
+            Some(events)
+        })
+        .collect();
+    progress.finish();
+
     let mut stats = DiscontinuityStats::default();
     let mut raw: Vec<Vec<DiscontinuitySegment>> = vec![Vec::new(); scene.surfaces.len()];
-
-    let frames: Vec<Option<PlaneFrame>> = scene
-        .surfaces
-        .iter()
-        .map(|s| PlaneFrame::of_polygon(&s.polygon))
-        .collect();
-
-    for (e, emitter) in scene.emitters() {
-        let Some(ef) = frames[e] else { continue };
-        let e_loop = &topology.loops[e];
-        for (r, receiver) in scene.surfaces.iter().enumerate() {
-            if r == e {
-                continue;
+    for (events, &(_, r)) in found.into_iter().zip(&pairs) {
+        match events {
+            Some(events) => {
+                stats.add(&events.stats);
+                raw[r].extend(events.segments);
             }
-            let Some(rf) = frames[r] else { continue };
-            let faces = emitter.polygon.iter().any(|&p| rf.height(p) > tol)
-                && receiver.polygon.iter().any(|&p| ef.height(p) > tol);
-            if !faces {
-                continue;
-            }
-            stats.pairs += 1;
-            // The shaft: the convex hull of emitter and receiver. A blocker must have a vertex in
-            // front of both and must not lie wholly beyond one of the hull's faces.
-            let mut ends = emitter.polygon.clone();
-            ends.extend(&receiver.polygon);
-            let shaft = hull::hull_planes(&ends, tol);
-            let blockers = shaft_blockers(
-                visibility,
-                [emitter.bounds(), receiver.bounds()],
-                e,
-                r,
-                |s| {
-                    let polygon = &scene.surfaces[s].polygon;
-                    polygon
-                        .iter()
-                        .any(|&p| ef.height(p) > tol && rf.height(p) > tol)
-                        && !hull::beyond_a_face(&shaft, polygon, tol)
-                },
-            );
-            if blockers.is_empty() {
-                stats.pairs_without_blockers += 1;
-                continue;
-            }
-            stats.blockers_in_shafts += blockers.len();
-            let mut vertices = BTreeSet::new();
-            let mut edges = BTreeSet::new();
-            for &b in &blockers {
-                let l = &topology.loops[b];
-                for k in 0..l.len() {
-                    let (u, w) = (l[k], l[(k + 1) % l.len()]);
-                    vertices.insert(u);
-                    if u != w {
-                        edges.insert((u.min(w), u.max(w)));
-                    }
-                }
-            }
-            let not_pair = |s: SurfaceId| s != e && s != r;
-            let in_front = |p: DVec3| ef.height(p) > tol && rf.height(p) > tol;
-            let mut wedges = Vec::new();
-            // EV: each emitter edge with each silhouette vertex.
-            for k in 0..e_loop.len() {
-                let (ia, ib) = (e_loop[k], e_loop[(k + 1) % e_loop.len()]);
-                let Some(source) = clip_segment(topology.points[ia], topology.points[ib], |p| {
-                    rf.height(p) - tol
-                }) else {
-                    continue;
-                };
-                for &v in &vertices {
-                    let pv = topology.points[v];
-                    if !in_front(pv) || e_loop.contains(&v) {
-                        continue;
-                    }
-                    let n =
-                        (topology.points[ib] - topology.points[ia]).cross(pv - topology.points[ia]);
-                    let Some(n) = n.try_normalize() else { continue };
-                    stats.wedges_considered += 1;
-                    if !topology.vertex_is_tangent(v, n, not_pair) {
-                        stats.wedges_culled += 1;
-                        continue;
-                    }
-                    let order = if topology.plane_holds_an_edge_at(v, n, not_pair) {
-                        1
-                    } else {
-                        2
-                    };
-                    wedges.push(Wedge {
-                        emitter: e,
-                        event: Event::Ev,
-                        source,
-                        through: [pv, pv],
-                        order,
-                    });
-                }
-            }
-            // VE: each emitter vertex with each silhouette edge.
-            for &ia in e_loop {
-                let pa = topology.points[ia];
-                if rf.height(pa) <= tol {
-                    continue;
-                }
-                for &(u, w) in &edges {
-                    let Some(through) = clip_segment(topology.points[u], topology.points[w], |p| {
-                        (ef.height(p) - tol).min(rf.height(p) - tol)
-                    }) else {
-                        continue;
-                    };
-                    if u == ia || w == ia {
-                        continue;
-                    }
-                    let Some(n) = (through[0] - pa).cross(through[1] - pa).try_normalize() else {
-                        continue;
-                    };
-                    stats.wedges_considered += 1;
-                    if !topology.vertex_is_tangent(ia, n, |s| s == e)
-                        || !topology.edge_is_tangent(u, w, n, not_pair)
-                    {
-                        stats.wedges_culled += 1;
-                        continue;
-                    }
-                    let order = if topology.plane_holds_an_edge_at(ia, n, |s| s == e) {
-                        1
-                    } else {
-                        2
-                    };
-                    wedges.push(Wedge {
-                        emitter: e,
-                        event: Event::Ve,
-                        source: [pa, pa],
-                        through,
-                        order,
-                    });
-                }
-            }
-            if options.eee {
-                let search = eee::EeeSearch {
-                    topology: &topology,
-                    visibility,
-                    emitter: e,
-                    receiver: r,
-                    emitter_frame: ef,
-                    receiver_frame: rf,
-                    tol,
-                    reach,
-                    chord_tolerance: options.eee_tolerance
-                        * penumbra_scenes::polygon::diameter(&receiver.polygon),
-                    receiver_polygon: &receiver.polygon,
-                    trim_samples: options.trim_samples,
-                    trim_tolerance: options.trim_tolerance
-                        * penumbra_scenes::polygon::diameter(&receiver.polygon),
-                };
-                let emitter_edges: Vec<(usize, usize)> = (0..e_loop.len())
-                    .map(|k| (e_loop[k], e_loop[(k + 1) % e_loop.len()]))
-                    .filter(|(a, b)| a != b)
-                    .collect();
-                let (curves, count) = search.curves(&emitter_edges, &edges, &blockers);
-                stats.eee_considered += count.considered;
-                stats.eee_events += count.events;
-                for curve in curves {
-                    for w in curve.points.windows(2) {
-                        for [a, b] in clip_to_polygon(&rf, &receiver.polygon, w[0], w[1]) {
-                            raw[r].push(DiscontinuitySegment {
-                                surface: r,
-                                emitter: e,
-                                from: a,
-                                to: b,
-                                event: Event::Eee,
-                                boundary: Boundary::Inner,
-                                order: curve.order,
-                            });
-                        }
-                    }
-                }
-            }
-            for wedge in wedges {
-                let Some([p, q]) = wedge.meet_plane(rf.origin, rf.normal, reach) else {
-                    continue;
-                };
-                let pieces = clip_to_polygon(&rf, &receiver.polygon, p, q);
-                let mut kept = false;
-                let trim_tol =
-                    options.trim_tolerance * penumbra_scenes::polygon::diameter(&receiver.polygon);
-                for [a, b] in pieces {
-                    let runs = trim::visible_runs(
-                        visibility,
-                        &wedge,
-                        r,
-                        a,
-                        b,
-                        options.trim_samples,
-                        trim_tol,
-                    );
-                    match runs.as_slice() {
-                        [] => stats.segments_hidden += 1,
-                        [[x, y]] if x.distance(a) <= trim_tol && y.distance(b) <= trim_tol => {}
-                        _ => stats.segments_trimmed += 1,
-                    }
-                    for [x, y] in runs {
-                        kept = true;
-                        raw[r].push(DiscontinuitySegment {
-                            surface: r,
-                            emitter: e,
-                            from: x,
-                            to: y,
-                            event: wedge.event,
-                            boundary: Boundary::Inner,
-                            order: wedge.order,
-                        });
-                    }
-                }
-                stats.wedges_kept += usize::from(kept);
-            }
+            None => stats.pairs_skipped += 1,
         }
     }
+    stats.pairs = pairs.len();
 
     // Contact lines, for every receiver that something touches.
     let mut hovering = vec![Vec::new(); scene.surfaces.len()];
     let emitters: Vec<SurfaceId> = scene.emitters().map(|(e, _)| e).collect();
-    for (r, contacts) in contact::contact_lines(scene, &frames, visibility) {
+    for (r, contacts) in contact::contact_lines(scene, &context.frames, visibility) {
         stats.contact_segments += contacts.len();
         hovering[r].extend(contacts.iter().copied().filter(|c| c.2 > 0.0));
         for (from, to, _) in contacts {
@@ -372,30 +234,15 @@ pub fn find_discontinuities(
         }
     }
 
-    let mut segments = Vec::with_capacity(raw.len());
-    for (r, list) in raw.into_iter().enumerate() {
-        let Some(rf) = frames[r] else {
-            segments.push(Vec::new());
-            continue;
-        };
-        let merged = merge_on_receiver(&rf, r, list, tol);
-        let boundary: Vec<DVec2> = scene.surfaces[r]
-            .polygon
-            .iter()
-            .map(|&p| rf.to_2d(p))
-            .collect();
-        let classified: Vec<DiscontinuitySegment> = merged
-            .into_iter()
-            // A line along the receiver's own edge is already an edge of every mesh of it.
-            .filter(|s| !on_polygon_edge(&boundary, rf.to_2d(s.from), rf.to_2d(s.to), tol))
-            .map(|s| DiscontinuitySegment {
-                boundary: classify(scene, visibility, &rf, &s),
-                ..s
-            })
-            .collect();
-        stats.segments += classified.len();
-        segments.push(classified);
-    }
+    let segments: Vec<Vec<DiscontinuitySegment>> = raw
+        .into_par_iter()
+        .enumerate()
+        .map(|(r, list)| match context.frames[r] {
+            Some(rf) => merge_and_classify(scene, visibility, &rf, r, list, context.tol),
+            None => Vec::new(),
+        })
+        .collect();
+    stats.segments = segments.iter().map(Vec::len).sum();
     stats.seconds = started.elapsed().as_secs_f64();
     Discontinuities {
         segments,
@@ -404,34 +251,30 @@ pub fn find_discontinuities(
     }
 }
 
-/// Surfaces other than `e` and `r` with a triangle in the shaft between two boxes for which
-/// `keep` holds, sorted.
-fn shaft_blockers(
+/// A receiver's segments merged where they coincide, those along its own edges dropped (they are
+/// edges of every mesh of it already), and each classified.
+fn merge_and_classify(
+    scene: &Scene,
     visibility: &Visibility,
-    [from, to]: [Bounds; 2],
-    e: SurfaceId,
+    rf: &PlaneFrame,
     r: SurfaceId,
-    keep: impl Fn(SurfaceId) -> bool,
-) -> Vec<SurfaceId> {
-    let mut found = BTreeSet::new();
-    visibility.triangles_overlapping_between(from, to, |t| {
-        let s = visibility.triangles()[t].surface;
-        if s != e && s != r {
-            found.insert(s);
-        }
-    });
-    found.into_iter().filter(|&s| keep(s)).collect()
-}
-
-/// The part of segment `a-b` where `h >= 0` (h linear along it), if any length remains.
-fn clip_segment(a: DVec3, b: DVec3, h: impl Fn(DVec3) -> f64) -> Option<[DVec3; 2]> {
-    let (ha, hb) = (h(a), h(b));
-    match (ha >= 0.0, hb >= 0.0) {
-        (true, true) => Some([a, b]),
-        (false, false) => None,
-        (true, false) => Some([a, a.lerp(b, ha / (ha - hb))]),
-        (false, true) => Some([a.lerp(b, ha / (ha - hb)), b]),
-    }
+    list: Vec<DiscontinuitySegment>,
+    tol: f64,
+) -> Vec<DiscontinuitySegment> {
+    let merged = merge_on_receiver(rf, r, list, tol);
+    let boundary: Vec<DVec2> = scene.surfaces[r]
+        .polygon
+        .iter()
+        .map(|&p| rf.to_2d(p))
+        .collect();
+    merged
+        .into_iter()
+        .filter(|s| !on_polygon_edge(&boundary, rf.to_2d(s.from), rf.to_2d(s.to), tol))
+        .map(|s| DiscontinuitySegment {
+            boundary: classify(scene, visibility, rf, &s),
+            ..s
+        })
+        .collect()
 }
 
 /// The pieces of segment `p-q` (on the polygon's plane) inside the polygon.

@@ -1,0 +1,390 @@
+//! The events of one emitter–receiver pair: the blockers in the shaft between them, their EV and
+//! VE wedges and EEE curves, and what each leaves on the receiver once trimmed where other
+//! geometry hides it. Pairs are independent, so the search runs them in parallel.
+
+use std::collections::BTreeSet;
+
+use glam::DVec3;
+use penumbra_scenes::{Bounds, PlaneFrame, Scene, SurfaceId, Visibility};
+
+use super::topology::Topology;
+use super::wedge::{Event, Wedge};
+use super::{
+    Boundary, DiscontinuityOptions, DiscontinuitySegment, DiscontinuityStats, clip_to_polygon, eee,
+    hull, trim,
+};
+
+/// What the whole search shares: the scene, its welded topology and every surface's frame.
+#[derive(Debug)]
+pub(crate) struct SearchContext<'a> {
+    pub scene: &'a Scene,
+    pub visibility: &'a Visibility,
+    pub topology: Topology,
+    pub frames: Vec<Option<PlaneFrame>>,
+    pub options: &'a DiscontinuityOptions,
+    /// Points closer than this count as coincident.
+    pub tol: f64,
+    /// How far wedges are followed: beyond the scene, whatever its shape.
+    pub reach: f64,
+}
+
+/// The segments one pair leaves on its receiver (before merging), and the figures of its search.
+#[derive(Debug, Default)]
+pub(crate) struct PairEvents {
+    pub segments: Vec<DiscontinuitySegment>,
+    pub stats: DiscontinuityStats,
+}
+
+/// One emitter–receiver pair with the blockers in the shaft between them.
+struct Shaft<'a> {
+    context: &'a SearchContext<'a>,
+    emitter: SurfaceId,
+    receiver: SurfaceId,
+    emitter_frame: PlaneFrame,
+    receiver_frame: PlaneFrame,
+    blockers: Vec<SurfaceId>,
+    /// The blockers' welded vertices and edges (vertex pairs, smaller index first).
+    vertices: BTreeSet<usize>,
+    edges: BTreeSet<(usize, usize)>,
+}
+
+impl<'a> SearchContext<'a> {
+    pub fn new(
+        scene: &'a Scene,
+        visibility: &'a Visibility,
+        options: &'a DiscontinuityOptions,
+    ) -> SearchContext<'a> {
+        let tol = visibility.contact_distance();
+        SearchContext {
+            scene,
+            visibility,
+            topology: Topology::new(scene, tol),
+            frames: scene
+                .surfaces
+                .iter()
+                .map(|s| PlaneFrame::of_polygon(&s.polygon))
+                .collect(),
+            options,
+            tol,
+            reach: 4.0 * scene.diagonal(),
+        }
+    }
+
+    /// Emitter–receiver pairs that face each other, emitters outermost.
+    pub fn facing_pairs(&self) -> Vec<(SurfaceId, SurfaceId)> {
+        let mut pairs = Vec::new();
+        for (e, emitter) in self.scene.emitters() {
+            let Some(ef) = self.frames[e] else { continue };
+            for (r, receiver) in self.scene.surfaces.iter().enumerate() {
+                let Some(rf) = self.frames[r] else { continue };
+                let faces = r != e
+                    && emitter.polygon.iter().any(|&p| rf.height(p) > self.tol)
+                    && receiver.polygon.iter().any(|&p| ef.height(p) > self.tol);
+                if faces {
+                    pairs.push((e, r));
+                }
+            }
+        }
+        pairs
+    }
+
+    /// Every event of the pair `(e, r)` on `r`.
+    pub fn pair_events(&self, e: SurfaceId, r: SurfaceId) -> PairEvents {
+        let mut out = PairEvents::default();
+        let Some(shaft) = self.shaft(e, r) else {
+            out.stats.pairs_without_blockers = 1;
+            return out;
+        };
+        out.stats.blockers_in_shafts = shaft.blockers.len();
+        let mut wedges = shaft.ev_wedges(&mut out.stats);
+        wedges.extend(shaft.ve_wedges(&mut out.stats));
+        if self.options.eee {
+            shaft.eee_segments(&mut out);
+        }
+        for wedge in wedges {
+            shaft.wedge_segments(&wedge, &mut out);
+        }
+        out
+    }
+
+    /// The pair's shaft (the convex hull of emitter and receiver) with the blockers in it, or
+    /// `None` when nothing blocks.
+    fn shaft(&'a self, e: SurfaceId, r: SurfaceId) -> Option<Shaft<'a>> {
+        let (emitter, receiver) = (&self.scene.surfaces[e], &self.scene.surfaces[r]);
+        let (ef, rf) = (self.frames[e]?, self.frames[r]?);
+        let tol = self.tol;
+        let mut ends = emitter.polygon.clone();
+        ends.extend(&receiver.polygon);
+        let hull = hull::hull_planes(&ends, tol);
+        // A blocker must have a vertex in front of both and must not lie wholly beyond one of
+        // the hull's faces.
+        let blockers = shaft_blockers(
+            self.visibility,
+            [emitter.bounds(), receiver.bounds()],
+            e,
+            r,
+            |s| {
+                let polygon = &self.scene.surfaces[s].polygon;
+                polygon
+                    .iter()
+                    .any(|&p| ef.height(p) > tol && rf.height(p) > tol)
+                    && !hull::beyond_a_face(&hull, polygon, tol)
+            },
+        );
+        if blockers.is_empty() {
+            return None;
+        }
+        let mut vertices = BTreeSet::new();
+        let mut edges = BTreeSet::new();
+        for &b in &blockers {
+            let l = &self.topology.loops[b];
+            for k in 0..l.len() {
+                let (u, w) = (l[k], l[(k + 1) % l.len()]);
+                vertices.insert(u);
+                if u != w {
+                    edges.insert((u.min(w), u.max(w)));
+                }
+            }
+        }
+        Some(Shaft {
+            context: self,
+            emitter: e,
+            receiver: r,
+            emitter_frame: ef,
+            receiver_frame: rf,
+            blockers,
+            vertices,
+            edges,
+        })
+    }
+}
+
+impl Shaft<'_> {
+    fn point(&self, v: usize) -> DVec3 {
+        self.context.topology.points[v]
+    }
+
+    fn emitter_loop(&self) -> &[usize] {
+        &self.context.topology.loops[self.emitter]
+    }
+
+    fn in_front(&self, p: DVec3) -> bool {
+        let tol = self.context.tol;
+        self.emitter_frame.height(p) > tol && self.receiver_frame.height(p) > tol
+    }
+
+    fn not_pair(&self) -> impl Fn(SurfaceId) -> bool + use<> {
+        let (e, r) = (self.emitter, self.receiver);
+        move |s| s != e && s != r
+    }
+
+    /// EV: each emitter edge (the part in front of the receiver) with each blocker vertex on the
+    /// silhouette as seen from it.
+    fn ev_wedges(&self, stats: &mut DiscontinuityStats) -> Vec<Wedge> {
+        let topology = &self.context.topology;
+        let e_loop = self.emitter_loop();
+        let tol = self.context.tol;
+        let mut wedges = Vec::new();
+        for k in 0..e_loop.len() {
+            let (ia, ib) = (e_loop[k], e_loop[(k + 1) % e_loop.len()]);
+            let Some(source) = clip_segment(self.point(ia), self.point(ib), |p| {
+                self.receiver_frame.height(p) - tol
+            }) else {
+                continue;
+            };
+            for &v in &self.vertices {
+                let pv = self.point(v);
+                if !self.in_front(pv) || e_loop.contains(&v) {
+                    continue;
+                }
+                let n = (self.point(ib) - self.point(ia)).cross(pv - self.point(ia));
+                let Some(n) = n.try_normalize() else { continue };
+                stats.wedges_considered += 1;
+                if !topology.vertex_is_tangent(v, n, self.not_pair()) {
+                    stats.wedges_culled += 1;
+                    continue;
+                }
+                let order = if topology.plane_holds_an_edge_at(v, n, self.not_pair()) {
+                    1
+                } else {
+                    2
+                };
+                wedges.push(Wedge {
+                    emitter: self.emitter,
+                    event: Event::Ev,
+                    source,
+                    through: [pv, pv],
+                    order,
+                });
+            }
+        }
+        wedges
+    }
+
+    /// VE: each emitter vertex in front of the receiver with each blocker edge (the part in front
+    /// of both) on the silhouette as seen from it.
+    fn ve_wedges(&self, stats: &mut DiscontinuityStats) -> Vec<Wedge> {
+        let topology = &self.context.topology;
+        let tol = self.context.tol;
+        let e = self.emitter;
+        let mut wedges = Vec::new();
+        for &ia in self.emitter_loop() {
+            let pa = self.point(ia);
+            if self.receiver_frame.height(pa) <= tol {
+                continue;
+            }
+            for &(u, w) in &self.edges {
+                let Some(through) = clip_segment(self.point(u), self.point(w), |p| {
+                    (self.emitter_frame.height(p) - tol).min(self.receiver_frame.height(p) - tol)
+                }) else {
+                    continue;
+                };
+                if u == ia || w == ia {
+                    continue;
+                }
+                let Some(n) = (through[0] - pa).cross(through[1] - pa).try_normalize() else {
+                    continue;
+                };
+                stats.wedges_considered += 1;
+                if !topology.vertex_is_tangent(ia, n, |s| s == e)
+                    || !topology.edge_is_tangent(u, w, n, self.not_pair())
+                {
+                    stats.wedges_culled += 1;
+                    continue;
+                }
+                let order = if topology.plane_holds_an_edge_at(ia, n, |s| s == e) {
+                    1
+                } else {
+                    2
+                };
+                wedges.push(Wedge {
+                    emitter: e,
+                    event: Event::Ve,
+                    source: [pa, pa],
+                    through,
+                    order,
+                });
+            }
+        }
+        wedges
+    }
+
+    /// The receiver's diameter times `fraction`: tolerances of this pair.
+    fn on_receiver(&self, fraction: f64) -> f64 {
+        let polygon = &self.context.scene.surfaces[self.receiver].polygon;
+        fraction * penumbra_scenes::polygon::diameter(polygon)
+    }
+
+    /// EEE: each emitter edge with two blocker edges, as polylines on the receiver.
+    fn eee_segments(&self, out: &mut PairEvents) {
+        let context = self.context;
+        let receiver_polygon = &context.scene.surfaces[self.receiver].polygon;
+        let search = eee::EeeSearch {
+            topology: &context.topology,
+            visibility: context.visibility,
+            emitter: self.emitter,
+            receiver: self.receiver,
+            emitter_frame: self.emitter_frame,
+            receiver_frame: self.receiver_frame,
+            tol: context.tol,
+            reach: context.reach,
+            chord_tolerance: self.on_receiver(context.options.eee_tolerance),
+            receiver_polygon,
+            trim_samples: context.options.trim_samples,
+            trim_tolerance: self.on_receiver(context.options.trim_tolerance),
+        };
+        let e_loop = self.emitter_loop();
+        let emitter_edges: Vec<(usize, usize)> = (0..e_loop.len())
+            .map(|k| (e_loop[k], e_loop[(k + 1) % e_loop.len()]))
+            .filter(|(a, b)| a != b)
+            .collect();
+        let (curves, count) = search.curves(&emitter_edges, &self.edges, &self.blockers);
+        out.stats.eee_considered += count.considered;
+        out.stats.eee_events += count.events;
+        for curve in curves {
+            for w in curve.points.windows(2) {
+                for [a, b] in clip_to_polygon(&self.receiver_frame, receiver_polygon, w[0], w[1]) {
+                    out.segments
+                        .push(self.segment(a, b, Event::Eee, curve.order));
+                }
+            }
+        }
+    }
+
+    /// Where a wedge meets the receiver, clipped to its polygon and trimmed to where the wedge's
+    /// rays are unobstructed.
+    fn wedge_segments(&self, wedge: &Wedge, out: &mut PairEvents) {
+        let context = self.context;
+        let rf = &self.receiver_frame;
+        let Some([p, q]) = wedge.meet_plane(rf.origin, rf.normal, context.reach) else {
+            return;
+        };
+        let receiver_polygon = &context.scene.surfaces[self.receiver].polygon;
+        let trim_tol = self.on_receiver(context.options.trim_tolerance);
+        let mut kept = false;
+        for [a, b] in clip_to_polygon(rf, receiver_polygon, p, q) {
+            let runs = trim::visible_runs(
+                context.visibility,
+                wedge,
+                self.receiver,
+                a,
+                b,
+                context.options.trim_samples,
+                trim_tol,
+            );
+            match runs.as_slice() {
+                [] => out.stats.segments_hidden += 1,
+                [[x, y]] if x.distance(a) <= trim_tol && y.distance(b) <= trim_tol => {}
+                _ => out.stats.segments_trimmed += 1,
+            }
+            for [x, y] in runs {
+                kept = true;
+                out.segments
+                    .push(self.segment(x, y, wedge.event, wedge.order));
+            }
+        }
+        out.stats.wedges_kept += usize::from(kept);
+    }
+
+    fn segment(&self, from: DVec3, to: DVec3, event: Event, order: u8) -> DiscontinuitySegment {
+        DiscontinuitySegment {
+            surface: self.receiver,
+            emitter: self.emitter,
+            from,
+            to,
+            event,
+            boundary: Boundary::Inner,
+            order,
+        }
+    }
+}
+
+/// Surfaces other than `e` and `r` with a triangle in the shaft between two boxes for which
+/// `keep` holds, sorted.
+fn shaft_blockers(
+    visibility: &Visibility,
+    [from, to]: [Bounds; 2],
+    e: SurfaceId,
+    r: SurfaceId,
+    keep: impl Fn(SurfaceId) -> bool,
+) -> Vec<SurfaceId> {
+    let mut found = BTreeSet::new();
+    visibility.triangles_overlapping_between(from, to, |t| {
+        let s = visibility.triangles()[t].surface;
+        if s != e && s != r {
+            found.insert(s);
+        }
+    });
+    found.into_iter().filter(|&s| keep(s)).collect()
+}
+
+/// The part of segment `a-b` where `h >= 0` (h linear along it), if any length remains.
+fn clip_segment(a: DVec3, b: DVec3, h: impl Fn(DVec3) -> f64) -> Option<[DVec3; 2]> {
+    let (ha, hb) = (h(a), h(b));
+    match (ha >= 0.0, hb >= 0.0) {
+        (true, true) => Some([a, b]),
+        (false, false) => None,
+        (true, false) => Some([a, a.lerp(b, ha / (ha - hb))]),
+        (false, true) => Some([a.lerp(b, ha / (ha - hb)), b]),
+    }
+}
