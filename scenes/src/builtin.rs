@@ -7,7 +7,7 @@ use crate::model::{Camera, Scene, Surface};
 use crate::polygon;
 
 /// Names and one-line descriptions of the built-in scenes.
-pub const NAMES: [(&str, &str); 8] = [
+pub const NAMES: [(&str, &str); 9] = [
     (
         "cornell",
         "the measured Cornell box (mm): red and green walls, two white blocks, ceiling light",
@@ -23,6 +23,10 @@ pub const NAMES: [(&str, &str); 8] = [
     (
         "boxworld",
         "100 boxes of random size and turn standing on a floor under a square light (seed 1); boxworld-N for N boxes",
+    ),
+    (
+        "tessellated",
+        "an L-shaped prism hanging under a square light, as 20 triangles; tessellated-N splits each into N x N (tessellated-0: its 8 polygons)",
     ),
     (
         "bars",
@@ -53,23 +57,33 @@ pub fn builtin(name: &str) -> Option<Scene> {
         "cie-5.3" => Some(crate::cie::area_source()),
         "cie-5.6" => Some(crate::cie::floor_reflection()),
         "cie-5.8" => Some(crate::cie::reflecting_cube(0.5)),
-        _ => boxworld_count(name).map(|count| boxworld(count, 1)),
+        "tessellated" => Some(crate::tessellated::tessellated(1)),
+        _ => boxworld_count(name)
+            .map(|count| boxworld(count, 1))
+            .or_else(|| tessellation_count(name).map(crate::tessellated::tessellated)),
     }
 }
 
 /// Most boxes a `boxworld-N` name may ask for (five million polygons).
 pub const MAX_BOXWORLD: usize = 1_000_000;
 
-/// `N` from `boxworld-N`, for 1 ≤ N ≤ [`MAX_BOXWORLD`].
-fn boxworld_count(name: &str) -> Option<usize> {
-    let digits = name.strip_prefix("boxworld-")?;
+/// `N` from `tessellated-N`, for 0 ≤ N ≤ [`crate::tessellated::MAX_SUBDIVISIONS`].
+fn tessellation_count(name: &str) -> Option<usize> {
+    count_after(name, "tessellated-").filter(|&n| n <= crate::tessellated::MAX_SUBDIVISIONS)
+}
+
+/// The plain decimal number that follows `prefix` in a built-in name.
+fn count_after(name: &str, prefix: &str) -> Option<usize> {
+    let digits = name.strip_prefix(prefix)?;
     if digits.is_empty() || !digits.bytes().all(|b| b.is_ascii_digit()) {
         return None;
     }
-    digits
-        .parse()
-        .ok()
-        .filter(|n| (1..=MAX_BOXWORLD).contains(n))
+    digits.parse().ok()
+}
+
+/// `N` from `boxworld-N`, for 1 ≤ N ≤ [`MAX_BOXWORLD`].
+fn boxworld_count(name: &str) -> Option<usize> {
+    count_after(name, "boxworld-").filter(|n| (1..=MAX_BOXWORLD).contains(n))
 }
 
 fn v(x: f64, y: f64, z: f64) -> DVec3 {

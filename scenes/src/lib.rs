@@ -28,6 +28,7 @@ pub mod model;
 pub mod obj;
 pub mod polygon;
 pub mod rng;
+pub mod tessellated;
 pub mod validate;
 pub mod visibility;
 

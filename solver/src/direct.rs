@@ -17,16 +17,25 @@ use penumbra_scenes::polygon::{is_convex_ccw, triangulate_ccw};
 use penumbra_scenes::{Bounds, PlaneFrame, Rgb, Scene, SurfaceId, Visibility};
 
 use crate::clip::{
-    HalfPlane, area_2d, clip_polygon_3d, merge_close_vertices, subtract_convex,
-    subtract_half_planes, wider_than,
+    HalfPlane, area_2d, clip_half_plane, clip_polygon_3d, inside_convex, merge_close_vertices,
+    subtract_convex, subtract_half_planes, wider_than,
 };
 use crate::lambert::{ReceivingPoint, contour_sum};
+use crate::shadow_union::{CornerKey, ShadowUnion, VisibleShape};
+use crate::solids::closed_solid_orientation;
 
 /// Visible pieces narrower than this many units in the last place of the coordinates involved
 /// are slivers left by rounding where two shadows share an edge; they are dropped.
 const SLIVER_ULPS: f64 = 64.0;
 /// Projected occluder vertices closer than this fraction of the emitter's diameter are merged.
 const MERGE_FRACTION: f64 = 1e-12;
+/// Up to this many occluders in a shaft are subtracted from the emitter one by one, as convex
+/// polygons; more are subtracted at once by one polygon difference ([`ShadowUnion`]), whose cost
+/// grows with their outline rather than with the product of their counts.
+pub const SEQUENTIAL_SHADOWS: usize = 16;
+/// Occluder faces whose corners are all at least this fraction of x's height from x (towards
+/// the emitter) project within this many times the shaft's width, and go whole into the union.
+const PROJECTION_REACH: f64 = 16.0;
 
 /// A planar convex polygon of a surface, with its plane.
 #[derive(Clone, Debug)]
@@ -34,6 +43,54 @@ struct ConvexPiece {
     surface: SurfaceId,
     polygon: Vec<DVec3>,
     normal: DVec3,
+    /// The corners' welded ids: the same for every face with a corner at the same point.
+    keys: Vec<CornerKey>,
+    /// The outward normal, for a face of a closed solid.
+    outward: Option<DVec3>,
+}
+
+impl ConvexPiece {
+    fn new(
+        surface: SurfaceId,
+        polygon: Vec<DVec3>,
+        normal: DVec3,
+        outward: Option<f64>,
+        corners: &mut CornerIds,
+    ) -> Self {
+        ConvexPiece {
+            surface,
+            keys: polygon.iter().map(|&p| corners.id(p)).collect(),
+            outward: outward.map(|sign| normal * sign),
+            polygon,
+            normal,
+        }
+    }
+}
+
+/// Welded ids of points, by their exact coordinates.
+#[derive(Default)]
+struct CornerIds(std::collections::HashMap<[u64; 3], CornerKey>);
+
+impl CornerIds {
+    fn id(&mut self, p: DVec3) -> CornerKey {
+        let next = self.0.len() as CornerKey;
+        *self
+            .0
+            .entry([p.x.to_bits(), p.y.to_bits(), p.z.to_bits()])
+            .or_insert(next)
+    }
+}
+
+/// What one occluder hides of an emitter piece, seen from a point.
+enum Blocking {
+    /// The occluder's plane holds the point (it stands on the receiver): regions of half-planes.
+    Contact(Vec<Vec<HalfPlane>>),
+    /// The occluder clipped to the shaft and projected onto the emitter's plane; with the
+    /// corners' keys when the whole occluder lies inside the shaft.
+    Shadow {
+        corners: Vec<DVec2>,
+        keys: Option<Vec<CornerKey>>,
+    },
 }
 
 #[derive(Clone, Debug)]
@@ -72,6 +129,8 @@ pub struct DirectLight<'a> {
     /// For each visibility triangle, the occluder piece that contains it.
     piece_of_triangle: Vec<usize>,
     tol: f64,
+    /// Occluders per shaft up to which shadows are subtracted one by one.
+    sequential_shadows: usize,
 }
 
 impl std::fmt::Debug for DirectLight<'_> {
@@ -105,17 +164,21 @@ impl<'a> DirectLight<'a> {
 
         // Occluders are whole convex surfaces where possible (fewer, larger pieces fragment the
         // visible region less), else the visibility index's own triangles.
+        let orientation = closed_solid_orientation(scene);
+        let mut corners = CornerIds::default();
         let mut occluders = Vec::new();
         let mut whole: Vec<Option<usize>> = vec![None; scene.surfaces.len()];
         for (surface, s) in scene.surfaces.iter().enumerate() {
             let pieces = convex_pieces(&s.polygon);
             if pieces.len() == 1 {
                 whole[surface] = Some(occluders.len());
-                occluders.push(ConvexPiece {
+                occluders.push(ConvexPiece::new(
                     surface,
-                    normal: s.normal(),
-                    polygon: s.polygon.clone(),
-                });
+                    s.polygon.clone(),
+                    s.normal(),
+                    orientation[surface],
+                    &mut corners,
+                ));
             }
         }
         let piece_of_triangle = visibility
@@ -124,13 +187,15 @@ impl<'a> DirectLight<'a> {
             .map(|t| match whole[t.surface] {
                 Some(piece) => piece,
                 None => {
-                    occluders.push(ConvexPiece {
-                        surface: t.surface,
-                        normal: (t.vertices[1] - t.vertices[0])
+                    occluders.push(ConvexPiece::new(
+                        t.surface,
+                        t.vertices.to_vec(),
+                        (t.vertices[1] - t.vertices[0])
                             .cross(t.vertices[2] - t.vertices[0])
                             .normalize_or_zero(),
-                        polygon: t.vertices.to_vec(),
-                    });
+                        orientation[t.surface],
+                        &mut corners,
+                    ));
                     occluders.len() - 1
                 }
             })
@@ -141,6 +206,16 @@ impl<'a> DirectLight<'a> {
             occluders,
             piece_of_triangle,
             tol: visibility.contact_distance(),
+            sequential_shadows: SEQUENTIAL_SHADOWS,
+        }
+    }
+
+    /// The same evaluator, subtracting up to `count` shadows one by one (and more at once): the
+    /// two ways agree to rounding, which tests check.
+    pub fn with_sequential_shadows(self, count: usize) -> Self {
+        DirectLight {
+            sequential_shadows: count,
+            ..self
         }
     }
 
@@ -162,20 +237,27 @@ impl<'a> DirectLight<'a> {
 
     /// The form factor from x to the part of emitter `k` that x sees.
     pub fn form_factor_visible(&self, x: &ReceivingPoint, receiver: SurfaceId, k: usize) -> f64 {
+        let tol = self.tol;
         self.visible_parts(x, receiver, k)
             .iter()
-            .map(|piece| contour_sum(x, piece, self.tol).abs())
+            .map(|shape| {
+                let mut contours = shape.iter().map(|c| contour_sum(x, c, tol).abs());
+                let outline = contours.next().unwrap_or(0.0);
+                (outline - contours.sum::<f64>()).max(0.0)
+            })
             .sum::<f64>()
             / (2.0 * PI)
     }
 
-    /// The part of emitter `k` visible from x, as convex polygons in 3D on the emitter's plane.
+    /// The part of emitter `k` visible from x, in 3D on the emitter's plane: shapes, each an
+    /// outline followed by its holes (convex outlines without holes where few occluders are in
+    /// the way).
     pub fn visible_parts(
         &self,
         x: &ReceivingPoint,
         receiver: SurfaceId,
         k: usize,
-    ) -> Vec<Vec<DVec3>> {
+    ) -> Vec<Vec<Vec<DVec3>>> {
         let e = &self.emitters[k];
         let tol = self.tol;
         if e.surface == receiver || !x.in_front_of(e.frame.origin, e.frame.normal, tol) {
@@ -192,15 +274,16 @@ impl<'a> DirectLight<'a> {
             if h_x <= tol {
                 // x lies in the emitter's plane (a surface meeting the emitter): the shaft is flat,
                 // and the one-sided limit sees the emitter unoccluded.
-                out.push(front);
+                out.push(vec![front]);
                 continue;
             }
             let visible = self.unblocked(x, receiver, e, &front, h_x);
-            out.extend(
-                visible
+            out.extend(visible.into_iter().map(|shape| {
+                shape
                     .into_iter()
-                    .map(|q| q.into_iter().map(|c| e.frame.to_3d(c)).collect::<Vec<_>>()),
-            );
+                    .map(|c| c.into_iter().map(|p| e.frame.to_3d(p)).collect::<Vec<_>>())
+                    .collect::<Vec<_>>()
+            }));
         }
         out
     }
@@ -214,14 +297,39 @@ impl<'a> DirectLight<'a> {
         e: &Emitter,
         front: &[DVec3],
         h_x: f64,
-    ) -> Vec<Vec<DVec2>> {
-        let tol = self.tol;
+    ) -> Vec<VisibleShape> {
         // The rounding scale of this evaluation: coordinates as large as these carry this error.
         let min_width = SLIVER_ULPS * f64::EPSILON * e.magnitude.max(x.point.abs().max_element());
-        let mut visible = vec![front.iter().map(|&p| e.frame.to_2d(p)).collect::<Vec<_>>()];
-        if area_2d(&visible[0]) < 0.0 {
-            visible[0].reverse();
+        let mut piece = front.iter().map(|&p| e.frame.to_2d(p)).collect::<Vec<_>>();
+        if area_2d(&piece) < 0.0 {
+            piece.reverse();
         }
+        let Some(blockings) = self.blockings(x, receiver, e, front, h_x, &piece) else {
+            return Vec::new();
+        };
+        if blockings.len() > self.sequential_shadows
+            && let Some(visible) = subtract_at_once(&piece, &blockings, e, min_width)
+        {
+            return visible;
+        }
+        subtract_one_by_one(piece, blockings, e, min_width)
+            .into_iter()
+            .map(|p| vec![p])
+            .collect()
+    }
+
+    /// What each occluder in the shaft from x to `front` hides of it, or `None` when one of them
+    /// hides all of it.
+    fn blockings(
+        &self,
+        x: &ReceivingPoint,
+        receiver: SurfaceId,
+        e: &Emitter,
+        front: &[DVec3],
+        h_x: f64,
+        piece: &[DVec2],
+    ) -> Option<Vec<Blocking>> {
+        let tol = self.tol;
         // The shaft's side planes through x and each edge, oriented to contain the piece.
         let center = front.iter().copied().sum::<DVec3>() / front.len() as f64;
         let sides: Vec<DVec3> = (0..front.len())
@@ -239,66 +347,179 @@ impl<'a> DirectLight<'a> {
         );
         candidates.sort_unstable();
         candidates.dedup();
+        candidates.retain(|&index| {
+            let occ = &self.occluders[index];
+            // A face of a closed solid turned away from x is behind another face of it.
+            occ.surface != receiver
+                && occ.surface != e.surface
+                && !occ
+                    .outward
+                    .is_some_and(|n| n.dot(x.point - occ.polygon[0]) < -tol)
+        });
+        let at_once = candidates.len() > self.sequential_shadows;
 
-        for piece in candidates {
-            let occ = &self.occluders[piece];
-            if occ.surface == receiver || occ.surface == e.surface {
-                continue;
-            }
+        let mut blockings = Vec::with_capacity(candidates.len());
+        for index in candidates {
+            let occ = &self.occluders[index];
             // A plane through x is seen edge-on: it hides nothing, unless x lies on the occluder
             // itself (a blocker standing on the receiver); then the limit from inside the
             // receiving surface sees it hide everything across its plane, within its corner.
             if occ.normal.dot(x.point - occ.polygon[0]).abs() <= tol {
-                for region in contact_shadow(x, occ, e, tol) {
-                    let mut next = Vec::with_capacity(visible.len() + 4);
-                    for v in &visible {
-                        subtract_half_planes(v, &region, min_width, &mut next);
-                    }
-                    visible = next;
-                }
-                if visible.is_empty() {
-                    break;
+                let regions = contact_shadow(x, occ, e, tol);
+                if !regions.is_empty() {
+                    blockings.push(Blocking::Contact(regions));
                 }
                 continue;
             }
-            let mut poly = clip_polygon_3d(&occ.polygon, |p| e.frame.height(p));
-            for &m in &sides {
-                if poly.len() < 3 {
-                    break;
-                }
-                poly = clip_polygon_3d(&poly, |p| m.dot(p - x.point));
+            // Wholly outside one side of the shaft, or beyond the emitter's plane: no shadow.
+            let heights: Vec<f64> = occ.polygon.iter().map(|&p| e.frame.height(p)).collect();
+            if heights.iter().all(|&h| h < 0.0)
+                || sides
+                    .iter()
+                    .any(|m| occ.polygon.iter().all(|&p| m.dot(p - x.point) < 0.0))
+            {
+                continue;
             }
+            let inside = heights.iter().all(|&h| h >= 0.0)
+                && occ
+                    .polygon
+                    .iter()
+                    .all(|&p| sides.iter().all(|m| m.dot(p - x.point) >= 0.0));
+            // Shadows subtracted at once may reach past the piece: a face between the two
+            // planes and not too close to x is projected whole, keeping its own corners.
+            let whole = inside
+                || (at_once
+                    && heights
+                        .iter()
+                        .all(|&h| h >= 0.0 && h <= h_x * (1.0 - 1.0 / PROJECTION_REACH)));
+            let poly = if whole {
+                occ.polygon.clone()
+            } else {
+                let mut poly = clip_polygon_3d(&occ.polygon, |p| e.frame.height(p));
+                for &m in &sides {
+                    if poly.len() < 3 {
+                        break;
+                    }
+                    poly = clip_polygon_3d(&poly, |p| m.dot(p - x.point));
+                }
+                poly
+            };
             if poly.len() < 3 {
                 continue;
             }
-            let mut shadow: Vec<DVec2> = poly
+            let corners: Vec<DVec2> = poly
                 .iter()
                 .map(|&p| {
                     let s = h_x / (h_x - e.frame.height(p));
                     e.frame.to_2d(x.point + (p - x.point) * s)
                 })
                 .collect();
-            merge_close_vertices(&mut shadow, e.merge_distance);
-            if shadow.len() < 3 {
-                continue;
+            if covers(&corners, piece) {
+                return None;
             }
-            if area_2d(&shadow) < 0.0 {
-                shadow.reverse();
+            blockings.push(Blocking::Shadow {
+                corners,
+                keys: whole.then(|| occ.keys.clone()),
+            });
+        }
+        Some(blockings)
+    }
+}
+
+/// Whether a shadow (a convex polygon, either orientation) covers all of a convex piece.
+fn covers(shadow: &[DVec2], piece: &[DVec2]) -> bool {
+    let mut ccw = shadow.to_vec();
+    if area_2d(&ccw) < 0.0 {
+        ccw.reverse();
+    }
+    ccw.len() >= 3 && piece.iter().all(|&p| inside_convex(p, &ccw))
+}
+
+/// A projected shadow as a counter-clockwise convex polygon without near-duplicate corners, or
+/// `None` if nothing wider than a rounding sliver is left.
+fn tidy_shadow(corners: &[DVec2], e: &Emitter, min_width: f64) -> Option<Vec<DVec2>> {
+    let mut shadow = corners.to_vec();
+    merge_close_vertices(&mut shadow, e.merge_distance);
+    if shadow.len() < 3 {
+        return None;
+    }
+    if area_2d(&shadow) < 0.0 {
+        shadow.reverse();
+    }
+    wider_than(&shadow, min_width).then_some(shadow)
+}
+
+/// `piece` minus each blocking in turn, as convex pieces.
+fn subtract_one_by_one(
+    piece: Vec<DVec2>,
+    blockings: Vec<Blocking>,
+    e: &Emitter,
+    min_width: f64,
+) -> Vec<Vec<DVec2>> {
+    let mut visible = vec![piece];
+    for blocking in blockings {
+        let mut next = Vec::with_capacity(visible.len() + 4);
+        match blocking {
+            Blocking::Contact(regions) => {
+                for region in regions {
+                    next.clear();
+                    for v in &visible {
+                        subtract_half_planes(v, &region, min_width, &mut next);
+                    }
+                    std::mem::swap(&mut visible, &mut next);
+                }
             }
-            if !wider_than(&shadow, min_width) {
-                continue;
-            }
-            let mut next = Vec::with_capacity(visible.len() + 4);
-            for v in &visible {
-                subtract_convex(v, &shadow, min_width, &mut next);
-            }
-            visible = next;
-            if visible.is_empty() {
-                break;
+            Blocking::Shadow { corners, .. } => {
+                let Some(shadow) = tidy_shadow(&corners, e, min_width) else {
+                    continue;
+                };
+                for v in &visible {
+                    subtract_convex(v, &shadow, min_width, &mut next);
+                }
+                visible = next;
             }
         }
-        visible
+        if visible.is_empty() {
+            break;
+        }
     }
+    visible
+}
+
+/// `piece` minus every blocking at once ([`ShadowUnion`]); `None` if the overlay refuses the
+/// coordinates.
+fn subtract_at_once(
+    piece: &[DVec2],
+    blockings: &[Blocking],
+    e: &Emitter,
+    min_width: f64,
+) -> Option<Vec<VisibleShape>> {
+    let mut union = ShadowUnion::default();
+    for blocking in blockings {
+        match blocking {
+            Blocking::Contact(regions) => {
+                for region in regions {
+                    let mut hidden = piece.to_vec();
+                    for h in region {
+                        hidden = clip_half_plane(&hidden, h);
+                    }
+                    if wider_than(&hidden, min_width) {
+                        union.add_contour(hidden);
+                    }
+                }
+            }
+            Blocking::Shadow {
+                corners,
+                keys: Some(keys),
+            } => union.add_face(keys, corners),
+            Blocking::Shadow { corners, .. } => {
+                if let Some(shadow) = tidy_shadow(corners, e, min_width) {
+                    union.add_contour(shadow);
+                }
+            }
+        }
+    }
+    union.subtract_from(piece)
 }
 
 /// What an occluder whose plane holds x hides of the emitter's plane, in the one-sided limit from
@@ -331,7 +552,7 @@ fn contact_shadow(
     let inside = through.is_empty()
         && PlaneFrame::of_polygon(&occ.polygon).is_some_and(|frame| {
             let flat: Vec<DVec2> = occ.polygon.iter().map(|&p| frame.to_2d(p)).collect();
-            crate::clip::inside_convex(frame.to_2d(x.point), &flat)
+            inside_convex(frame.to_2d(x.point), &flat)
         });
     if through.is_empty() && !inside {
         return Vec::new();

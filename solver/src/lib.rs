@@ -30,6 +30,8 @@ pub mod measure;
 pub mod path_trace;
 pub mod progress;
 pub mod progressive;
+mod shadow_union;
+pub mod solids;
 
 pub use direct::DirectLight;
 pub use elements::Discretization;

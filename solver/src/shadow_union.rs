@@ -1,0 +1,247 @@
+//! Many shadows at once: the part of an emitter piece that no shadow covers, by one polygon
+//! difference instead of subtracting the shadows one by one (which splits the visible region
+//! into as many convex pieces as the shadows have edges, and costs their product).
+//!
+//! The difference is computed by `i_overlay` on its 64-bit integer grid: coordinates are snapped
+//! to 2⁻⁶¹ of the piece's extent, finer than f64 rounding at that scale, so the result is exact
+//! to the precision of the inputs.
+//!
+//! Shadows of occluder faces lying wholly inside the shaft are fused before the overlay: each is
+//! a polygon of the face's own vertices, projected, so the faces of a welded mesh share their
+//! projected corners exactly and every inner edge appears once in each direction. Those pairs
+//! cancel, and what reaches the overlay is the outline of each connected sheet of faces — its
+//! silhouette from the receiving point — however finely the mesh is tessellated.
+
+use std::collections::HashMap;
+
+use glam::DVec2;
+use i_overlay::core::fill_rule::FillRule;
+use i_overlay::core::overlay::ShapeType;
+use i_overlay::core::overlay_rule::OverlayRule;
+use i_overlay::float::overlay::FloatOverlay;
+use i_overlay::i_float::adapter::FloatPointAdapter;
+use i_overlay::i_float::float::rect::FloatRect;
+
+use crate::clip::area_2d;
+
+/// A corner of an occluder face, welded: faces that share a point share its key.
+pub(crate) type CornerKey = u32;
+
+/// One directed edge of a projected face, between two corners.
+#[derive(Clone, Copy, Debug)]
+struct SheetEdge {
+    from: CornerKey,
+    to: CornerKey,
+    at: DVec2,
+}
+
+/// The shadows cast on one emitter piece from one receiving point.
+#[derive(Debug, Default)]
+pub(crate) struct ShadowUnion {
+    /// Edges of faces wholly inside the shaft, oriented counter-clockwise.
+    sheet: Vec<SheetEdge>,
+    /// Other shadows (clipped to the shaft), counter-clockwise.
+    contours: Vec<Vec<DVec2>>,
+}
+
+/// A visible part of an emitter piece: an outline (counter-clockwise) and its holes (clockwise).
+pub(crate) type VisibleShape = Vec<Vec<DVec2>>;
+
+impl ShadowUnion {
+    /// Adds the shadow of a face wholly inside the shaft: its corners' keys and projections.
+    pub fn add_face(&mut self, keys: &[CornerKey], corners: &[DVec2]) {
+        let n = corners.len();
+        let reversed = area_2d(corners) < 0.0;
+        for i in 0..n {
+            let (a, b) = if reversed {
+                (n - 1 - i, (2 * n - 2 - i) % n)
+            } else {
+                (i, (i + 1) % n)
+            };
+            if keys[a] != keys[b] {
+                self.sheet.push(SheetEdge {
+                    from: keys[a],
+                    to: keys[b],
+                    at: corners[a],
+                });
+            }
+        }
+    }
+
+    /// Adds a shadow given as a counter-clockwise contour.
+    pub fn add_contour(&mut self, contour: Vec<DVec2>) {
+        self.contours.push(contour);
+    }
+
+    /// `piece` (convex, counter-clockwise) minus every shadow, or `None` if the overlay cannot
+    /// represent the coordinates (not finite).
+    pub fn subtract_from(self, piece: &[DVec2]) -> Option<Vec<VisibleShape>> {
+        let mut contours = self.contours;
+        contours.extend(outlines(self.sheet)?);
+        let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
+        for p in piece.iter().chain(contours.iter().flatten()) {
+            lo = lo.min(*p);
+            hi = hi.max(*p);
+        }
+        if !(lo.is_finite() && hi.is_finite()) {
+            return None;
+        }
+        let rect = FloatRect::new(lo.x, hi.x, lo.y, hi.y).ok()?;
+        let adapter = FloatPointAdapter::<[f64; 2], i64>::new_conservative(rect);
+        let edges = piece.len() + contours.iter().map(Vec::len).sum::<usize>();
+        let mut overlay = FloatOverlay::<[f64; 2], i64>::with_adapter(adapter, edges);
+        overlay = overlay.unsafe_add_contour(&to_arrays(piece), ShapeType::Subject);
+        for c in &contours {
+            overlay = overlay.unsafe_add_contour(&to_arrays(c), ShapeType::Clip);
+        }
+        let shapes = overlay.overlay(OverlayRule::Difference, FillRule::NonZero);
+        Some(
+            shapes
+                .into_iter()
+                .map(|shape| {
+                    shape
+                        .into_iter()
+                        .map(|c| c.into_iter().map(|[x, y]| DVec2::new(x, y)).collect())
+                        .collect()
+                })
+                .collect(),
+        )
+    }
+}
+
+fn to_arrays(contour: &[DVec2]) -> Vec<[f64; 2]> {
+    contour.iter().map(|p| [p.x, p.y]).collect()
+}
+
+/// The closed outlines of the sheet's edges once each edge met in both directions cancels
+/// (the winding number of what remains is that of the faces). `None` if the edges do not close,
+/// which faces of distinct corners always do.
+fn outlines(mut edges: Vec<SheetEdge>) -> Option<Vec<Vec<DVec2>>> {
+    // Group each corner pair's edges, forward ones (from the smaller key) first, and keep only
+    // their surplus in one direction.
+    edges.sort_by(|a, b| {
+        let key = |e: &SheetEdge| (e.from.min(e.to), e.from.max(e.to), e.from > e.to);
+        key(a).cmp(&key(b))
+    });
+    let mut kept: Vec<SheetEdge> = Vec::with_capacity(edges.len() / 4);
+    let mut i = 0;
+    while i < edges.len() {
+        let pair = |e: &SheetEdge| (e.from.min(e.to), e.from.max(e.to));
+        let j = i + edges[i..]
+            .iter()
+            .take_while(|e| pair(e) == pair(&edges[i]))
+            .count();
+        let forward = edges[i..j].iter().filter(|e| e.from < e.to).count();
+        let backward = (j - i) - forward;
+        if forward > backward {
+            kept.extend_from_slice(&edges[i..i + forward - backward]);
+        } else {
+            kept.extend_from_slice(&edges[i + forward..i + forward + backward - forward]);
+        }
+        i = j;
+    }
+    // Walk the surviving edges into closed loops: every corner has as many edges in as out.
+    let mut leaving: HashMap<CornerKey, Vec<usize>> = HashMap::new();
+    for (k, e) in kept.iter().enumerate().rev() {
+        leaving.entry(e.from).or_default().push(k);
+    }
+    let mut used = vec![false; kept.len()];
+    let mut loops = Vec::new();
+    for start in 0..kept.len() {
+        if used[start] {
+            continue;
+        }
+        used[start] = true;
+        let mut contour = vec![kept[start].at];
+        let mut at = kept[start].to;
+        while at != kept[start].from {
+            let next = leaving.get_mut(&at).and_then(|list| {
+                while let Some(k) = list.pop() {
+                    if !used[k] {
+                        return Some(k);
+                    }
+                }
+                None
+            })?;
+            used[next] = true;
+            contour.push(kept[next].at);
+            at = kept[next].to;
+        }
+        loops.push(contour);
+    }
+    Some(loops)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn key(i: u32) -> CornerKey {
+        i
+    }
+
+    fn area(shapes: &[VisibleShape]) -> f64 {
+        shapes.iter().flatten().map(|c| area_2d(c)).sum()
+    }
+
+    fn square(x0: f64, y0: f64, s: f64) -> Vec<DVec2> {
+        vec![
+            DVec2::new(x0, y0),
+            DVec2::new(x0 + s, y0),
+            DVec2::new(x0 + s, y0 + s),
+            DVec2::new(x0, y0 + s),
+        ]
+    }
+
+    /// A 4 x 4 grid of corners, split into 18 triangles (some listed clockwise): the sheet's
+    /// inner edges cancel and its outline is the grid's square.
+    #[test]
+    fn a_welded_sheet_fuses_into_its_outline() {
+        let corner = |i: u32, j: u32| (key(4 * i + j), DVec2::new(i as f64, j as f64) * 0.25);
+        let mut union = ShadowUnion::default();
+        for i in 0..3 {
+            for j in 0..3 {
+                let (a, b, c, d) = (
+                    corner(i, j),
+                    corner(i + 1, j),
+                    corner(i + 1, j + 1),
+                    corner(i, j + 1),
+                );
+                union.add_face(&[a.0, b.0, c.0], &[a.1, b.1, c.1]);
+                // Clockwise on purpose: faces are oriented by their projection.
+                union.add_face(&[a.0, d.0, c.0], &[a.1, d.1, c.1]);
+            }
+        }
+        let loops = outlines(union.sheet.clone()).expect("closes");
+        assert_eq!(loops.len(), 1);
+        assert_eq!(loops[0].len(), 12, "the outline's corners");
+        let visible = union
+            .subtract_from(&square(-0.5, -0.5, 2.0))
+            .expect("finite");
+        assert!((area(&visible) - (4.0 - 0.5625)).abs() < 1e-15);
+    }
+
+    /// Overlapping shadows count once; a shadow reaching past the piece removes only what it
+    /// covers; a hole is counted negative.
+    #[test]
+    fn overlapping_shadows_are_counted_once() {
+        let mut union = ShadowUnion::default();
+        union.add_contour(square(0.0, 0.0, 1.0));
+        union.add_contour(square(0.5, 0.5, 1.0));
+        union.add_contour(square(3.5, 3.5, 1.0));
+        let visible = union
+            .subtract_from(&square(-1.0, -1.0, 5.0))
+            .expect("finite");
+        assert!((area(&visible) - (25.0 - 1.75 - 0.25)).abs() < 1e-13);
+        assert_eq!(visible.len(), 1);
+        assert_eq!(visible[0].len(), 2, "one outline with one hole");
+        assert!(area_2d(&visible[0][1]) < 0.0);
+    }
+
+    #[test]
+    fn non_finite_shadows_are_refused() {
+        let mut union = ShadowUnion::default();
+        union.add_contour(vec![DVec2::ZERO, DVec2::X, DVec2::new(f64::NAN, 1.0)]);
+        assert!(union.subtract_from(&square(0.0, 0.0, 1.0)).is_none());
+    }
+}

@@ -1,0 +1,151 @@
+//! Closed solids among a scene's surfaces: groups of faces that share every edge with exactly
+//! one other face of the group, oriented consistently. Light that reaches a closed solid enters
+//! it through a face turned towards the light's source, so faces turned away can never be the
+//! first thing a ray meets and are skipped as occluders.
+
+use std::collections::HashMap;
+
+use glam::DVec3;
+use penumbra_scenes::Scene;
+
+/// A corner identified by its exact coordinates (faces of a welded mesh share them).
+fn key(p: DVec3) -> [u64; 3] {
+    [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()]
+}
+
+/// For each surface, `Some(sign)` when it is a face of a closed, consistently oriented solid:
+/// its outward normal is `sign` times its own normal. `None` for every other surface.
+pub fn closed_solid_orientation(scene: &Scene) -> Vec<Option<f64>> {
+    let surfaces = &scene.surfaces;
+    // Directed edges by their corners, and the faces that hold them.
+    let mut edges: HashMap<([u64; 3], [u64; 3]), Vec<usize>> = HashMap::new();
+    for (s, surface) in surfaces.iter().enumerate() {
+        let p = &surface.polygon;
+        for i in 0..p.len() {
+            edges
+                .entry((key(p[i]), key(p[(i + 1) % p.len()])))
+                .or_default()
+                .push(s);
+        }
+    }
+    let mut groups = UnionFind::new(surfaces.len());
+    let mut open = vec![false; surfaces.len()];
+    for (&(a, b), faces) in &edges {
+        match (faces.as_slice(), edges.get(&(b, a)).map(Vec::as_slice)) {
+            ([s], Some([t])) => groups.join(*s, *t),
+            _ => faces.iter().for_each(|&s| open[s] = true),
+        }
+    }
+    // A group is closed when none of its faces has an unmatched edge; its signed volume says
+    // which way its faces turn.
+    let mut closed: HashMap<usize, (bool, f64, DVec3)> = HashMap::new();
+    for s in 0..surfaces.len() {
+        let root = groups.find(s);
+        let entry = closed
+            .entry(root)
+            .or_insert((true, 0.0, surfaces[s].polygon[0]));
+        entry.0 &= !open[s];
+        let (origin, p) = (entry.2, &surfaces[s].polygon);
+        for i in 1..p.len().saturating_sub(1) {
+            entry.1 += (p[0] - origin).dot((p[i] - origin).cross(p[i + 1] - origin));
+        }
+    }
+    (0..surfaces.len())
+        .map(|s| {
+            let (is_closed, volume, _) = closed[&groups.find(s)];
+            (is_closed && volume != 0.0).then(|| volume.signum())
+        })
+        .collect()
+}
+
+/// Disjoint sets of surfaces, by path halving.
+struct UnionFind(Vec<usize>);
+
+impl UnionFind {
+    fn new(n: usize) -> UnionFind {
+        UnionFind((0..n).collect())
+    }
+
+    fn find(&mut self, mut i: usize) -> usize {
+        while self.0[i] != i {
+            self.0[i] = self.0[self.0[i]];
+            i = self.0[i];
+        }
+        i
+    }
+
+    fn join(&mut self, a: usize, b: usize) {
+        let (a, b) = (self.find(a), self.find(b));
+        // The smaller root wins, so the grouping does not depend on the order of joins.
+        let (lo, hi) = (a.min(b), a.max(b));
+        self.0[hi] = lo;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use penumbra_scenes::{Rgb, Surface};
+
+    fn cube(flip: bool) -> Vec<Surface> {
+        let c = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
+        let faces = [
+            [c(0., 0., 0.), c(0., 1., 0.), c(1., 1., 0.), c(1., 0., 0.)],
+            [c(0., 0., 1.), c(1., 0., 1.), c(1., 1., 1.), c(0., 1., 1.)],
+            [c(0., 0., 0.), c(1., 0., 0.), c(1., 0., 1.), c(0., 0., 1.)],
+            [c(0., 1., 0.), c(0., 1., 1.), c(1., 1., 1.), c(1., 1., 0.)],
+            [c(0., 0., 0.), c(0., 0., 1.), c(0., 1., 1.), c(0., 1., 0.)],
+            [c(1., 0., 0.), c(1., 1., 0.), c(1., 1., 1.), c(1., 0., 1.)],
+        ];
+        faces
+            .into_iter()
+            .enumerate()
+            .map(|(i, mut f)| {
+                if flip {
+                    f.reverse();
+                }
+                Surface::new(format!("f{i}"), f.to_vec(), Rgb::splat(0.5))
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_closed_cube_is_found_with_its_orientation() {
+        for (flip, sign) in [(false, 1.0), (true, -1.0)] {
+            let mut scene = penumbra_scenes::builtin::textbook();
+            let before = scene.surfaces.len();
+            scene.surfaces.extend(cube(flip));
+            let found = closed_solid_orientation(&scene);
+            assert!(found[..before].iter().all(Option::is_none));
+            assert!(
+                found[before..].iter().all(|&o| o == Some(sign)),
+                "{found:?}"
+            );
+            // Outward normals point away from the centre.
+            for (s, o) in scene.surfaces[before..].iter().zip(&found[before..]) {
+                let outward = s.normal() * o.unwrap_or(0.0);
+                let centre = DVec3::splat(0.5);
+                assert!(outward.dot(s.polygon[0] - centre) > 0.0);
+            }
+        }
+    }
+
+    #[test]
+    fn an_open_box_or_an_inconsistent_one_is_not_closed() {
+        let mut open = penumbra_scenes::builtin::textbook();
+        let mut faces = cube(false);
+        faces.pop();
+        open.surfaces.extend(faces);
+        assert!(closed_solid_orientation(&open).iter().all(Option::is_none));
+
+        let mut inconsistent = penumbra_scenes::builtin::textbook();
+        let mut faces = cube(false);
+        faces[2].polygon.reverse();
+        inconsistent.surfaces.extend(faces);
+        assert!(
+            closed_solid_orientation(&inconsistent)
+                .iter()
+                .all(Option::is_none)
+        );
+    }
+}
