@@ -14,7 +14,7 @@ use penumbra::outputs::write_outputs;
 use penumbra::progress_bar::Bars;
 use penumbra::{DEFAULT_MAX_ELEMENTS, MeshMethod, RunOptions};
 use penumbra_meshing::grading::DEFAULT_PENUMBRA_DENSITY;
-use penumbra_scenes::{builtin, load_scene};
+use penumbra_scenes::{ObjOptions, SceneError, builtin, load_scene_with};
 use penumbra_solver::progressive::DEFAULT_EPSILON;
 use penumbra_solver::{Interrupt, SolverOptions};
 
@@ -43,6 +43,10 @@ enum Command {
     Check {
         /// A .json or .obj file, or the name of a built-in scene.
         scene: String,
+        /// OBJ files: keep every face as its own surface (by default coplanar adjacent faces of
+        /// one material are merged where the union is a simple polygon).
+        #[arg(long)]
+        no_merge: bool,
     },
 }
 
@@ -101,6 +105,10 @@ impl From<IndirectArg> for penumbra_solver::estimate::IndirectEstimate {
 struct RunArgs {
     /// A .json or .obj file, or the name of a built-in scene (see `penumbra scenes`).
     scene: String,
+    /// OBJ files: keep every face as its own surface (by default coplanar adjacent faces of one
+    /// material are merged where the union is a simple polygon).
+    #[arg(long)]
+    no_merge: bool,
     /// Output directory.
     #[arg(long, default_value = "out")]
     out: PathBuf,
@@ -322,7 +330,7 @@ fn dispatch(cli: Cli) -> Result<ExitCode, Failure> {
                 println!("{name:<10} {description}");
             }
         }
-        Command::Check { scene } => check(&scene)?,
+        Command::Check { scene, no_merge } => check(&scene, obj_options(no_merge))?,
         Command::Run(args) => return run(&args),
         Command::Sweep(args) => sweep(&args)?,
         Command::FormFactors(args) => form_factors(&args)?,
@@ -389,7 +397,7 @@ fn sweep(args: &SweepArgs) -> Result<(), Failure> {
             args.initial_fraction
         )));
     }
-    let loaded = load(&args.scene)?;
+    let loaded = load(&args.scene, ObjOptions::default())?;
     let mut surfaces = Vec::new();
     for name in &args.surfaces {
         surfaces.push(loaded.scene.surface_id(name).ok_or_else(|| {
@@ -561,13 +569,27 @@ fn traced_reference(
     Ok(cached.values)
 }
 
-fn load(spec: &str) -> Result<penumbra_scenes::LoadedScene, Failure> {
-    // Every scene error (unreadable, malformed, invalid) is the input's: exit code 2.
-    load_scene(spec).map_err(usage)
+fn obj_options(no_merge: bool) -> ObjOptions {
+    ObjOptions {
+        merge_coplanar: !no_merge,
+    }
 }
 
-fn check(spec: &str) -> Result<(), Failure> {
-    let loaded = load(spec)?;
+fn load(spec: &str, options: ObjOptions) -> Result<penumbra_scenes::LoadedScene, Failure> {
+    // Every scene error (unreadable, malformed, invalid) is the input's: exit code 2.
+    load_scene_with(spec, &options).map_err(|e| {
+        // What loading repaired often explains what validation then refused.
+        if let SceneError::Invalid { warnings, .. } = &e {
+            for w in warnings {
+                eprintln!("warning: {w}");
+            }
+        }
+        usage(e)
+    })
+}
+
+fn check(spec: &str, options: ObjOptions) -> Result<(), Failure> {
+    let loaded = load(spec, options)?;
     for w in &loaded.warnings {
         eprintln!("warning: {w}");
     }
@@ -632,7 +654,7 @@ fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
             "--width and --height must be at least 1"
         )));
     }
-    let loaded = load(&args.scene)?;
+    let loaded = load(&args.scene, obj_options(args.no_merge))?;
     if !args.quiet {
         for w in &loaded.warnings {
             eprintln!("warning: {w}");

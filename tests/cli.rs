@@ -782,3 +782,48 @@ fn the_memory_estimate_bounds_the_peak() {
         }
     }
 }
+
+/// `penumbra check` on OBJ files: repairs and merges are reported, `--no-merge` keeps every face,
+/// and when validation refuses a scene the repairs come first, before the problems.
+#[test]
+fn check_reports_obj_repairs_even_when_the_scene_is_refused() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    std::fs::write(
+        dir.path().join("m.mtl"),
+        "newmtl white\nKd 0.7 0.7 0.7\nnewmtl lamp\nKd 0 0 0\nKe 5 5 5\n",
+    )
+    .expect("write mtl");
+    // A floor of two triangles under a lamp, and a face with no area.
+    let lit = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 0 0 1\nv 0 1 1\nv 1 1 1\n\
+        o floor\nusemtl white\nf 1 2 3\nf 1 3 4\nf 1 2 5\n\
+        o lamp\nusemtl lamp\nf 6 7 8\n";
+    let scene = dir.path().join("lit.obj");
+    std::fs::write(&scene, lit).expect("write obj");
+    let path = scene.to_str().expect("utf-8");
+    let o = penumbra(&["check", path]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("warning: dropped 1 faces with zero area (first: floor/white/2 at line 14)"),
+        "{err}"
+    );
+    assert!(
+        err.contains("warning: merged 2 coplanar faces into 1 surfaces"),
+        "{err}"
+    );
+    assert!(String::from_utf8_lossy(&o.stdout).contains("2 surfaces, 1 emitting"));
+    let o = penumbra(&["check", "--no-merge", path]);
+    assert!(String::from_utf8_lossy(&o.stdout).contains("3 surfaces, 1 emitting"));
+
+    // Without the lamp the scene is refused, and the repair is still reported, first.
+    let dark = dir.path().join("dark.obj");
+    std::fs::write(&dark, lit.replace("usemtl lamp", "usemtl white")).expect("write obj");
+    let o = penumbra(&["check", dark.to_str().expect("utf-8")]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    let warning = err
+        .find("warning: dropped 1 faces")
+        .expect("the repair is reported");
+    let error = err.find("error:").expect("the refusal is reported");
+    assert!(warning < error && err.contains("no surface emits"), "{err}");
+}

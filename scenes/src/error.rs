@@ -38,5 +38,8 @@ pub enum SceneError {
     Invalid {
         source_name: String,
         problems: Vec<Problem>,
+        /// What loading repaired before validation refused the scene (OBJ only), one line each:
+        /// often the explanation of the problems, so callers should show them first.
+        warnings: Vec<String>,
     },
 }

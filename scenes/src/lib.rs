@@ -19,6 +19,7 @@
 pub mod builtin;
 pub mod cie;
 pub mod color;
+pub mod coplanar;
 pub mod error;
 pub mod extremes;
 pub mod frame;
@@ -35,7 +36,8 @@ pub mod visibility;
 pub use color::Rgb;
 pub use error::SceneError;
 pub use frame::PlaneFrame;
-pub use load::{LoadedScene, load_scene};
+pub use load::{LoadedScene, load_scene, load_scene_with};
 pub use model::{Bounds, Camera, Scene, Surface, SurfaceId};
+pub use obj::ObjOptions;
 pub use validate::{Problem, ProblemKind, validate};
 pub use visibility::{CONTACT_TOLERANCE, Hit, SceneTriangle, Visibility};

@@ -7,7 +7,7 @@ use glam::DVec3;
 use crate::builtin;
 use crate::error::SceneError;
 use crate::model::Scene;
-use crate::obj;
+use crate::obj::{self, ObjOptions};
 use crate::validate::validate;
 
 /// A validated scene and what loading it had to repair.
@@ -23,6 +23,12 @@ pub struct LoadedScene {
 /// Loads `spec` — a path to a `.json` or `.obj` file, or the name of a built-in scene — and
 /// validates it. Every problem is reported at once.
 pub fn load_scene(spec: &str) -> Result<LoadedScene, SceneError> {
+    load_scene_with(spec, &ObjOptions::default())
+}
+
+/// [`load_scene`] with choices for OBJ files. When validation refuses the scene, the error
+/// carries the loader's warnings too: they often explain the problems.
+pub fn load_scene_with(spec: &str, options: &ObjOptions) -> Result<LoadedScene, SceneError> {
     let path = Path::new(spec);
     // A file that exists wins; then a built-in name (some have dots: "cie-5.3"); then anything
     // that looks like a path is read as one, for its error.
@@ -37,7 +43,7 @@ pub fn load_scene(spec: &str) -> Result<LoadedScene, SceneError> {
     let (scene, source, warnings) = if let Some(scene) = builtin_scene {
         (scene, format!("builtin:{spec}"), Vec::new())
     } else if path.exists() || looks_like_path {
-        let (scene, warnings) = read_scene_file(path)?;
+        let (scene, warnings) = read_scene_file_with(path, options)?;
         (scene, path.display().to_string(), warnings)
     } else {
         return Err(SceneError::UnknownScene {
@@ -50,6 +56,7 @@ pub fn load_scene(spec: &str) -> Result<LoadedScene, SceneError> {
         return Err(SceneError::Invalid {
             source_name: source,
             problems,
+            warnings,
         });
     }
     Ok(LoadedScene {
@@ -61,6 +68,14 @@ pub fn load_scene(spec: &str) -> Result<LoadedScene, SceneError> {
 
 /// Reads a scene file without validating it.
 pub fn read_scene_file(path: &Path) -> Result<(Scene, Vec<String>), SceneError> {
+    read_scene_file_with(path, &ObjOptions::default())
+}
+
+/// Reads a scene file without validating it, with choices for OBJ files.
+pub fn read_scene_file_with(
+    path: &Path,
+    options: &ObjOptions,
+) -> Result<(Scene, Vec<String>), SceneError> {
     let extension = path
         .extension()
         .and_then(|e| e.to_str())
@@ -74,7 +89,7 @@ pub fn read_scene_file(path: &Path) -> Result<(Scene, Vec<String>), SceneError> 
             let scene = parse_json(&text, path)?;
             Ok((scene, Vec::new()))
         }
-        Some("obj") => obj::read_obj(path),
+        Some("obj") => obj::read_obj_with(path, options),
         _ => Err(SceneError::UnsupportedFormat {
             path: path.to_path_buf(),
         }),

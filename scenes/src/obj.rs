@@ -1,32 +1,96 @@
-//! OBJ+MTL import: each face becomes a surface, `Kd` its reflectance and `Ke` its emission.
+//! OBJ+MTL import: faces become surfaces, `Kd` their reflectance and `Ke` their emission.
 //!
 //! Exported meshes are rarely clean. Repairs that cannot change the lighting are made and listed
-//! as warnings: repeated vertices are merged, zero-area faces dropped, and non-planar faces split
-//! into triangles. Anything else is left for validation to report.
+//! as warnings that say how many faces each touched and name the first few (by surface name
+//! and line): repeated corners are dropped, faces that touch themselves are cut into loops,
+//! faces with no area dropped, and non-planar faces split into triangles ([`repair`]). Then
+//! coplanar adjacent faces of one material are merged into single surfaces where that is exact
+//! ([`crate::coplanar`]), unless [`ObjOptions::merge_coplanar`] is off. Anything else is left
+//! for validation to report.
+//!
+//! Faces are named `object/material/index` ([`faces`]); a merged surface takes the name of its
+//! first face, and a face cut into pieces names them `name.0`, `name.1`, ...
 
-use std::path::Path;
+mod faces;
+mod repair;
+mod source_lines;
+mod tally;
 
-use glam::DVec3;
+use std::cell::RefCell;
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
 
 use crate::color::Rgb;
+use crate::coplanar::merge_coplanar;
 use crate::error::SceneError;
-use crate::model::{Scene, Surface};
-use crate::polygon;
-use crate::validate::{MIN_THINNESS, PLANARITY_TOLERANCE};
+use crate::model::{Bounds, Scene, Surface};
+use faces::collect_faces;
+use repair::{Face, Repairs, repair_face};
+use source_lines::SourceLines;
+use tally::{FaceSource, Tally, thousands};
 
 /// Reflectance of faces without a material.
 pub const DEFAULT_REFLECTANCE: f64 = 0.5;
 
-/// Reads an OBJ file and the MTL files it names (beside it).
+/// Choices in reading OBJ files.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ObjOptions {
+    /// Merge coplanar adjacent faces of one material into single surfaces where the union is a
+    /// simple polygon (on by default). Off, every face is a surface.
+    pub merge_coplanar: bool,
+}
+
+impl Default for ObjOptions {
+    fn default() -> Self {
+        ObjOptions {
+            merge_coplanar: true,
+        }
+    }
+}
+
+/// Reads an OBJ file and the MTL files it names (beside it), with the default options.
 pub fn read_obj(path: &Path) -> Result<(Scene, Vec<String>), SceneError> {
-    let file = std::fs::File::open(path).map_err(|source| SceneError::Io {
+    read_obj_with(path, &ObjOptions::default())
+}
+
+/// Reads an OBJ file and the MTL files it names, looked for beside it.
+pub fn read_obj_with(
+    path: &Path,
+    options: &ObjOptions,
+) -> Result<(Scene, Vec<String>), SceneError> {
+    let bytes = std::fs::read(path).map_err(|source| SceneError::Io {
         path: path.to_path_buf(),
         source,
     })?;
     let dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
-    parse_obj(&mut std::io::BufReader::new(file), path, |mtl| {
-        let text = std::fs::read(dir.join(mtl)).map_err(|_| tobj::LoadError::OpenFileFailed)?;
-        load_mtl(&String::from_utf8_lossy(&text))
+    // Names in comments are often in a legacy encoding; they need not stop the import.
+    let text = String::from_utf8_lossy(&bytes);
+    parse(&text, path, options, |library| {
+        let looked_for = dir.join(library);
+        let text = std::fs::read(&looked_for).map(|b| String::from_utf8_lossy(&b).into_owned());
+        (looked_for, text)
+    })
+}
+
+/// Parses OBJ text with the default options; every `mtllib` it names reads as `mtl`. `path` only
+/// names the source.
+pub fn parse_obj_text(
+    obj: &str,
+    mtl: &str,
+    path: &Path,
+) -> Result<(Scene, Vec<String>), SceneError> {
+    parse_obj_text_with(obj, mtl, path, &ObjOptions::default())
+}
+
+/// Parses OBJ text; every `mtllib` it names reads as `mtl`. `path` only names the source.
+pub fn parse_obj_text_with(
+    obj: &str,
+    mtl: &str,
+    path: &Path,
+    options: &ObjOptions,
+) -> Result<(Scene, Vec<String>), SceneError> {
+    parse(obj, path, options, |library| {
+        (library.to_path_buf(), Ok(mtl.to_string()))
     })
 }
 
@@ -42,135 +106,126 @@ fn load_mtl(text: &str) -> tobj::MTLLoadResult {
     tobj::load_mtl_buf(&mut text.as_bytes())
 }
 
-/// Parses OBJ text; every `mtllib` it names reads as `mtl`. `path` only names the source.
-pub fn parse_obj_text(
-    obj: &str,
-    mtl: &str,
+/// Reads `text`; `read_library` gives, for a name in `mtllib`, the path it looked for and the
+/// library's text.
+fn parse(
+    text: &str,
     path: &Path,
+    options: &ObjOptions,
+    read_library: impl Fn(&Path) -> (PathBuf, std::io::Result<String>),
 ) -> Result<(Scene, Vec<String>), SceneError> {
-    parse_obj(&mut obj.as_bytes(), path, |_| load_mtl(mtl))
-}
-
-fn parse_obj(
-    reader: &mut impl std::io::BufRead,
-    path: &Path,
-    load_mtl: impl Fn(&Path) -> tobj::MTLLoadResult,
-) -> Result<(Scene, Vec<String>), SceneError> {
-    let options = tobj::LoadOptions {
+    let lines = SourceLines::scan(text);
+    let library_warnings = RefCell::new(Vec::new());
+    let load_library = |library: &Path| {
+        let (looked_for, read) = read_library(library);
+        let at = lines
+            .libraries
+            .get(library.to_string_lossy().as_ref())
+            .map(|line| format!(" (mtllib at line {line})"))
+            .unwrap_or_default();
+        let consequence = format!(
+            "faces with its materials get reflectance {DEFAULT_REFLECTANCE} and no emission"
+        );
+        let result = read.map_err(|e| {
+            library_warnings
+                .borrow_mut()
+                .push(if e.kind() == std::io::ErrorKind::NotFound {
+                    format!(
+                        "material library not found: looked for {}{at}; {consequence}",
+                        looked_for.display()
+                    )
+                } else {
+                    format!(
+                        "cannot read material library {}{at}: {e}; {consequence}",
+                        looked_for.display()
+                    )
+                });
+            tobj::LoadError::OpenFileFailed
+        })?;
+        load_mtl(&result).inspect_err(|e| {
+            library_warnings.borrow_mut().push(format!(
+                "materials could not be read from {}{at} ({e}); {consequence}",
+                looked_for.display()
+            ));
+        })
+    };
+    let load_options = tobj::LoadOptions {
         triangulate: false,
         single_index: true,
         ignore_points: true,
         ignore_lines: true,
     };
-    let (models, materials) =
-        tobj::load_obj_buf(reader, &options, load_mtl).map_err(|e| SceneError::Obj {
+    let (models, materials) = tobj::load_obj_buf(&mut text.as_bytes(), &load_options, load_library)
+        .map_err(|e| SceneError::Obj {
             path: path.to_path_buf(),
             message: format!("{e}; check the file is a valid OBJ"),
         })?;
-    let mut warnings = Vec::new();
-    let materials = materials.unwrap_or_else(|e| {
-        warnings.push(format!(
-            "materials could not be read ({e}); faces get reflectance {DEFAULT_REFLECTANCE} and no emission"
-        ));
-        Vec::new()
-    });
+    let mut warnings = library_warnings.into_inner();
+    // tobj reports a library error only when no library loaded; it is already a warning above.
+    let materials = materials.unwrap_or_default();
+    warnings.extend(undefined_materials(&lines, &materials));
 
-    let mut faces = Vec::new();
-    let mut missing_material = 0usize;
-    for model in &models {
-        let mesh = &model.mesh;
-        let position = |i: u32| {
-            let i = i as usize * 3;
-            DVec3::new(
-                mesh.positions[i],
-                mesh.positions[i + 1],
-                mesh.positions[i + 2],
-            )
-        };
-        let (reflectance, emission) = match mesh.material_id.and_then(|m| materials.get(m)) {
-            Some(m) => (
-                m.diffuse
-                    .map(Rgb::from)
-                    .unwrap_or(Rgb::splat(DEFAULT_REFLECTANCE)),
-                m.emissive.map(Rgb::from).unwrap_or(Rgb::ZERO),
-            ),
-            None => {
-                missing_material += 1;
-                (Rgb::splat(DEFAULT_REFLECTANCE), Rgb::ZERO)
-            }
-        };
-        let arities: Vec<usize> = if mesh.face_arities.is_empty() {
-            vec![3; mesh.indices.len() / 3]
-        } else {
-            mesh.face_arities.iter().map(|&a| a as usize).collect()
-        };
-        let mut start = 0;
-        for (face_index, arity) in arities.into_iter().enumerate() {
-            let Some(indices) = mesh.indices.get(start..start + arity) else {
-                break;
-            };
-            start += arity;
-            let name = if model.name.is_empty() {
-                format!("face{face_index}")
-            } else {
-                format!("{}/{face_index}", model.name)
-            };
-            faces.push((
-                name,
-                indices.iter().map(|&i| position(i)).collect::<Vec<_>>(),
-                reflectance,
-                emission,
-            ));
-        }
-    }
-    if missing_material > 0 {
-        warnings.push(format!(
-            "{missing_material} object(s) have no material; they get reflectance {DEFAULT_REFLECTANCE} and no emission"
-        ));
-    }
+    let collected = collect_faces(&models, &materials, &lines);
+    warnings.extend(collected.without_material.describe(
+        "",
+        &format!(
+            "faces have no material; they get reflectance {DEFAULT_REFLECTANCE} and no emission"
+        ),
+    ));
+    warnings.extend(collected.polylines.describe(
+        "ignored",
+        "polylines (`l` statements; they are lines, not surfaces)",
+    ));
+    let scene_diagonal = Bounds::from_points(
+        collected
+            .faces
+            .iter()
+            .filter(|f| f.polygon.iter().all(|p| p.is_finite()))
+            .flat_map(|f| &f.polygon),
+    )
+    .diagonal();
+    let mut repairs = Repairs::default();
+    let faces: Vec<Face> = collected
+        .faces
+        .into_iter()
+        .flat_map(|f| repair_face(f, scene_diagonal, &mut repairs))
+        .collect();
+    warnings.extend(repairs.warnings());
 
-    let mut surfaces = Vec::new();
-    let (mut merged, mut dropped, mut split) = (0usize, 0usize, 0usize);
-    for (name, mut polygon, reflectance, emission) in faces {
-        let before = polygon.len();
-        crate::load::drop_repeated_vertices(&mut polygon);
-        merged += before - polygon.len();
-        let diameter = polygon::diameter(&polygon);
-        let area = 0.5 * polygon::newell_normal(&polygon).length();
-        if polygon.len() < 3 || !(area >= MIN_THINNESS * diameter * diameter) {
-            dropped += 1;
-            continue;
+    let material_of = |face: &Face| match face.material.and_then(|m| materials.get(m)) {
+        Some(m) => (
+            m.diffuse
+                .map(Rgb::from)
+                .unwrap_or(Rgb::splat(DEFAULT_REFLECTANCE)),
+            m.emissive.map(Rgb::from).unwrap_or(Rgb::ZERO),
+        ),
+        None => (Rgb::splat(DEFAULT_REFLECTANCE), Rgb::ZERO),
+    };
+    let surfaces = if options.merge_coplanar {
+        let (surfaces, summary) = merged_surfaces(&faces, scene_diagonal, material_of);
+        warnings.extend(summary);
+        surfaces
+    } else {
+        if !faces.is_empty() {
+            warnings.push(
+                "coplanar faces were not merged (merging is off): every face is a surface".into(),
+            );
         }
-        let pieces = if is_planar(&polygon, diameter) {
-            vec![polygon]
-        } else {
-            split += 1;
-            split_into_triangles(&polygon)
-        };
-        let count = pieces.len();
-        for (k, piece) in pieces.into_iter().enumerate() {
-            let name = if count == 1 {
-                name.clone()
-            } else {
-                format!("{name}.{k}")
-            };
-            surfaces.push(Surface {
-                name,
-                polygon: piece,
-                emission,
-                reflectance,
-            });
-        }
-    }
-    if merged > 0 {
-        warnings.push(format!("merged {merged} repeated vertices"));
-    }
-    if dropped > 0 {
-        warnings.push(format!("dropped {dropped} faces with zero area"));
-    }
-    if split > 0 {
-        warnings.push(format!("split {split} non-planar faces into triangles"));
-    }
+        faces
+            .iter()
+            .map(|f| {
+                let (reflectance, emission) = material_of(f);
+                Surface {
+                    name: f.source.name.clone(),
+                    polygon: f.polygon.clone(),
+                    emission,
+                    reflectance,
+                }
+            })
+            .collect()
+    };
+    let (surfaces, renamed) = unique_names(surfaces);
+    warnings.extend(renamed);
     let name = path
         .file_stem()
         .and_then(|s| s.to_str())
@@ -186,29 +241,98 @@ fn parse_obj(
     ))
 }
 
-fn is_planar(polygon: &[DVec3], diameter: f64) -> bool {
-    let normal = polygon::newell_normal(polygon).normalize_or_zero();
-    let centroid = polygon::centroid(polygon);
-    polygon
-        .iter()
-        .all(|&p| (p - centroid).dot(normal).abs() <= PLANARITY_TOLERANCE * diameter)
+/// Materials `usemtl` selects that no library defines, as one warning.
+fn undefined_materials(lines: &SourceLines, materials: &[tobj::Material]) -> Option<String> {
+    let defined: HashSet<&str> = materials.iter().map(|m| m.name.as_str()).collect();
+    let mut undefined = Tally::default();
+    for (name, line) in &lines.materials_used {
+        if !defined.contains(name.as_str()) {
+            undefined.note(&FaceSource {
+                name: format!("\"{name}\""),
+                line: Some(*line),
+            });
+        }
+    }
+    undefined.describe(
+        "",
+        &format!(
+            "materials are used but defined in no material library; their faces get reflectance \
+             {DEFAULT_REFLECTANCE} and no emission"
+        ),
+    )
 }
 
-/// A fan from the vertex that gives the most even triangles; for quads, the shorter diagonal.
-fn split_into_triangles(polygon: &[DVec3]) -> Vec<Vec<DVec3>> {
-    let n = polygon.len();
-    let apex = if n == 4 && polygon[1].distance(polygon[3]) < polygon[0].distance(polygon[2]) {
-        1
-    } else {
-        0
-    };
-    (1..n - 1)
-        .map(|k| {
-            vec![
-                polygon[apex],
-                polygon[(apex + k) % n],
-                polygon[(apex + k + 1) % n],
-            ]
+/// The surfaces of `faces` with coplanar neighbours of one material merged, and a line saying
+/// what was merged.
+fn merged_surfaces(
+    faces: &[Face],
+    scene_diagonal: f64,
+    material_of: impl Fn(&Face) -> (Rgb, Rgb),
+) -> (Vec<Surface>, Option<String>) {
+    let polygons: Vec<_> = faces.iter().map(|f| f.polygon.clone()).collect();
+    let groups: Vec<usize> = faces
+        .iter()
+        .map(|f| f.material.map_or(0, |m| m + 1))
+        .collect();
+    let (pieces, summary) = merge_coplanar(&polygons, &groups, scene_diagonal);
+    let surfaces = pieces
+        .into_iter()
+        .filter_map(|piece| {
+            let first = &faces[*piece.faces.first()?];
+            let (reflectance, emission) = material_of(first);
+            Some(Surface {
+                name: first.source.name.clone(),
+                polygon: piece.polygon,
+                emission,
+                reflectance,
+            })
         })
-        .collect()
+        .collect();
+    let line = (summary.merged_faces > 0).then(|| {
+        let mut line = format!(
+            "merged {} coplanar faces into {} surfaces",
+            thousands(summary.merged_faces),
+            thousands(summary.merged_surfaces)
+        );
+        if summary.split_regions > 0 {
+            line += &format!(
+                "; {} regions of coplanar faces stay in several pieces (one polygon would have holes or \
+                 touch itself)",
+                thousands(summary.split_regions)
+            );
+        }
+        line
+    });
+    (surfaces, line)
+}
+
+/// Surfaces with unique names: a name already taken (object or material names with `/` can
+/// collide) gets `#2`, `#3`, ... appended.
+fn unique_names(mut surfaces: Vec<Surface>) -> (Vec<Surface>, Option<String>) {
+    let mut taken: HashSet<String> = surfaces.iter().map(|s| s.name.clone()).collect();
+    if taken.len() == surfaces.len() {
+        return (surfaces, None);
+    }
+    let mut seen: HashSet<String> = HashSet::new();
+    let mut renamed = Tally::default();
+    for surface in &mut surfaces {
+        if seen.insert(surface.name.clone()) {
+            continue;
+        }
+        let mut k = 2;
+        while taken.contains(&format!("{}#{k}", surface.name)) {
+            k += 1;
+        }
+        surface.name = format!("{}#{k}", surface.name);
+        taken.insert(surface.name.clone());
+        seen.insert(surface.name.clone());
+        renamed.note(&FaceSource {
+            name: surface.name.clone(),
+            line: None,
+        });
+    }
+    (
+        surfaces,
+        renamed.describe("renamed", "surfaces whose names were taken"),
+    )
 }

@@ -235,52 +235,52 @@ fn check_material(surface: &Surface, report: &mut impl FnMut(ProblemKind)) {
 }
 
 fn check_geometry(surface: &Surface, scene_diagonal: f64, report: &mut impl FnMut(ProblemKind)) {
-    let points = &surface.polygon;
+    if let Some(kind) = polygon_problem(&surface.polygon, scene_diagonal) {
+        report(kind);
+    }
+}
+
+/// The first thing wrong with a polygon as a surface of a scene whose bounding-box diagonal is
+/// `scene_diagonal`, or `None` when it is a valid surface. Importers call it to make sure a
+/// polygon they build (a merged or repaired face) will pass validation.
+pub fn polygon_problem(points: &[DVec3], scene_diagonal: f64) -> Option<ProblemKind> {
     if points.iter().any(|p| !p.is_finite()) {
-        report(ProblemKind::NonFinite { field: "polygon" });
-        return;
+        return Some(ProblemKind::NonFinite { field: "polygon" });
     }
     let same = SAME_POINT_TOLERANCE * scene_diagonal;
     let mut distinct: Vec<DVec3> = Vec::new();
     for &p in points {
-        if distinct.iter().all(|&q| q.distance(p) > same) {
+        if distinct.len() < 3 && distinct.iter().all(|&q| q.distance(p) > same) {
             distinct.push(p);
         }
     }
     if distinct.len() < 3 {
-        report(ProblemKind::TooFewVertices {
+        return Some(ProblemKind::TooFewVertices {
             distinct: distinct.len(),
         });
-        return;
     }
     for i in 0..points.len() {
         for j in i + 1..points.len() {
             if points[i].distance(points[j]) <= same {
-                report(ProblemKind::RepeatedVertex {
+                return Some(ProblemKind::RepeatedVertex {
                     first: i,
                     second: j,
                 });
-                return;
             }
         }
     }
     let diameter = polygon::diameter(points);
-    let area = surface.area();
+    let area = 0.5 * polygon::newell_normal(points).length();
+    let tiny = ProblemKind::TinyArea {
+        area,
+        diameter,
+        scene_diagonal,
+    };
     if diameter < MIN_RELATIVE_SIZE * scene_diagonal || area < MIN_THINNESS * diameter * diameter {
-        report(ProblemKind::TinyArea {
-            area,
-            diameter,
-            scene_diagonal,
-        });
-        return;
+        return Some(tiny);
     }
     let Some(frame) = PlaneFrame::of_polygon(points) else {
-        report(ProblemKind::TinyArea {
-            area,
-            diameter,
-            scene_diagonal,
-        });
-        return;
+        return Some(tiny);
     };
     // Distances are measured from the best-fit plane through the centroid, not the first vertex.
     let centroid = polygon::centroid(points);
@@ -292,17 +292,15 @@ fn check_geometry(surface: &Surface, scene_diagonal: f64, report: &mut impl FnMu
         .max_by(|a, b| a.1.total_cmp(&b.1))
         .filter(|&(_, d)| d > tolerance)
     {
-        report(ProblemKind::NonPlanar {
+        return Some(ProblemKind::NonPlanar {
             deviation,
             vertex,
             tolerance,
         });
-        return;
     }
     let flat: Vec<_> = points.iter().map(|&p| frame.to_2d(p)).collect();
-    if let Some((edge_a, edge_b)) = polygon::first_self_intersection(&flat) {
-        report(ProblemKind::SelfIntersecting { edge_a, edge_b });
-    }
+    polygon::first_self_intersection(&flat)
+        .map(|(edge_a, edge_b)| ProblemKind::SelfIntersecting { edge_a, edge_b })
 }
 
 fn camera_problem(c: &crate::model::Camera) -> Option<&'static str> {

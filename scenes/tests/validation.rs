@@ -229,6 +229,7 @@ fn every_problem_is_reported_at_once() {
     let err = SceneError::Invalid {
         source_name: "x.json".into(),
         problems,
+        warnings: Vec::new(),
     };
     let text = err.to_string();
     assert!(text.starts_with("x.json: 5 problems:"), "{text}");
@@ -298,9 +299,9 @@ fn obj_import_maps_materials_and_repairs_faces() {
     std::fs::write(&path, obj).expect("write obj");
     let loaded = load_scene(path.to_str().expect("utf-8 path")).expect("loads");
     let s = &loaded.scene;
-    let floor = &s.surfaces[s.surface_id("floor/0").expect("floor face")];
+    let floor = &s.surfaces[s.surface_id("floor/white/0").expect("floor face")];
     assert_eq!(floor.reflectance, Rgb::new(0.7, 0.7, 0.7));
-    let lamp = &s.surfaces[s.surface_id("lamp/0").expect("lamp face")];
+    let lamp = &s.surfaces[s.surface_id("lamp/lamp/0").expect("lamp face")];
     assert_eq!(lamp.emission, Rgb::splat(5.0));
     assert!(lamp.normal().z < -0.99, "the lamp faces down");
     // The collinear face is dropped; the non-planar quad becomes two triangles.
