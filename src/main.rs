@@ -169,6 +169,11 @@ struct RunArgs {
     /// Discontinuity meshes: leave out EEE events (emitter edge with two blocker edges).
     #[arg(long)]
     no_eee: bool,
+    /// Discontinuity meshes: blockers (flat patches of faces) that can hide less than this
+    /// fraction of a light from a receiver start no events there; adaptive refinement and the
+    /// penumbra grading mesh their shadows instead.
+    #[arg(long, default_value_t = penumbra_meshing::discontinuity::DEFAULT_EVENT_TOLERANCE)]
+    event_tol: f64,
     /// Stop shooting when the unshot power is below this fraction of the emitted power.
     #[arg(long, default_value_t = DEFAULT_EPSILON)]
     epsilon: f64,
@@ -649,6 +654,12 @@ fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
             "--memory-limit must be a positive number of MiB, not {mib}"
         )));
     }
+    if !(0.0..=1.0).contains(&args.event_tol) {
+        return Err(usage(anyhow::anyhow!(
+            "--event-tol must be a fraction between 0 and 1, not {}",
+            args.event_tol
+        )));
+    }
     if args.width == 0 || args.height == 0 {
         return Err(usage(anyhow::anyhow!(
             "--width and --height must be at least 1"
@@ -684,6 +695,7 @@ fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
             }),
         discontinuity: penumbra_meshing::discontinuity::DiscontinuityOptions {
             eee: !args.no_eee,
+            event_tolerance: args.event_tol,
             ..Default::default()
         },
         solver: SolverOptions {

@@ -118,6 +118,7 @@ struct Method {
     penumbra_density: f64,
     eee: bool,
     eee_tolerance: f64,
+    event_tolerance: f64,
     /// Seconds the run was allowed (absent: no limit).
     #[serde(skip_serializing_if = "Option::is_none")]
     time_budget: Option<f64>,
@@ -187,6 +188,7 @@ pub fn report_json(result: &RunResult) -> String {
             penumbra_density: opts.penumbra_density,
             eee: opts.discontinuity.eee,
             eee_tolerance: opts.discontinuity.eee_tolerance,
+            event_tolerance: opts.discontinuity.event_tolerance,
             time_budget: opts.time_budget,
             epsilon: opts.solver.epsilon,
             max_shots: opts.solver.max_shots,

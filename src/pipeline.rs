@@ -241,6 +241,7 @@ pub fn run(
             scene,
             &visibility,
             &DiscontinuityOptions {
+                element_area: Some(scene.total_area() / options.max_elements.max(1) as f64),
                 deadline: solver.deadline,
                 interrupt: options.solver.interrupt.clone(),
                 ..options.discontinuity.clone()

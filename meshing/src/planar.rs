@@ -46,3 +46,24 @@ pub fn clip_segment(a: DVec2, b: DVec2, polygon: &[DVec2]) -> Vec<[f64; 2]> {
         .map(|w| [w[0], w[1]])
         .collect()
 }
+
+/// The point of a polygon (inside or on its outline) nearest to `p`.
+pub fn closest_point_in_polygon(polygon: &[DVec2], p: DVec2) -> DVec2 {
+    if polygon.len() < 3 || inside_polygon(p, polygon) {
+        return p;
+    }
+    let n = polygon.len();
+    (0..n)
+        .map(|i| {
+            let (a, b) = (polygon[i], polygon[(i + 1) % n]);
+            let d = b - a;
+            let t = if d == DVec2::ZERO {
+                0.0
+            } else {
+                ((p - a).dot(d) / d.length_squared()).clamp(0.0, 1.0)
+            };
+            a + d * t
+        })
+        .min_by(|x, y| x.distance_squared(p).total_cmp(&y.distance_squared(p)))
+        .unwrap_or(p)
+}

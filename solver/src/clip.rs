@@ -171,6 +171,38 @@ pub fn clip_half_plane(polygon: &[DVec2], h: &HalfPlane) -> Vec<DVec2> {
     out
 }
 
+/// Edges of a convex polygon shorter than this fraction of its longest edge are rounding
+/// leftovers (a corner repeated a few ulps away): their direction means nothing, so they cut
+/// nothing.
+const DEGENERATE_EDGE: f64 = 1e-9;
+
+/// The part of a closed contour inside a convex counter-clockwise polygon (Sutherland–Hodgman,
+/// which keeps the contour's winding inside), or `None` when none is.
+pub fn clip_to_convex(contour: &[DVec2], convex: &[DVec2]) -> Option<Vec<DVec2>> {
+    let n = convex.len();
+    let edge = |i: usize| convex[(i + 1) % n] - convex[i];
+    let longest = (0..n).map(|i| edge(i).length()).fold(0.0, f64::max);
+    let mut out = contour.to_vec();
+    for i in 0..n {
+        let (a, d) = (convex[i], edge(i));
+        if d.length() <= DEGENERATE_EDGE * longest {
+            continue;
+        }
+        let normal = DVec2::new(-d.y, d.x);
+        out = clip_half_plane(
+            &out,
+            &HalfPlane {
+                normal,
+                offset: -normal.dot(a),
+            },
+        );
+        if out.len() < 3 {
+            return None;
+        }
+    }
+    Some(out)
+}
+
 /// `piece` minus the convex region where every half-plane holds, as convex pieces no narrower
 /// than `min_width`.
 pub fn subtract_half_planes(

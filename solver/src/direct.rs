@@ -17,8 +17,8 @@ use penumbra_scenes::polygon::{is_convex_ccw, triangulate_ccw};
 use penumbra_scenes::{Bounds, PlaneFrame, Rgb, Scene, SurfaceId, Visibility};
 
 use crate::clip::{
-    HalfPlane, area_2d, clip_half_plane, clip_polygon_3d, inside_convex, merge_close_vertices,
-    subtract_convex, subtract_half_planes, wider_than,
+    HalfPlane, area_2d, clip_half_plane, clip_polygon_3d, clip_to_convex, inside_convex,
+    merge_close_vertices, subtract_convex, subtract_half_planes, wider_than,
 };
 use crate::lambert::{ReceivingPoint, contour_sum};
 use crate::shadow_union::{CornerKey, ShadowUnion, VisibleShape};
@@ -83,7 +83,10 @@ impl CornerIds {
 
 /// What one occluder hides of an emitter piece, seen from a point.
 enum Blocking {
-    /// The occluder's plane holds the point (it stands on the receiver): regions of half-planes.
+    /// The occluder's plane holds the point (occluder index): what it hides depends on the side
+    /// the receiving surface lies on ([`contact_shadow`]).
+    Touching(usize),
+    /// A touching occluder's hidden regions, for one receiver: intersections of half-planes.
     Contact(Vec<Vec<HalfPlane>>),
     /// The occluder clipped to the shaft and projected onto the emitter's plane; with the
     /// corners' keys when the whole occluder lies inside the shaft.
@@ -230,6 +233,151 @@ impl<'a> DirectLight<'a> {
             .sum()
     }
 
+    /// The irradiance at receivers that share one point (the faces of a mesh meeting at a
+    /// vertex), each as [`Self::irradiance`] gives it to rounding. What the occluders other than
+    /// the faces through the point hide of each light is found once for all of them; each
+    /// receiver then keeps the part in front of it and loses what the faces through the point
+    /// hide on its side.
+    pub fn irradiance_group(&self, group: &[(ReceivingPoint, SurfaceId)]) -> Vec<Rgb> {
+        let mut out = vec![Rgb::ZERO; group.len()];
+        let Some((first, _)) = group.first() else {
+            return out;
+        };
+        for (k, e) in self.emitters.iter().enumerate() {
+            let shared = if group.len() > 1 {
+                self.shared_view(first.point, e)
+            } else {
+                None
+            };
+            for ((x, r), h) in group.iter().zip(&mut out) {
+                let sees =
+                    *r != e.surface && x.in_front_of(e.frame.origin, e.frame.normal, self.tol);
+                let f = match &shared {
+                    Some(view) if sees => self.form_factor_of_view(view, x, *r, e),
+                    _ => self.form_factor_visible(x, *r, k),
+                };
+                *h += e.emission * f;
+            }
+        }
+        out
+    }
+
+    /// What the occluders not through `point` leave visible of each piece of emitter `e`, when
+    /// enough of them are in the way to be subtracted at once (else `None`: each receiver is
+    /// evaluated on its own, one shadow at a time).
+    fn shared_view(&self, point: DVec3, e: &Emitter) -> Option<Vec<PieceView>> {
+        let h_x = e.frame.height(point);
+        if h_x <= self.tol {
+            return None;
+        }
+        let min_width = SLIVER_ULPS * f64::EPSILON * e.magnitude.max(point.abs().max_element());
+        let mut views = Vec::with_capacity(e.pieces.len());
+        for full in &e.pieces {
+            let mut piece: Vec<DVec2> = full.iter().map(|&p| e.frame.to_2d(p)).collect();
+            if area_2d(&piece) < 0.0 {
+                piece.reverse();
+            }
+            let (visible, touching) = match self.blockings(point, None, e, full, h_x, &piece) {
+                None => (Vec::new(), Vec::new()),
+                Some(blockings) => {
+                    if blockings.len() <= self.sequential_shadows {
+                        return None;
+                    }
+                    let touching = blockings
+                        .iter()
+                        .filter_map(|b| match b {
+                            Blocking::Touching(index) => Some(*index),
+                            _ => None,
+                        })
+                        .collect();
+                    (
+                        subtract_at_once(&piece, &blockings, e, min_width)?,
+                        touching,
+                    )
+                }
+            };
+            views.push(PieceView {
+                piece,
+                visible,
+                touching,
+            });
+        }
+        Some(views)
+    }
+
+    /// The form factor from receiver x (at the shared view's point) to what it sees of `e`.
+    fn form_factor_of_view(
+        &self,
+        views: &[PieceView],
+        x: &ReceivingPoint,
+        receiver: SurfaceId,
+        e: &Emitter,
+    ) -> f64 {
+        let tol = self.tol;
+        // Points of the emitter's plane in front of x: n . (p - x) >= 0.
+        let n = x.normal;
+        let front = HalfPlane {
+            normal: DVec2::new(n.dot(e.frame.u), n.dot(e.frame.v)),
+            offset: n.dot(e.frame.origin - x.point),
+        };
+        let signed_sum = |contours: &[Vec<DVec2>]| -> f64 {
+            contours
+                .iter()
+                .map(|c| {
+                    let c3: Vec<DVec3> = c.iter().map(|&q| e.frame.to_3d(q)).collect();
+                    area_2d(c).signum() * contour_sum(x, &c3, tol).abs()
+                })
+                .sum()
+        };
+        let mut total = 0.0;
+        for view in views {
+            let seen: Vec<Vec<DVec2>> = view
+                .visible
+                .iter()
+                .flatten()
+                .map(|c| clip_half_plane(c, &front))
+                .filter(|c| c.len() >= 3)
+                .collect();
+            if seen.is_empty() {
+                continue;
+            }
+            let mut sum = signed_sum(&seen);
+            // What the faces through x hide on the receiver's side, as disjoint convex pieces.
+            let mut hidden: Vec<Vec<DVec2>> = Vec::new();
+            for &index in &view.touching {
+                let occ = &self.occluders[index];
+                if occ.surface == receiver {
+                    continue;
+                }
+                for region in contact_shadow(x, occ, e, tol) {
+                    let mut part = clip_half_plane(&view.piece, &front);
+                    for h in &region {
+                        part = clip_half_plane(&part, h);
+                    }
+                    if part.len() < 3 {
+                        continue;
+                    }
+                    let mut parts = vec![part];
+                    for earlier in &hidden {
+                        let mut next = Vec::new();
+                        for p in &parts {
+                            subtract_convex(p, earlier, 0.0, &mut next);
+                        }
+                        parts = next;
+                    }
+                    hidden.extend(parts);
+                }
+            }
+            for h in &hidden {
+                let inside: Vec<Vec<DVec2>> =
+                    seen.iter().filter_map(|c| clip_to_convex(c, h)).collect();
+                sum -= signed_sum(&inside);
+            }
+            total += sum.max(0.0);
+        }
+        total / (2.0 * PI)
+    }
+
     /// The surface id of emitter `k`.
     pub fn emitter_surface(&self, k: usize) -> SurfaceId {
         self.emitters[k].surface
@@ -304,9 +452,15 @@ impl<'a> DirectLight<'a> {
         if area_2d(&piece) < 0.0 {
             piece.reverse();
         }
-        let Some(blockings) = self.blockings(x, receiver, e, front, h_x, &piece) else {
+        let Some(mut blockings) = self.blockings(x.point, Some(receiver), e, front, h_x, &piece)
+        else {
             return Vec::new();
         };
+        for b in &mut blockings {
+            if let Blocking::Touching(index) = *b {
+                *b = Blocking::Contact(contact_shadow(x, &self.occluders[index], e, self.tol));
+            }
+        }
         if blockings.len() > self.sequential_shadows
             && let Some(visible) = subtract_at_once(&piece, &blockings, e, min_width)
         {
@@ -322,26 +476,27 @@ impl<'a> DirectLight<'a> {
     /// hides all of it.
     fn blockings(
         &self,
-        x: &ReceivingPoint,
-        receiver: SurfaceId,
+        point: DVec3,
+        receiver: Option<SurfaceId>,
         e: &Emitter,
         front: &[DVec3],
         h_x: f64,
         piece: &[DVec2],
     ) -> Option<Vec<Blocking>> {
         let tol = self.tol;
+        let min_width = SLIVER_ULPS * f64::EPSILON * e.magnitude.max(point.abs().max_element());
         // The shaft's side planes through x and each edge, oriented to contain the piece.
         let center = front.iter().copied().sum::<DVec3>() / front.len() as f64;
         let sides: Vec<DVec3> = (0..front.len())
             .map(|i| {
-                let m = (front[i] - x.point).cross(front[(i + 1) % front.len()] - x.point);
-                if m.dot(center - x.point) < 0.0 { -m } else { m }
+                let m = (front[i] - point).cross(front[(i + 1) % front.len()] - point);
+                if m.dot(center - point) < 0.0 { -m } else { m }
             })
             .collect();
 
         let mut candidates = Vec::new();
         self.visibility.triangles_overlapping_between(
-            Bounds::from_points([&x.point]),
+            Bounds::from_points([&point]),
             Bounds::from_points(front),
             |t| candidates.push(self.piece_of_triangle[t]),
         );
@@ -350,11 +505,11 @@ impl<'a> DirectLight<'a> {
         candidates.retain(|&index| {
             let occ = &self.occluders[index];
             // A face of a closed solid turned away from x is behind another face of it.
-            occ.surface != receiver
+            Some(occ.surface) != receiver
                 && occ.surface != e.surface
                 && !occ
                     .outward
-                    .is_some_and(|n| n.dot(x.point - occ.polygon[0]) < -tol)
+                    .is_some_and(|n| n.dot(point - occ.polygon[0]) < -tol)
         });
         let at_once = candidates.len() > self.sequential_shadows;
 
@@ -364,11 +519,8 @@ impl<'a> DirectLight<'a> {
             // A plane through x is seen edge-on: it hides nothing, unless x lies on the occluder
             // itself (a blocker standing on the receiver); then the limit from inside the
             // receiving surface sees it hide everything across its plane, within its corner.
-            if occ.normal.dot(x.point - occ.polygon[0]).abs() <= tol {
-                let regions = contact_shadow(x, occ, e, tol);
-                if !regions.is_empty() {
-                    blockings.push(Blocking::Contact(regions));
-                }
+            if occ.normal.dot(point - occ.polygon[0]).abs() <= tol {
+                blockings.push(Blocking::Touching(index));
                 continue;
             }
             // Wholly outside one side of the shaft, or beyond the emitter's plane: no shadow.
@@ -376,7 +528,7 @@ impl<'a> DirectLight<'a> {
             if heights.iter().all(|&h| h < 0.0)
                 || sides
                     .iter()
-                    .any(|m| occ.polygon.iter().all(|&p| m.dot(p - x.point) < 0.0))
+                    .any(|m| occ.polygon.iter().all(|&p| m.dot(p - point) < 0.0))
             {
                 continue;
             }
@@ -384,7 +536,7 @@ impl<'a> DirectLight<'a> {
                 && occ
                     .polygon
                     .iter()
-                    .all(|&p| sides.iter().all(|m| m.dot(p - x.point) >= 0.0));
+                    .all(|&p| sides.iter().all(|m| m.dot(p - point) >= 0.0));
             // Shadows subtracted at once may reach past the piece: a face between the two
             // planes and not too close to x is projected whole, keeping its own corners.
             let whole = inside
@@ -400,7 +552,7 @@ impl<'a> DirectLight<'a> {
                     if poly.len() < 3 {
                         break;
                     }
-                    poly = clip_polygon_3d(&poly, |p| m.dot(p - x.point));
+                    poly = clip_polygon_3d(&poly, |p| m.dot(p - point));
                 }
                 poly
             };
@@ -411,10 +563,10 @@ impl<'a> DirectLight<'a> {
                 .iter()
                 .map(|&p| {
                     let s = h_x / (h_x - e.frame.height(p));
-                    e.frame.to_2d(x.point + (p - x.point) * s)
+                    e.frame.to_2d(point + (p - point) * s)
                 })
                 .collect();
-            if covers(&corners, piece) {
+            if tidy_shadow(&corners, e, min_width).is_some_and(|shadow| covers(&shadow, piece)) {
                 return None;
             }
             blockings.push(Blocking::Shadow {
@@ -426,13 +578,18 @@ impl<'a> DirectLight<'a> {
     }
 }
 
-/// Whether a shadow (a convex polygon, either orientation) covers all of a convex piece.
+/// One convex piece of an emitter seen from a point: what the occluders not through the point
+/// leave of it (shapes of an outline and holes), and the occluders through the point.
+struct PieceView {
+    piece: Vec<DVec2>,
+    visible: Vec<VisibleShape>,
+    touching: Vec<usize>,
+}
+
+/// Whether a shadow (a convex counter-clockwise polygon, tidied by [`tidy_shadow`]) covers all
+/// of a convex piece.
 fn covers(shadow: &[DVec2], piece: &[DVec2]) -> bool {
-    let mut ccw = shadow.to_vec();
-    if area_2d(&ccw) < 0.0 {
-        ccw.reverse();
-    }
-    ccw.len() >= 3 && piece.iter().all(|&p| inside_convex(p, &ccw))
+    piece.iter().all(|&p| inside_convex(p, shadow))
 }
 
 /// A projected shadow as a counter-clockwise convex polygon without near-duplicate corners, or
@@ -460,6 +617,7 @@ fn subtract_one_by_one(
     for blocking in blockings {
         let mut next = Vec::with_capacity(visible.len() + 4);
         match blocking {
+            Blocking::Touching(_) => {}
             Blocking::Contact(regions) => {
                 for region in regions {
                     next.clear();
@@ -497,6 +655,7 @@ fn subtract_at_once(
     let mut union = ShadowUnion::default();
     for blocking in blockings {
         match blocking {
+            Blocking::Touching(_) => {}
             Blocking::Contact(regions) => {
                 for region in regions {
                     let mut hidden = piece.to_vec();

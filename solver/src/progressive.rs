@@ -197,10 +197,47 @@ pub fn direct_irradiance(
 ) -> Result<Vec<Rgb>, SolveError> {
     let direct = DirectLight::new(scene, visibility);
     let all: Vec<usize> = (0..disc.receiver_count()).collect();
-    let interrupt = options.interrupt.as_ref();
-    irradiance_at(&all, "direct light", interrupt, progress, |v| {
-        direct.irradiance(&disc.receivers[v], disc.receiver_surface[v])
-    })
+    direct_at(&direct, disc, &all, options.interrupt.as_ref(), progress)
+}
+
+/// The exact direct irradiance at `receivers`, computed once per point for receivers that
+/// share one (faces of a mesh meeting at a vertex; see [`DirectLight::irradiance_group`]).
+fn direct_at(
+    direct: &DirectLight,
+    disc: &Discretization,
+    receivers: &[usize],
+    interrupt: Option<&Interrupt>,
+    progress: &dyn Progress,
+) -> Result<Vec<Rgb>, SolveError> {
+    // Groups in order of first appearance, so the work and its result do not depend on hashing.
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    let mut at_point: HashMap<[u64; 3], usize> = HashMap::new();
+    for (i, &v) in receivers.iter().enumerate() {
+        let p = disc.receivers[v].point;
+        let key = [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
+        let g = *at_point.entry(key).or_insert_with(|| {
+            groups.push(Vec::new());
+            groups.len() - 1
+        });
+        groups[g].push(i);
+    }
+    let per_group = par_map_with_progress(&groups, "direct light", interrupt, progress, |g| {
+        let members: Vec<(ReceivingPoint, SurfaceId)> = g
+            .iter()
+            .map(|&i| {
+                let v = receivers[i];
+                (disc.receivers[v], disc.receiver_surface[v])
+            })
+            .collect();
+        direct.irradiance_group(&members)
+    })?;
+    let mut out = vec![Rgb::ZERO; receivers.len()];
+    for (g, values) in groups.iter().zip(per_group) {
+        for (&i, h) in g.iter().zip(values) {
+            out[i] = h;
+        }
+    }
+    Ok(out)
 }
 
 /// `f` at each of `receivers`, in parallel, with a progress bar; stops early, with
@@ -212,16 +249,28 @@ fn irradiance_at(
     progress: &dyn Progress,
     f: impl Fn(usize) -> Rgb + Sync,
 ) -> Result<Vec<Rgb>, SolveError> {
+    par_map_with_progress(receivers, stage, interrupt, progress, |&v| f(v))
+}
+
+/// `f` of each item, in parallel and in order, with a progress bar; stops early, with
+/// [`SolveError::Interrupted`], once `interrupt` is set.
+fn par_map_with_progress<T: Sync, U: Send + Default>(
+    items: &[T],
+    stage: &str,
+    interrupt: Option<&Interrupt>,
+    progress: &dyn Progress,
+    f: impl Fn(&T) -> U + Sync,
+) -> Result<Vec<U>, SolveError> {
     let interrupted = || interrupt.is_some_and(Interrupt::is_set);
-    progress.start(stage, receivers.len() as u64);
+    progress.start(stage, items.len() as u64);
     let done = std::sync::atomic::AtomicU64::new(0);
-    let out = receivers
+    let out = items
         .par_iter()
-        .map(|&v| {
+        .map(|item| {
             if interrupted() {
-                return Rgb::ZERO;
+                return U::default();
             }
-            let h = f(v);
+            let h = f(item);
             let d = done.fetch_add(1, Ordering::Relaxed);
             if d.is_multiple_of(256) {
                 progress.set(d);
@@ -608,10 +657,7 @@ impl<'a> ProgressiveSolver<'a> {
         let t = Instant::now();
         // Remeshing runs to its end: the refinement loop checks for interrupts between rounds,
         // and stopping here would lose the solution it has.
-        let new_direct = irradiance_at(&fresh, "direct light", None, progress, |v| {
-            self.direct
-                .irradiance(&disc.receivers[v], disc.receiver_surface[v])
-        })?;
+        let new_direct = direct_at(&self.direct, &disc, &fresh, None, progress)?;
         self.direct_seconds += t.elapsed().as_secs_f64();
         let t = Instant::now();
         let rays = std::sync::atomic::AtomicU64::new(0);

@@ -22,7 +22,7 @@ use i_overlay::float::overlay::FloatOverlay;
 use i_overlay::i_float::adapter::FloatPointAdapter;
 use i_overlay::i_float::float::rect::FloatRect;
 
-use crate::clip::area_2d;
+use crate::clip::{area_2d, clip_to_convex};
 
 /// A corner of an occluder face, welded: faces that share a point share its key.
 pub(crate) type CornerKey = u32;
@@ -78,6 +78,21 @@ impl ShadowUnion {
     pub fn subtract_from(self, piece: &[DVec2]) -> Option<Vec<VisibleShape>> {
         let mut contours = self.contours;
         contours.extend(outlines(self.sheet)?);
+        if !piece
+            .iter()
+            .chain(contours.iter().flatten())
+            .all(|p| p.is_finite())
+        {
+            return None;
+        }
+        // Only what lies on the piece matters to the difference.
+        let contours: Vec<Vec<DVec2>> = contours
+            .iter()
+            .filter_map(|c| clip_to_convex(c, piece))
+            .collect();
+        if contours.is_empty() {
+            return Some(vec![vec![piece.to_vec()]]);
+        }
         let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
         for p in piece.iter().chain(contours.iter().flatten()) {
             lo = lo.min(*p);

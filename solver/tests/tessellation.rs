@@ -84,3 +84,49 @@ fn one_by_one_and_all_at_once_agree() {
         }
     }
 }
+
+/// Receivers that share a point (the faces of the prism meeting at a vertex) get from the
+/// shared evaluation what each gets on its own, with and without other faces touching them.
+#[test]
+fn receivers_at_one_point_share_work_without_changing_it() {
+    use penumbra_solver::Discretization;
+    use std::collections::BTreeMap;
+    for scene in [tessellated(3), tessellated(6)] {
+        let vis = Visibility::build(&scene);
+        let direct = DirectLight::new(&scene, &vis);
+        // Shared whatever the number of occluders, against each receiver on its own.
+        let shared_always = DirectLight::new(&scene, &vis).with_sequential_shadows(0);
+        let mesh = penumbra_meshing::mesh_scene_uniform(&scene, 4000).expect("meshes");
+        let disc = Discretization::new(&scene, &mesh, 24);
+        let mut at_point: BTreeMap<[u64; 3], Vec<usize>> = BTreeMap::new();
+        for (v, x) in disc.receivers.iter().enumerate() {
+            let p = x.point;
+            at_point
+                .entry([p.x.to_bits(), p.y.to_bits(), p.z.to_bits()])
+                .or_default()
+                .push(v);
+        }
+        let shared: Vec<&Vec<usize>> = at_point.values().filter(|g| g.len() > 1).collect();
+        assert!(shared.len() > 50, "the prism's vertices are shared");
+        let (mut worst, mut peak, mut lit) = (0.0f64, 0.0f64, 0);
+        for group in shared {
+            let members: Vec<(ReceivingPoint, usize)> = group
+                .iter()
+                .map(|&v| (disc.receivers[v], disc.receiver_surface[v]))
+                .collect();
+            let together = shared_always.irradiance_group(&members);
+            for ((x, r), h) in members.iter().zip(&together) {
+                let alone = direct.irradiance(x, *r);
+                worst = worst.max((alone.r - h.r).abs());
+                peak = peak.max(alone.r);
+                lit += usize::from(alone.r > 0.0);
+            }
+        }
+        assert!(lit > 50, "enough lit receivers to compare");
+        assert!(
+            worst <= 1e-12 * peak,
+            "{}: off by {worst:e} of {peak}",
+            scene.name
+        );
+    }
+}

@@ -12,7 +12,9 @@ pub mod contact;
 pub mod eee;
 pub mod hull;
 pub mod merge;
+pub mod patches;
 mod shaft;
+pub mod strength;
 pub mod topology;
 pub mod trim;
 pub mod wedge;
@@ -75,6 +77,13 @@ pub struct DiscontinuityOptions {
     pub eee: bool,
     /// EEE curves become polylines within this fraction of the receiver's diameter.
     pub eee_tolerance: f64,
+    /// Blocker patches that can hide less than this fraction of an emitter from a receiver start
+    /// no events there ([`strength`]).
+    pub event_tolerance: f64,
+    /// The area of a typical element of the mesh to come, if known: receivers smaller than
+    /// [`MIN_RECEIVER_ELEMENTS`] such elements get no events, and blocker patches whose shadow
+    /// is smaller than one element start none.
+    pub element_area: Option<f64>,
     /// When to stop starting new emitter–receiver pairs (a run's time budget).
     pub deadline: Option<Instant>,
     /// Stops the search early when set (Ctrl-C).
@@ -88,6 +97,15 @@ impl DiscontinuityOptions {
     }
 }
 
+/// The default [`DiscontinuityOptions::event_tolerance`]: a hundredth of the emitter.
+pub const DEFAULT_EVENT_TOLERANCE: f64 = 0.01;
+/// Receivers of fewer elements than this (of [`DiscontinuityOptions::element_area`]) get no
+/// events: a constraint would only cut slivers from their one or two triangles.
+pub const MIN_RECEIVER_ELEMENTS: f64 = 2.0;
+/// Shafts with more blocker edges than this skip the EEE search (tessellated blockers, whose
+/// EEE events are many and weak); they are counted.
+pub const EEE_MAX_EDGES: usize = 2048;
+
 impl Default for DiscontinuityOptions {
     fn default() -> Self {
         DiscontinuityOptions {
@@ -95,6 +113,8 @@ impl Default for DiscontinuityOptions {
             trim_tolerance: 1e-9,
             eee: true,
             eee_tolerance: 1e-4,
+            event_tolerance: DEFAULT_EVENT_TOLERANCE,
+            element_area: None,
             deadline: None,
             interrupt: None,
         }
@@ -111,8 +131,16 @@ pub struct DiscontinuityStats {
     /// Pairs not searched because the time budget ran out or the run was interrupted: their
     /// receivers lack those pairs' events.
     pub pairs_skipped: usize,
+    /// Receivers too small for events ([`MIN_RECEIVER_ELEMENTS`]), counted once per emitter.
+    pub receivers_too_small: usize,
     /// Blocker surfaces found in shafts, summed over pairs.
     pub blockers_in_shafts: usize,
+    /// Of those, surfaces of patches too weak for events ([`strength`]), and the largest share
+    /// of an emitter such a patch could hide: the most any dropped event changes the light by.
+    pub blockers_weak: usize,
+    pub weak_share_max: f64,
+    /// Shafts whose EEE search was skipped for their many blocker edges ([`EEE_MAX_EDGES`]).
+    pub eee_shafts_skipped: usize,
     /// Feature pairs that could form a wedge (in front of both emitter and receiver).
     pub wedges_considered: usize,
     /// Of those, not tangent to the emitter or the blocker's silhouette.
@@ -140,7 +168,11 @@ impl DiscontinuityStats {
         self.pairs += other.pairs;
         self.pairs_without_blockers += other.pairs_without_blockers;
         self.pairs_skipped += other.pairs_skipped;
+        self.receivers_too_small += other.receivers_too_small;
         self.blockers_in_shafts += other.blockers_in_shafts;
+        self.blockers_weak += other.blockers_weak;
+        self.weak_share_max = self.weak_share_max.max(other.weak_share_max);
+        self.eee_shafts_skipped += other.eee_shafts_skipped;
         self.wedges_considered += other.wedges_considered;
         self.wedges_culled += other.wedges_culled;
         self.wedges_kept += other.wedges_kept;

@@ -7,11 +7,13 @@ use std::collections::BTreeSet;
 use glam::DVec3;
 use penumbra_scenes::{Bounds, PlaneFrame, Scene, SurfaceId, Visibility};
 
+use super::patches::Patches;
+use super::strength::Pair;
 use super::topology::Topology;
 use super::wedge::{Event, Wedge};
 use super::{
-    Boundary, DiscontinuityOptions, DiscontinuitySegment, DiscontinuityStats, clip_to_polygon, eee,
-    hull, trim,
+    Boundary, DiscontinuityOptions, DiscontinuitySegment, DiscontinuityStats, EEE_MAX_EDGES,
+    MIN_RECEIVER_ELEMENTS, clip_to_polygon, eee, hull, trim,
 };
 
 /// What the whole search shares: the scene, its welded topology and every surface's frame.
@@ -20,6 +22,10 @@ pub(crate) struct SearchContext<'a> {
     pub scene: &'a Scene,
     pub visibility: &'a Visibility,
     pub topology: Topology,
+    /// Flat patches of welded coplanar faces, judged as one blocker.
+    pub patches: Patches,
+    /// Vertices inside a straight stretch of edges: no corner, so no EV event.
+    pub straight: Vec<bool>,
     pub frames: Vec<Option<PlaneFrame>>,
     pub options: &'a DiscontinuityOptions,
     /// Points closer than this count as coincident.
@@ -55,10 +61,15 @@ impl<'a> SearchContext<'a> {
         options: &'a DiscontinuityOptions,
     ) -> SearchContext<'a> {
         let tol = visibility.contact_distance();
+        let topology = Topology::new(scene, tol);
         SearchContext {
             scene,
             visibility,
-            topology: Topology::new(scene, tol),
+            patches: Patches::new(&topology),
+            straight: (0..topology.points.len())
+                .map(|v| topology.is_straight(v))
+                .collect(),
+            topology,
             frames: scene
                 .surfaces
                 .iter()
@@ -91,15 +102,26 @@ impl<'a> SearchContext<'a> {
     /// Every event of the pair `(e, r)` on `r`.
     pub fn pair_events(&self, e: SurfaceId, r: SurfaceId) -> PairEvents {
         let mut out = PairEvents::default();
-        let Some(shaft) = self.shaft(e, r) else {
+        if self
+            .options
+            .element_area
+            .is_some_and(|a| self.scene.surfaces[r].area() < MIN_RECEIVER_ELEMENTS * a)
+        {
+            out.stats.receivers_too_small = 1;
+            return out;
+        }
+        let Some(shaft) = self.shaft(e, r, &mut out.stats) else {
             out.stats.pairs_without_blockers = 1;
             return out;
         };
-        out.stats.blockers_in_shafts = shaft.blockers.len();
         let mut wedges = shaft.ev_wedges(&mut out.stats);
         wedges.extend(shaft.ve_wedges(&mut out.stats));
         if self.options.eee {
-            shaft.eee_segments(&mut out);
+            if shaft.edges.len() > EEE_MAX_EDGES {
+                out.stats.eee_shafts_skipped += 1;
+            } else {
+                shaft.eee_segments(&mut out);
+            }
         }
         for wedge in wedges {
             shaft.wedge_segments(&wedge, &mut out);
@@ -107,9 +129,14 @@ impl<'a> SearchContext<'a> {
         out
     }
 
-    /// The pair's shaft (the convex hull of emitter and receiver) with the blockers in it, or
-    /// `None` when nothing blocks.
-    fn shaft(&'a self, e: SurfaceId, r: SurfaceId) -> Option<Shaft<'a>> {
+    /// The pair's shaft (the convex hull of emitter and receiver) with the blockers in it strong
+    /// enough for events, or `None` when nothing blocks.
+    fn shaft(
+        &'a self,
+        e: SurfaceId,
+        r: SurfaceId,
+        stats: &mut DiscontinuityStats,
+    ) -> Option<Shaft<'a>> {
         let (emitter, receiver) = (&self.scene.surfaces[e], &self.scene.surfaces[r]);
         let (ef, rf) = (self.frames[e]?, self.frames[r]?);
         let tol = self.tol;
@@ -134,6 +161,8 @@ impl<'a> SearchContext<'a> {
         if blockers.is_empty() {
             return None;
         }
+        stats.blockers_in_shafts = blockers.len();
+        let blockers = self.strong_blockers(e, &ef, r, &rf, blockers, stats);
         let mut vertices = BTreeSet::new();
         let mut edges = BTreeSet::new();
         for &b in &blockers {
@@ -156,6 +185,46 @@ impl<'a> SearchContext<'a> {
             vertices,
             edges,
         })
+    }
+}
+
+impl SearchContext<'_> {
+    /// The blockers whose patch is strong enough for events on `r` ([`super::strength`]).
+    fn strong_blockers(
+        &self,
+        e: SurfaceId,
+        ef: &PlaneFrame,
+        r: SurfaceId,
+        rf: &PlaneFrame,
+        blockers: Vec<SurfaceId>,
+        stats: &mut DiscontinuityStats,
+    ) -> Vec<SurfaceId> {
+        let pair = Pair {
+            scene: self.scene,
+            emitter: e,
+            emitter_frame: ef,
+            receiver: r,
+            receiver_frame: rf,
+        };
+        let element_size = self.options.element_area.map_or(0.0, f64::sqrt);
+        let mut judged: std::collections::HashMap<usize, bool> = Default::default();
+        blockers
+            .into_iter()
+            .filter(|&b| {
+                let patch = self.patches.of_surface[b];
+                let strong = *judged.entry(patch).or_insert_with(|| {
+                    let s = pair.strength(&self.patches.corners[patch]);
+                    let strong =
+                        s.share >= self.options.event_tolerance && s.footprint >= element_size;
+                    if !strong {
+                        stats.weak_share_max = stats.weak_share_max.max(s.share);
+                    }
+                    strong
+                });
+                stats.blockers_weak += usize::from(!strong);
+                strong
+            })
+            .collect()
     }
 }
 
@@ -194,7 +263,7 @@ impl Shaft<'_> {
             };
             for &v in &self.vertices {
                 let pv = self.point(v);
-                if !self.in_front(pv) || e_loop.contains(&v) {
+                if !self.in_front(pv) || e_loop.contains(&v) || self.context.straight[v] {
                     continue;
                 }
                 let n = (self.point(ib) - self.point(ia)).cross(pv - self.point(ia));
