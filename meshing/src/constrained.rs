@@ -13,7 +13,7 @@
 use std::collections::HashMap;
 
 use glam::{DVec2, DVec3};
-use penumbra_scenes::{Surface, SurfaceId};
+use penumbra_scenes::{PlaneFrame, Surface, SurfaceId};
 
 use crate::error::MeshError;
 use crate::grading::Density;
@@ -65,8 +65,24 @@ impl ConstrainedSurface {
         surface: &Surface,
         constraints: &[Constraint],
     ) -> Result<ConstrainedSurface, MeshError> {
-        let coords = MeshCoordinates::of_surface(id, surface)?;
+        // The constraints are in the polygon's own frame; the mesh's starts at the corner the
+        // constraints pick among those it could start at, which for a polygon without a
+        // rotational symmetry is the same.
+        let plane = PlaneFrame::of_polygon(&surface.polygon);
+        let marks: Vec<DVec3> = plane
+            .iter()
+            .flat_map(|f| {
+                constraints
+                    .iter()
+                    .flat_map(|c| [f.to_3d(c.from), f.to_3d(c.to)])
+            })
+            .collect();
+        let coords = MeshCoordinates::of_surface_marked(id, surface, &marks)?;
         let to_mesh = |p: DVec2| {
+            let p = match plane {
+                Some(f) if f != coords.frame => coords.frame.to_2d(f.to_3d(p)),
+                _ => p,
+            };
             let q = p / coords.scale;
             DVec2::new(snap(q.x), snap(q.y))
         };

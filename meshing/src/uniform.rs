@@ -3,10 +3,13 @@
 //!
 //! Triangulations are built in *mesh coordinates*: the surface's plane-frame coordinates divided
 //! by the polygon's extent and snapped to a grid of 2^-36. The input to spade then depends only on
-//! the polygon's shape, so a scene that is moved, rotated or scaled is meshed identically.
+//! the polygon's shape, so a scene that is moved, rotated or scaled is meshed identically, and so
+//! is a polygon whose vertex list starts at another corner (the frame and the boundary both start
+//! at one of [`penumbra_scenes::polygon::canonical_starts`]; see `marked_start` for polygons
+//! with a rotational symmetry).
 
-use glam::DVec2;
-use penumbra_scenes::polygon::signed_area_2d;
+use glam::{DVec2, DVec3};
+use penumbra_scenes::polygon::{canonical_starts, signed_area_2d};
 use penumbra_scenes::{PlaneFrame, Surface, SurfaceId};
 use spade::handles::{FixedFaceHandle, InnerTag};
 use spade::{
@@ -19,11 +22,35 @@ use crate::mesh::SurfaceMesh;
 
 /// Grid of mesh coordinates: 2^-36 of a polygon's extent (about 1.5e-11).
 pub const SNAP_BITS: i32 = 36;
+/// Marks (see [`MeshCoordinates::of_surface_marked`]) are compared on a grid of 2^-24 of the
+/// polygon's diameter (about 6e-8): coarse against rounding, so that the frame a mark is seen
+/// from does not change what is compared.
+pub const MARK_QUANTUM: f64 = 1.0 / (1u64 << 24) as f64;
 /// Smallest angle the refinement aims for.
 pub const MIN_ANGLE_DEG: f64 = 25.0;
 /// Rounds of graded refinement: each halves the triangles still too large, so a density of
 /// 2^8 is reached.
 const GRADING_ROUNDS: usize = 8;
+
+/// Rounds of splitting the faces spade's refinement skipped (see
+/// `SurfaceTriangulation::refine_cdt`): each round's splits let the next refinement take over,
+/// so one round normally suffices.
+const SKIPPED_FACE_ROUNDS: usize = 4;
+
+/// A polygon whose calibrated refinements all come to less than this share of its target is
+/// refined until it reaches the target instead (see `SurfaceTriangulation::refined_capped`).
+const CAPPED_BELOW: f64 = 0.5;
+
+/// Vertices a refinement to `target` triangles may add: the target (about twice what it needs)
+/// and a few for small targets.
+fn allowance(target: usize) -> usize {
+    target + 64
+}
+
+/// Rounds of a refinement stopped before its target (see
+/// `SurfaceTriangulation::refined_capped`): each closes at least half the gap to the target
+/// left by the one before, unless the refinement is complete.
+const CAPPED_ROUNDS: usize = 8;
 
 /// The triangulation type. It keeps spade's default hint generator: with
 /// `HierarchyHintGenerator`, `add_constraint_and_split` panics on random crossing segments
@@ -45,12 +72,34 @@ pub struct MeshCoordinates {
 
 impl MeshCoordinates {
     pub fn of_surface(id: SurfaceId, surface: &Surface) -> Result<MeshCoordinates, MeshError> {
+        MeshCoordinates::of_surface_marked(id, surface, &[])
+    }
+
+    /// The mesh coordinates of a surface that carries `marks` (points on its plane, such as the
+    /// ends of its discontinuity segments). They start at one of the polygon's
+    /// [`canonical_starts`]: a polygon with a rotational symmetry has several, from which it
+    /// looks the same, and of those the one from which the marks look greatest is taken, so that
+    /// the mesh follows the marks, not the polygon's list.
+    pub fn of_surface_marked(
+        id: SurfaceId,
+        surface: &Surface,
+        marks: &[DVec3],
+    ) -> Result<MeshCoordinates, MeshError> {
         let degenerate = || MeshError::Degenerate {
             surface: id,
             name: surface.name.clone(),
         };
-        let frame = PlaneFrame::of_polygon(&surface.polygon).ok_or_else(degenerate)?;
-        let flat: Vec<DVec2> = surface.polygon.iter().map(|&p| frame.to_2d(p)).collect();
+        let polygon = &surface.polygon;
+        let start = marked_start(polygon, marks);
+        let frame = PlaneFrame::of_polygon_at(polygon, start).ok_or_else(degenerate)?;
+        // The boundary starts where the frame does: spade's triangulation, and so the mesh,
+        // depends on the order the boundary is inserted in, which then does not depend on the
+        // corner the polygon's list starts at.
+        let flat: Vec<DVec2> = polygon[start..]
+            .iter()
+            .chain(&polygon[..start])
+            .map(|&p| frame.to_2d(p))
+            .collect();
         let (lo, hi) = flat
             .iter()
             .fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), &p| {
@@ -77,6 +126,43 @@ impl MeshCoordinates {
             boundary,
         })
     }
+}
+
+/// Of the polygon's [`canonical_starts`], the one from which `marks` look greatest: their
+/// coordinates in the frame starting there, in units of [`MARK_QUANTUM`], sorted, compared
+/// lexicographically. With no marks, or marks as symmetric as the polygon, the first in list
+/// order: the meshes from the others are then the same, turned by the symmetry. No choice could
+/// do better there: one that did not depend on the list would have to pick the same corner of a
+/// square in the square turned by a quarter, which is the same square with its list rotated, and
+/// then a turned scene would not keep its frames.
+fn marked_start(polygon: &[DVec3], marks: &[DVec3]) -> usize {
+    let starts = canonical_starts(polygon);
+    if starts.len() < 2 || marks.is_empty() {
+        return starts.first().copied().unwrap_or(0);
+    }
+    let unit = MARK_QUANTUM * penumbra_scenes::polygon::diameter(polygon);
+    let view = |start: usize| {
+        let mut seen: Vec<(i64, i64)> = match PlaneFrame::of_polygon_at(polygon, start) {
+            Some(frame) => marks
+                .iter()
+                .map(|&m| {
+                    let q = frame.to_2d(m) / unit;
+                    (q.x.round() as i64, q.y.round() as i64)
+                })
+                .collect(),
+            None => Vec::new(),
+        };
+        seen.sort_unstable();
+        seen
+    };
+    let mut best = (starts[0], view(starts[0]));
+    for &start in &starts[1..] {
+        let seen = view(start);
+        if seen > best.1 {
+            best = (start, seen);
+        }
+    }
+    best.0
 }
 
 /// The polygon's constrained triangulation and the faces outside it.
@@ -179,7 +265,7 @@ impl SurfaceTriangulation {
     /// A refinement with about `target` triangles (never more, unless the triangulation already
     /// has more) and angles of at least `min_angle_deg` where the budget allows.
     pub fn refined(&self, target: usize, min_angle_deg: f64) -> SurfaceTriangulation {
-        self.calibrated(target, |max_area| {
+        self.calibrated(target, min_angle_deg, |max_area| {
             self.refined_to_area(max_area, min_angle_deg, target)
         })
     }
@@ -194,10 +280,11 @@ impl SurfaceTriangulation {
         min_angle_deg: f64,
         density: &Density,
     ) -> SurfaceTriangulation {
-        self.calibrated(target, |max_area| {
+        self.calibrated(target, min_angle_deg, |max_area| {
             let mut cdt = self.cdt.clone();
             let smallest = max_area / density.max_factor();
-            self.refine_cdt(&mut cdt, min_angle_deg, Some(max_area), max_area, target);
+            let allowed = allowance(target);
+            self.refine_cdt(&mut cdt, min_angle_deg, Some(max_area), max_area, allowed);
             for _ in 0..GRADING_ROUNDS {
                 let points = split_points(&cdt, |face| {
                     let centroid = face_centroid(face);
@@ -211,7 +298,7 @@ impl SurfaceTriangulation {
                     // Only positions spade cannot represent fail; skipping one costs a split.
                     let _ = cdt.insert(Point2::new(p.x, p.y));
                 }
-                self.refine_cdt(&mut cdt, min_angle_deg, None, smallest, target);
+                self.refine_cdt(&mut cdt, min_angle_deg, None, smallest, allowed);
             }
             cdt
         })
@@ -244,7 +331,7 @@ impl SurfaceTriangulation {
         }
         let mut cdt = std::mem::take(&mut self.cdt);
         let budget = cdt.num_vertices();
-        self.refine_cdt(&mut cdt, min_angle_deg, None, smallest, budget);
+        self.refine_cdt(&mut cdt, min_angle_deg, None, smallest, allowance(budget));
         self.cdt = cdt;
         self.find_outside();
         self.cdt.num_vertices() - before
@@ -260,34 +347,99 @@ impl SurfaceTriangulation {
     /// more vertices than there are).
     pub(crate) fn refined_to_area(&self, max_area: f64, min_angle_deg: f64, target: usize) -> Cdt {
         let mut cdt = self.cdt.clone();
-        self.refine_cdt(&mut cdt, min_angle_deg, Some(max_area), max_area, target);
+        self.refine_cdt(
+            &mut cdt,
+            min_angle_deg,
+            Some(max_area),
+            max_area,
+            allowance(target),
+        );
         cdt
     }
 
     /// Runs spade's refinement: angles of at least `min_angle_deg`, triangles no larger than
-    /// `max_area` (when given), none refined below a thousandth of `base_area`.
+    /// `max_area` (when given), none refined below a thousandth of `base_area`, at most
+    /// `added` more vertices.
+    ///
+    /// spade skips a face whose circumcenter it locates outside the convex hull, and does not
+    /// come back to it. While no hull edge is encroached (no vertex strictly inside its diametral
+    /// circle), circumcenters lie in the hull (Ruppert's lemma); one just outside comes from a
+    /// vertex *on* a hull edge's diametral circle, such as the right angle of a triangle facing
+    /// its hypotenuse, whose circumcenter is the hypotenuse's midpoint: rounding then decides
+    /// whether the edge counts as encroached and on which side of it the circumcenter falls.
+    /// A right triangle with its legs along the frame's axes (half of a rectangle, as in split
+    /// quads) was skipped about 30 % of the time and stayed one element at any budget. So
+    /// faces still over `max_area` when spade is done are split here at their centroids, which
+    /// encroach the edge, and refined again.
     fn refine_cdt(
         &self,
         cdt: &mut Cdt,
         min_angle_deg: f64,
         max_area: Option<f64>,
         base_area: f64,
-        target: usize,
+        added: usize,
     ) {
-        let mut parameters = RefinementParameters::<f64>::new()
-            .exclude_outer_faces(self.boundary_only)
-            .with_angle_limit(AngleLimit::from_deg(min_angle_deg))
-            .with_min_required_area(1e-3 * base_area)
-            .with_max_additional_vertices(target + 64);
-        if let Some(max_area) = max_area {
-            parameters = parameters.with_max_allowed_area(max_area);
+        let most_vertices = cdt.num_vertices() + added;
+        let parameters = |cdt: &Cdt| {
+            let mut parameters = RefinementParameters::<f64>::new()
+                .exclude_outer_faces(self.boundary_only)
+                .with_angle_limit(AngleLimit::from_deg(min_angle_deg))
+                .with_min_required_area(1e-3 * base_area)
+                .with_max_additional_vertices(most_vertices.saturating_sub(cdt.num_vertices()));
+            if let Some(max_area) = max_area {
+                parameters = parameters.with_max_allowed_area(max_area);
+            }
+            parameters
+        };
+        let mut complete = cdt.refine(parameters(cdt)).refinement_complete;
+        let Some(max_area) = max_area else {
+            return;
+        };
+        for _ in 0..SKIPPED_FACE_ROUNDS {
+            // An incomplete refinement ran out of vertices: the faces left large are the budget's.
+            if !complete {
+                break;
+            }
+            let room = most_vertices.saturating_sub(cdt.num_vertices());
+            let skipped: Vec<DVec2> = cdt
+                .inner_faces()
+                .filter(|&face| face.area() > max_area)
+                .map(face_centroid)
+                .filter(|&c| crate::planar::inside_polygon(c, &self.coords.boundary))
+                .take(room)
+                .collect();
+            if skipped.is_empty() {
+                break;
+            }
+            for p in skipped {
+                // Only positions spade cannot represent fail; the next round tries again.
+                let _ = cdt.insert(Point2::new(p.x, p.y));
+            }
+            complete = cdt.refine(parameters(cdt)).refinement_complete;
         }
-        cdt.refine(parameters);
+    }
+
+    /// This triangulation's polygon with another triangulation of it.
+    fn with_cdt(&self, cdt: Cdt) -> SurfaceTriangulation {
+        let mut t = SurfaceTriangulation {
+            coords: self.coords.clone(),
+            cdt,
+            outside: Vec::new(),
+            boundary_only: self.boundary_only,
+        };
+        t.find_outside();
+        t
     }
 
     /// The best of a few refinements made by `refine(max_area)` with the area bound calibrated so
-    /// that the count comes to 90-100 % of `target`.
-    fn calibrated(&self, target: usize, refine: impl Fn(f64) -> Cdt) -> SurfaceTriangulation {
+    /// that the count comes to 90-100 % of `target`; if none comes to [`CAPPED_BELOW`] of it, a
+    /// refinement (to angles of `min_angle_deg`) stopped at the target.
+    fn calibrated(
+        &self,
+        target: usize,
+        min_angle_deg: f64,
+        refine: impl Fn(f64) -> Cdt,
+    ) -> SurfaceTriangulation {
         let mut best = self.clone();
         let base_count = self.count();
         if target <= base_count {
@@ -297,13 +449,7 @@ impl SurfaceTriangulation {
         // Calibrate the area bound from the counts of a few trial runs.
         let mut max_area = self.area_for(target);
         for _ in 0..8 {
-            let mut refined = SurfaceTriangulation {
-                coords: self.coords.clone(),
-                cdt: refine(max_area),
-                outside: Vec::new(),
-                boundary_only: self.boundary_only,
-            };
-            refined.find_outside();
+            let refined = self.with_cdt(refine(max_area));
             let count = refined.count();
             let ratio = count as f64 / target as f64;
             if count <= target && count > best_count {
@@ -319,7 +465,38 @@ impl SurfaceTriangulation {
                 ratio * 0.98
             };
         }
+        if (best_count as f64) < CAPPED_BELOW * target as f64 {
+            let capped = self.refined_capped(target, min_angle_deg);
+            if capped.count() <= target && capped.count() > best_count {
+                best = capped;
+            }
+        }
         best
+    }
+
+    /// A refinement stopped before it can exceed `target` triangles. Refining a sliver splits
+    /// its long edges over and over, each split point encroaching the edge across, until they are
+    /// as short as the sliver is wide: more vertices than a small target allows, whatever the
+    /// angle limit. Stopped early, the splits, made breadth-first, still spread along the sliver,
+    /// which is better than leaving it whole. Each vertex adds at most two triangles, so each
+    /// round adds half as many vertices as triangles are missing.
+    fn refined_capped(&self, target: usize, min_angle_deg: f64) -> SurfaceTriangulation {
+        let max_area = self.area_for(target);
+        let mut refined = self.clone();
+        for _ in 0..CAPPED_ROUNDS {
+            let added = target.saturating_sub(refined.count()) / 2;
+            if added == 0 || refined.count() as f64 >= 0.9 * target as f64 {
+                break;
+            }
+            let mut cdt = refined.cdt.clone();
+            let before = cdt.num_vertices();
+            self.refine_cdt(&mut cdt, min_angle_deg, Some(max_area), max_area, added);
+            if cdt.num_vertices() == before {
+                break;
+            }
+            refined = self.with_cdt(cdt);
+        }
+        refined
     }
 
     pub fn into_mesh(self, id: SurfaceId, surface: &Surface) -> SurfaceMesh {
@@ -472,6 +649,73 @@ mod tests {
             }
             // The mesh covers the surface's own polygon up to the snap.
             assert!((m.area() - s.area()).abs() <= 1e-9 * s.area());
+        }
+    }
+
+    /// A triangulation of `boundary`, given in mesh coordinates (a frame in the plane z = 0).
+    fn triangulation_of(boundary: Vec<DVec2>) -> SurfaceTriangulation {
+        let frame = PlaneFrame {
+            origin: DVec3::ZERO,
+            u: DVec3::X,
+            v: DVec3::Y,
+            normal: DVec3::Z,
+        };
+        let coords = MeshCoordinates {
+            frame,
+            scale: 1.0,
+            boundary,
+        };
+        let cdt = boundary_cdt(0, &coords).expect("a triangle triangulates");
+        SurfaceTriangulation::new(coords, cdt, true)
+    }
+
+    /// With its legs along the axes, a right triangle's circumcenter (its hypotenuse's midpoint)
+    /// rounds to outside the triangle about 30 % of the time, and spade's refinement skipped
+    /// it: the ceiling of a scene stayed one triangle at any budget. The first case is that
+    /// ceiling's triangle in the frame it had then.
+    #[test]
+    fn right_triangles_with_legs_along_the_axes_refine() {
+        let mut rng = penumbra_scenes::rng::SplitMix64::new(17);
+        let mut cases = vec![[
+            DVec2::new(0.0, 0.0),
+            DVec2::new(1.0, 0.0),
+            DVec2::new(1.0, 0.9950738916231785),
+        ]];
+        for _ in 0..300 {
+            let (w, h) = (
+                snap(0.2 + 0.8 * rng.next_f64()),
+                snap(0.2 + 0.8 * rng.next_f64()),
+            );
+            cases.push([DVec2::ZERO, DVec2::new(w, 0.0), DVec2::new(w, h)]);
+            cases.push([DVec2::ZERO, DVec2::new(w, 0.0), DVec2::new(0.0, h)]);
+        }
+        for case in cases {
+            let refined = triangulation_of(case.to_vec()).refined(100, MIN_ANGLE_DEG);
+            assert!(
+                (70..=100).contains(&refined.count()),
+                "{case:?}: {} triangles for 100",
+                refined.count()
+            );
+        }
+    }
+
+    /// A sliver cannot be refined to its angles, nor even have its encroached edges split, with
+    /// few triangles; it gets its share anyway, stopped short.
+    #[test]
+    fn slivers_get_their_share() {
+        for height in [2e-2, 2e-3, 2e-4] {
+            let sliver = triangulation_of(vec![
+                DVec2::new(0.0, 0.0),
+                DVec2::new(1.0, 0.0),
+                DVec2::new(0.3, height),
+            ]);
+            for target in [10, 30, 100, 300] {
+                let count = sliver.refined(target, MIN_ANGLE_DEG).count();
+                assert!(
+                    count <= target && 2 * count >= target,
+                    "height {height}: {count} triangles for {target}"
+                );
+            }
         }
     }
 

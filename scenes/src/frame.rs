@@ -1,8 +1,10 @@
 //! Plane frames: each surface's own 2D coordinate system.
 //!
-//! A frame is built from the polygon alone (origin at its first vertex, `u` along its first edge,
-//! `v = n × u`), so a surface's 2D coordinates do not depend on where the scene sits in space:
-//! moving or rotating the scene leaves them unchanged up to rounding.
+//! A frame is built from the polygon alone (origin at the start of a longest edge, `u` along
+//! that edge, `v = n × u`; see [`polygon::canonical_start`]), so a surface's 2D coordinates do
+//! not depend on where the scene sits in space, nor on which corner its vertex list starts at:
+//! moving or rotating the scene leaves them unchanged up to rounding, and so does rotating the
+//! list (to the bit, unless the polygon has a rotational symmetry).
 
 use glam::{DVec2, DVec3};
 
@@ -20,13 +22,20 @@ pub struct PlaneFrame {
 impl PlaneFrame {
     /// The frame of a polygon; `None` when the polygon has no area or no usable edge.
     pub fn of_polygon(points: &[DVec3]) -> Option<PlaneFrame> {
+        PlaneFrame::of_polygon_at(points, polygon::canonical_start(points))
+    }
+
+    /// The frame of a polygon with its origin at vertex `start` and `u` along the edge from it
+    /// (the next one if that edge is negligible); `None` when the polygon has no area or no
+    /// usable edge, or has no vertex `start`.
+    pub fn of_polygon_at(points: &[DVec3], start: usize) -> Option<PlaneFrame> {
         let normal = polygon::newell_normal(points).try_normalize()?;
-        let origin = *points.first()?;
-        // The first edge that is not negligible against the polygon's size sets `u`.
+        let origin = *points.get(start)?;
+        // The first edge from there that is not negligible against the polygon's size sets `u`.
         let size = polygon::diameter(points);
-        let u = points
+        let u = points[start + 1..]
             .iter()
-            .skip(1)
+            .chain(&points[..start])
             .map(|&p| p - origin)
             .map(|d| d - normal * normal.dot(d))
             .find(|d| d.length() > 1e-9 * size)?
@@ -80,5 +89,21 @@ mod tests {
         let q: Vec<DVec2> = poly.iter().map(|&p| f.to_2d(p)).collect();
         assert!(polygon::signed_area_2d(&q) > 0.0);
         assert!((polygon::signed_area_2d(&q) - 15.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn rotating_the_vertex_list_keeps_the_frame() {
+        let triangle = [
+            DVec3::new(-1.02, -0.99, 1.99),
+            DVec3::new(-1.02, 1.04, 1.99),
+            DVec3::new(1.0, 1.04, 1.99),
+        ];
+        let reference = PlaneFrame::of_polygon(&triangle).expect("a triangle has a frame");
+        // The longest edge, the hypotenuse, runs from the third vertex to the first.
+        assert_eq!(reference.origin, triangle[2]);
+        for k in 1..3 {
+            let turned: Vec<DVec3> = (0..3).map(|i| triangle[(i + k) % 3]).collect();
+            assert_eq!(PlaneFrame::of_polygon(&turned), Some(reference));
+        }
     }
 }

@@ -6,17 +6,80 @@
 use glam::{DVec2, DVec3};
 use robust::{Coord, orient2d};
 
-/// Newell's normal: its direction is the right-hand-rule normal and its length twice the area.
-pub fn newell_normal(points: &[DVec3]) -> DVec3 {
-    let Some(&anchor) = points.first() else {
-        return DVec3::ZERO;
-    };
-    // Relative to the first vertex, so that far-away polygons keep their digits.
-    let mut n = DVec3::ZERO;
-    for i in 1..points.len().saturating_sub(1) {
-        n += (points[i] - anchor).cross(points[i + 1] - anchor);
+/// Lengths that agree to this fraction of a polygon's longest edge are equal when
+/// [`canonical_starts`] compares its corners (about 2e-10): a square stays a square after the
+/// rounding of a move or a turn, so the moved square starts at the same corner.
+pub const START_LENGTH_QUANTUM: f64 = 1.0 / (1u64 << 32) as f64;
+
+/// The corners a polygon's own computations (its frame, its mesh) may start at, whichever
+/// vertex its list starts at, in list order.
+///
+/// Each corner `i` is described by the lengths of its edge `i -> i+1` and of the diagonal
+/// `i -> i+2`, in units of [`START_LENGTH_QUANTUM`]; but for the sense of each turn, these
+/// determine the polygon up to a rigid motion. The starts are the corners whose sequence of
+/// descriptions, read round the polygon from them, is greatest: each starts a longest edge.
+/// Rotating the list moves them along with the vertices, and moving, turning or scaling the
+/// polygon keeps them (lengths change by rounding, far less than the quantum). There is more
+/// than one only when the polygon has a rotational symmetry (a rectangle has two, a square
+/// four): the polygon looks the same from each.
+pub fn canonical_starts(points: &[DVec3]) -> Vec<usize> {
+    let n = points.len();
+    let length = |a: usize, b: usize| points[a % n].distance(points[b % n]);
+    // The longest edge as the unit: a maximum, so the same whatever order the edges come in.
+    let longest = (0..n).map(|i| length(i, i + 1)).fold(0.0, f64::max);
+    let quantum = START_LENGTH_QUANTUM * longest;
+    if !(quantum > 0.0 && quantum.is_finite()) {
+        return vec![0];
     }
-    n
+    let units = |a: usize, b: usize| (length(a, b) / quantum).round() as u64;
+    let corners: Vec<(u64, u64)> = (0..n).map(|i| (units(i, i + 1), units(i, i + 2))).collect();
+    let corners = &corners;
+    let read_from = |start: usize| (0..n).map(move |k| corners[(start + k) % n]);
+    let best = (1..n).fold(0, |best, i| {
+        if read_from(i).cmp(read_from(best)) == std::cmp::Ordering::Greater {
+            i
+        } else {
+            best
+        }
+    });
+    (0..n)
+        .filter(|&i| read_from(i).eq(read_from(best)))
+        .collect()
+}
+
+/// The first of [`canonical_starts`] in list order: the corner a polygon's frame starts at.
+/// Where the polygon has a rotational symmetry, the list decides among equivalent corners, so
+/// that a moved scene keeps its frames (see [`crate::PlaneFrame`]).
+pub fn canonical_start(points: &[DVec3]) -> usize {
+    canonical_starts(points).first().copied().unwrap_or(0)
+}
+
+/// Newell's normal: its direction is the right-hand-rule normal and its length twice the area.
+/// It is summed from one of [`canonical_starts`], the one with the least coordinates, so that
+/// its rounding does not depend on where the polygon's list starts.
+pub fn newell_normal(points: &[DVec3]) -> DVec3 {
+    if points.is_empty() {
+        return DVec3::ZERO;
+    }
+    let n = points.len();
+    let least = |i: &usize, j: &usize| {
+        let (p, q) = (points[*i], points[*j]);
+        (p.x.total_cmp(&q.x))
+            .then(p.y.total_cmp(&q.y))
+            .then(p.z.total_cmp(&q.z))
+    };
+    let start = canonical_starts(points)
+        .into_iter()
+        .min_by(least)
+        .unwrap_or(0);
+    let at = |i: usize| points[(start + i) % n];
+    // Relative to the start vertex, so that far-away polygons keep their digits.
+    let anchor = at(0);
+    let mut normal = DVec3::ZERO;
+    for i in 1..n.saturating_sub(1) {
+        normal += (at(i) - anchor).cross(at(i + 1) - anchor);
+    }
+    normal
 }
 
 /// Largest distance between two vertices.
@@ -184,6 +247,61 @@ mod tests {
 
     fn v(x: f64, y: f64) -> DVec2 {
         DVec2::new(x, y)
+    }
+
+    fn v3(x: f64, y: f64) -> DVec3 {
+        DVec3::new(x, y, 0.0)
+    }
+
+    fn rotated(points: &[DVec3], k: usize) -> Vec<DVec3> {
+        (0..points.len())
+            .map(|i| points[(i + k) % points.len()])
+            .collect()
+    }
+
+    #[test]
+    fn the_start_moves_with_the_list() {
+        let polygons = [
+            // A right triangle: its hypotenuse is the longest edge.
+            vec![v3(0.0, 0.0), v3(3.0, 0.0), v3(3.0, 2.0)],
+            // An isosceles triangle: of its two longest sides, the one followed by the base.
+            vec![v3(0.0, 0.0), v3(4.0, -1.0), v3(4.0, 1.0)],
+            // A non-convex hexagon: its longest edge closes it.
+            vec![
+                v3(0.0, 0.0),
+                v3(2.0, 0.0),
+                v3(2.0, 1.0),
+                v3(1.0, 1.0),
+                v3(1.0, 3.0),
+                v3(-1.0, 3.0),
+            ],
+        ];
+        let expected = [2, 0, 5];
+        for (polygon, start) in polygons.iter().zip(expected) {
+            assert_eq!(canonical_start(polygon), start, "{polygon:?}");
+            for k in 1..polygon.len() {
+                let turned = rotated(polygon, k);
+                let moved = (start + polygon.len() - k) % polygon.len();
+                assert_eq!(canonical_start(&turned), moved, "{polygon:?} from {k}");
+                assert_eq!(newell_normal(&turned), newell_normal(polygon));
+            }
+        }
+    }
+
+    /// A square looks the same from each corner: its list's first corner is taken, and stays
+    /// taken when the rounding of a turn makes its sides differ in the last bits.
+    #[test]
+    fn symmetric_polygons_start_at_their_first_corner_however_turned() {
+        let square = [v3(0.0, 0.0), v3(1.0, 0.0), v3(1.0, 1.0), v3(0.0, 1.0)];
+        let rectangle = [v3(0.0, 0.0), v3(0.3, 0.0), v3(0.3, 1.7), v3(0.0, 1.7)];
+        let turn = glam::DQuat::from_euler(glam::EulerRot::XYZ, 0.7, -0.4, 2.1);
+        for scale in [1e-6, 1.0, 1e6] {
+            let map = |p: &DVec3| turn * (*p * scale) + DVec3::new(1.3, -2.9, 0.6) * scale;
+            let moved: Vec<DVec3> = square.iter().map(map).collect();
+            assert_eq!(canonical_start(&moved), 0);
+            let moved: Vec<DVec3> = rectangle.iter().map(map).collect();
+            assert_eq!(canonical_start(&moved), 1);
+        }
     }
 
     #[test]
