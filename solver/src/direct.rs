@@ -222,6 +222,11 @@ impl<'a> DirectLight<'a> {
         }
     }
 
+    /// The diagonal of the scene's bounding box.
+    pub fn scene_diagonal(&self) -> f64 {
+        self.tol / penumbra_scenes::CONTACT_TOLERANCE
+    }
+
     pub fn emitter_count(&self) -> usize {
         self.emitters.len()
     }

@@ -200,6 +200,11 @@ pub fn direct_irradiance(
     direct_at(&direct, disc, &all, options.interrupt.as_ref(), progress)
 }
 
+/// Receivers closer than this fraction of the scene's diagonal share one evaluation of what
+/// their light's occluders hide: the meshes of faces meeting at a vertex put their vertices
+/// there a few ulps apart, and the light seen from points that close differs by as little.
+const SHARED_POINT: f64 = 1e-12;
+
 /// The exact direct irradiance at `receivers`, computed once per point for receivers that
 /// share one (faces of a mesh meeting at a vertex; see [`DirectLight::irradiance_group`]).
 fn direct_at(
@@ -211,10 +216,16 @@ fn direct_at(
 ) -> Result<Vec<Rgb>, SolveError> {
     // Groups in order of first appearance, so the work and its result do not depend on hashing.
     let mut groups: Vec<Vec<usize>> = Vec::new();
-    let mut at_point: HashMap<[u64; 3], usize> = HashMap::new();
+    let mut at_point: HashMap<[i64; 3], usize> = HashMap::new();
+    let quantum = SHARED_POINT * direct.scene_diagonal();
     for (i, &v) in receivers.iter().enumerate() {
         let p = disc.receivers[v].point;
-        let key = [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
+        let key = if quantum > 0.0 && quantum.is_finite() {
+            let q = (p / quantum).round();
+            [q.x as i64, q.y as i64, q.z as i64]
+        } else {
+            [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()].map(|b| b as i64)
+        };
         let g = *at_point.entry(key).or_insert_with(|| {
             groups.push(Vec::new());
             groups.len() - 1
