@@ -224,18 +224,20 @@ pub fn subtract_half_planes(
     }
 }
 
+/// An axis-aligned square, counter-clockwise, for tests.
+#[cfg(test)]
+pub(crate) fn sq(x0: f64, y0: f64, s: f64) -> Vec<DVec2> {
+    vec![
+        DVec2::new(x0, y0),
+        DVec2::new(x0 + s, y0),
+        DVec2::new(x0 + s, y0 + s),
+        DVec2::new(x0, y0 + s),
+    ]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn sq(x0: f64, y0: f64, s: f64) -> Vec<DVec2> {
-        vec![
-            DVec2::new(x0, y0),
-            DVec2::new(x0 + s, y0),
-            DVec2::new(x0 + s, y0 + s),
-            DVec2::new(x0, y0 + s),
-        ]
-    }
 
     #[test]
     fn difference_of_squares_has_the_right_area() {

@@ -199,15 +199,6 @@ mod tests {
         shapes.iter().flatten().map(|c| area_2d(c)).sum()
     }
 
-    fn square(x0: f64, y0: f64, s: f64) -> Vec<DVec2> {
-        vec![
-            DVec2::new(x0, y0),
-            DVec2::new(x0 + s, y0),
-            DVec2::new(x0 + s, y0 + s),
-            DVec2::new(x0, y0 + s),
-        ]
-    }
-
     /// A 4 x 4 grid of corners, split into 18 triangles (some listed clockwise): the sheet's
     /// inner edges cancel and its outline is the grid's square.
     #[test]
@@ -231,7 +222,7 @@ mod tests {
         assert_eq!(loops.len(), 1);
         assert_eq!(loops[0].len(), 12, "the outline's corners");
         let visible = union
-            .subtract_from(&square(-0.5, -0.5, 2.0))
+            .subtract_from(&crate::clip::sq(-0.5, -0.5, 2.0))
             .expect("finite");
         assert!((area(&visible) - (4.0 - 0.5625)).abs() < 1e-15);
     }
@@ -241,11 +232,11 @@ mod tests {
     #[test]
     fn overlapping_shadows_are_counted_once() {
         let mut union = ShadowUnion::default();
-        union.add_contour(square(0.0, 0.0, 1.0));
-        union.add_contour(square(0.5, 0.5, 1.0));
-        union.add_contour(square(3.5, 3.5, 1.0));
+        union.add_contour(crate::clip::sq(0.0, 0.0, 1.0));
+        union.add_contour(crate::clip::sq(0.5, 0.5, 1.0));
+        union.add_contour(crate::clip::sq(3.5, 3.5, 1.0));
         let visible = union
-            .subtract_from(&square(-1.0, -1.0, 5.0))
+            .subtract_from(&crate::clip::sq(-1.0, -1.0, 5.0))
             .expect("finite");
         assert!((area(&visible) - (25.0 - 1.75 - 0.25)).abs() < 1e-13);
         assert_eq!(visible.len(), 1);
@@ -257,6 +248,10 @@ mod tests {
     fn non_finite_shadows_are_refused() {
         let mut union = ShadowUnion::default();
         union.add_contour(vec![DVec2::ZERO, DVec2::X, DVec2::new(f64::NAN, 1.0)]);
-        assert!(union.subtract_from(&square(0.0, 0.0, 1.0)).is_none());
+        assert!(
+            union
+                .subtract_from(&crate::clip::sq(0.0, 0.0, 1.0))
+                .is_none()
+        );
     }
 }

@@ -121,12 +121,21 @@ mod tests {
     use super::*;
     use penumbra_scenes::builtin;
 
-    fn pair(scene: &Scene) -> (PlaneFrame, PlaneFrame, SurfaceId, SurfaceId) {
+    /// The strength of surface `blocker` between a scene's light and floor.
+    fn strength_of(scene: &Scene, blocker: SurfaceId) -> PatchStrength {
         let e = scene.surface_id("light").expect("light");
         let r = scene.surface_id("floor").expect("floor");
         let frame =
             |s: SurfaceId| PlaneFrame::of_polygon(&scene.surfaces[s].polygon).expect("a plane");
-        (frame(e), frame(r), e, r)
+        let (ef, rf) = (frame(e), frame(r));
+        Pair {
+            scene,
+            emitter: e,
+            emitter_frame: &ef,
+            receiver: r,
+            receiver_frame: &rf,
+        }
+        .strength(&scene.surfaces[blocker].polygon)
     }
 
     /// The textbook blocker (a unit square at height 1 under a unit light at height 3) seen from
@@ -135,24 +144,24 @@ mod tests {
     #[test]
     fn the_textbook_blocker_is_strong() {
         let scene = builtin::textbook();
-        let (ef, rf, e, r) = pair(&scene);
-        let blocker = scene.surface_id("blocker").expect("blocker");
-        let p = Pair {
-            scene: &scene,
-            emitter: e,
-            emitter_frame: &ef,
-            receiver: r,
-            receiver_frame: &rf,
-        };
-        let s = p.strength(&scene.surfaces[blocker].polygon);
+        let s = strength_of(&scene, scene.surface_id("blocker").expect("blocker"));
         assert_eq!(s.share, 1.0);
-        // From a light corner at (±0.5, ±0.5, 3) through blocker corners at (±0.5, ±0.5, 1):
-        // the floor point is a + (p - a) * 3/2, reaching ±1.0 on each axis.
         assert!((s.footprint - 2.0 * 2f64.sqrt()).abs() < 1e-12, "{s:?}");
     }
 
     /// A face a hundredth of the light's size, halfway up, is magnified 3/2 seen from the floor:
     /// it hides 2.25 ten-thousandths of the light.
+    #[test]
+    fn a_small_face_is_weak() {
+        let mut scene = builtin::textbook();
+        let small = scene.surface_id("blocker").expect("blocker");
+        for p in &mut scene.surfaces[small].polygon {
+            *p = DVec3::new(p.x * 0.01, p.y * 0.01, 2.0);
+        }
+        let s = strength_of(&scene, small);
+        assert!((s.share - 2.25e-4).abs() < 1e-15, "{s:?}");
+    }
+
     #[test]
     fn hulls_have_their_area() {
         let square = [
@@ -166,24 +175,5 @@ mod tests {
         let points = square.iter().map(|&(x, y)| DVec2::new(x, y)).collect();
         assert_eq!(hull_area(points), 4.0);
         assert_eq!(hull_area(vec![DVec2::ZERO, DVec2::X, DVec2::X * 2.0]), 0.0);
-    }
-
-    #[test]
-    fn a_small_face_is_weak() {
-        let mut scene = builtin::textbook();
-        let small = scene.surface_id("blocker").expect("blocker");
-        for p in &mut scene.surfaces[small].polygon {
-            *p = DVec3::new(p.x * 0.01, p.y * 0.01, 2.0);
-        }
-        let (ef, rf, e, r) = pair(&scene);
-        let p = Pair {
-            scene: &scene,
-            emitter: e,
-            emitter_frame: &ef,
-            receiver: r,
-            receiver_frame: &rf,
-        };
-        let s = p.strength(&scene.surfaces[small].polygon);
-        assert!((s.share - 2.25e-4).abs() < 1e-15, "{s:?}");
     }
 }
