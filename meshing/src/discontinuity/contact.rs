@@ -8,6 +8,7 @@
 
 use glam::DVec3;
 use penumbra_scenes::{Bounds, PlaneFrame, Scene, SurfaceId, Visibility};
+use rayon::prelude::*;
 
 use super::clip_to_polygon;
 
@@ -22,66 +23,76 @@ pub fn contact_lines(
     frames: &[Option<PlaneFrame>],
     visibility: &Visibility,
 ) -> Vec<(SurfaceId, Vec<ContactLine>)> {
+    (0..scene.surfaces.len())
+        .into_par_iter()
+        .filter_map(|r| {
+            let lines = receiver_contacts(scene, frames[r]?, r, visibility);
+            (!lines.is_empty()).then_some((r, lines))
+        })
+        .collect()
+}
+
+/// The contact lines on receiver `r`, whose plane frame is `rf`.
+fn receiver_contacts(
+    scene: &Scene,
+    rf: PlaneFrame,
+    r: SurfaceId,
+    visibility: &Visibility,
+) -> Vec<ContactLine> {
     let tol = visibility.contact_distance();
-    let mut out = Vec::new();
-    for (r, receiver) in scene.surfaces.iter().enumerate() {
-        let Some(rf) = frames[r] else { continue };
-        let mut candidates = std::collections::BTreeSet::new();
-        // Grown by the largest gap a face of the receiver's size may hover at.
-        let b = receiver.bounds();
-        let reach = DVec3::splat(HOVER * b.diagonal());
-        let near = Bounds {
-            min: b.min - reach,
-            max: b.max + reach,
-        };
-        visibility.triangles_overlapping(near, |t| {
-            candidates.insert(visibility.triangles()[t].surface);
-        });
-        let mut lines = Vec::new();
-        for b in candidates {
-            if b == r {
-                continue;
-            }
-            let poly = &scene.surfaces[b].polygon;
-            let h: Vec<f64> = poly
-                .iter()
-                .map(|&p| {
-                    let h = rf.height(p);
-                    if h.abs() <= tol { 0.0 } else { h }
-                })
-                .collect();
-            // Only blockers reaching the front matter, and coplanar ones hide nothing.
-            if !h.iter().any(|&x| x > 0.0) {
-                continue;
-            }
-            if let Some(gap) = hovering(poly, &h, tol) {
-                let n = poly.len();
-                for i in 0..n {
-                    let (p, q) = (
-                        poly[i] - rf.normal * gap,
-                        poly[(i + 1) % n] - rf.normal * gap,
-                    );
-                    for [a, c] in clip_to_polygon(&rf, &receiver.polygon, p, q) {
-                        if a.distance(c) > tol {
-                            lines.push((a, c, gap));
-                        }
-                    }
-                }
-                continue;
-            }
-            for (p, q) in plane_section(poly, &h) {
+    let receiver = &scene.surfaces[r];
+    let mut candidates = std::collections::BTreeSet::new();
+    // Grown by the largest gap a face of the receiver's size may hover at.
+    let b = receiver.bounds();
+    let reach = DVec3::splat(HOVER * b.diagonal());
+    let near = Bounds {
+        min: b.min - reach,
+        max: b.max + reach,
+    };
+    visibility.triangles_overlapping(near, |t| {
+        candidates.insert(visibility.triangles()[t].surface);
+    });
+    let mut lines = Vec::new();
+    for b in candidates {
+        if b == r {
+            continue;
+        }
+        let poly = &scene.surfaces[b].polygon;
+        let h: Vec<f64> = poly
+            .iter()
+            .map(|&p| {
+                let h = rf.height(p);
+                if h.abs() <= tol { 0.0 } else { h }
+            })
+            .collect();
+        // Only blockers reaching the front matter, and coplanar ones hide nothing.
+        if !h.iter().any(|&x| x > 0.0) {
+            continue;
+        }
+        if let Some(gap) = hovering(poly, &h, tol) {
+            let n = poly.len();
+            for i in 0..n {
+                let (p, q) = (
+                    poly[i] - rf.normal * gap,
+                    poly[(i + 1) % n] - rf.normal * gap,
+                );
                 for [a, c] in clip_to_polygon(&rf, &receiver.polygon, p, q) {
                     if a.distance(c) > tol {
-                        lines.push((a, c, 0.0));
+                        lines.push((a, c, gap));
                     }
                 }
             }
+            continue;
         }
-        if !lines.is_empty() {
-            out.push((r, lines));
+        for (p, q) in plane_section(poly, &h) {
+            for [a, c] in clip_to_polygon(&rf, &receiver.polygon, p, q) {
+                if a.distance(c) > tol {
+                    lines.push((a, c, 0.0));
+                }
+            }
         }
     }
-    out
+    lines
 }
 
 /// How close, relative to its diameter, a parallel face must hover over a receiver for its
