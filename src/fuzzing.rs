@@ -13,7 +13,7 @@ pub fn run_small(scene: Scene) -> Result<(), String> {
         return Ok(()); // rejected, as the loader would
     }
     let options = RunOptions {
-        max_elements: 400,
+        max_elements: 400.into(),
         solver: SolverOptions {
             epsilon: 1e-2,
             max_shots: 300,

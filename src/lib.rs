@@ -5,6 +5,7 @@
 //! thin command line around it.
 
 pub mod adaptive;
+pub mod energy;
 pub mod form_factor_study;
 pub mod fuzzing;
 pub mod memory;
@@ -13,4 +14,6 @@ pub mod pipeline;
 pub mod progress_bar;
 pub mod sweep;
 
-pub use pipeline::{DEFAULT_MAX_ELEMENTS, MeshMethod, RunError, RunOptions, RunResult, run};
+pub use pipeline::{
+    DEFAULT_BUDGET, DEFAULT_MAX_ELEMENTS, MeshMethod, RunError, RunOptions, RunResult, run,
+};

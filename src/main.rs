@@ -10,13 +10,19 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use anyhow::Context;
 use clap::{Parser, Subcommand, ValueEnum};
-use penumbra::outputs::write_outputs;
+use penumbra::outputs::{DEFAULT_SVG_SURFACES, SvgSelection, write_outputs};
 use penumbra::progress_bar::Bars;
-use penumbra::{DEFAULT_MAX_ELEMENTS, MeshMethod, RunOptions};
+use penumbra::{DEFAULT_BUDGET, DEFAULT_MAX_ELEMENTS, MeshMethod, RunOptions};
 use penumbra_meshing::grading::DEFAULT_PENUMBRA_DENSITY;
+use penumbra_meshing::{ElementBudget, FIT_TRIANGLES_PER_SURFACE, MeshError};
 use penumbra_scenes::{ObjOptions, SceneError, builtin, load_scene_with};
 use penumbra_solver::progressive::DEFAULT_EPSILON;
 use penumbra_solver::{Interrupt, SolverOptions};
+
+// The help texts below give these figures in words.
+const _: () = assert!(
+    DEFAULT_MAX_ELEMENTS == 10_000 && FIT_TRIANGLES_PER_SURFACE == 4 && DEFAULT_SVG_SURFACES == 24
+);
 
 #[derive(Parser, Debug)]
 #[command(version, about = "Radiosity meshes that respect where shadows change")]
@@ -27,7 +33,8 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
-    /// Mesh, solve and render a scene; write solution.json, report.json, render.png and SVGs.
+    /// Mesh, solve and render a scene; write solution.json, report.json, render.png and the
+    /// SVGs of the surfaces worth looking at (--svg).
     Run(RunArgs),
     /// Run uniform, uniform + adaptive, discontinuity and discontinuity + adaptive meshes over a
     /// ladder of element budgets and score each against a reference; write sweep.csv and
@@ -116,9 +123,11 @@ struct RunArgs {
     /// uniform).
     #[arg(long, value_enum)]
     mesh: Option<MeshArg>,
-    /// Cap on triangles for the whole scene, spread over the surfaces by area.
-    #[arg(long, default_value_t = DEFAULT_MAX_ELEMENTS)]
-    max_elements: usize,
+    /// Cap on triangles for the whole scene, spread over the surfaces by area. Default: what the
+    /// scene needs: 10,000, or, when that is too few, the least mesh of its polygons with their
+    /// discontinuities as edges and 4 triangles more per surface.
+    #[arg(long)]
+    max_elements: Option<usize>,
     /// Discontinuity meshes: how many times smaller in area triangles are in partial shadow than
     /// in full light or full shadow (1: no grading). Default: 8, or 1 with --refine-tol, where
     /// refinement finds the penumbrae itself.
@@ -129,7 +138,8 @@ struct RunArgs {
     /// scene's mean radiosity, up to --max-elements.
     #[arg(long)]
     refine_tol: Option<f64>,
-    /// With --refine-tol: triangles of the starting mesh (default: a tenth of --max-elements).
+    /// With --refine-tol: triangles of the starting mesh (default: a tenth of --max-elements;
+    /// without --max-elements, a tenth of 10,000, or the scene's least mesh if that is more).
     #[arg(long)]
     initial_elements: Option<usize>,
     /// With --refine-tol, in full solutions: how the indirect light's interpolation error is
@@ -205,7 +215,12 @@ struct RunArgs {
     /// Render height in pixels.
     #[arg(long, default_value_t = 640)]
     height: u32,
-    /// No progress bars and no summary.
+    /// Which surfaces get an SVG in OUT/surfaces: `auto` (every surface of a scene of at most 24,
+    /// else the 24 with the most discontinuity segments, then the largest), `all`, `none`, or
+    /// surface names, comma-separated.
+    #[arg(long, default_value = "auto", value_name = "auto|all|none|NAME,...")]
+    svg: String,
+    /// No progress bars, no summary and no warnings.
     #[arg(long)]
     quiet: bool,
 }
@@ -301,13 +316,66 @@ impl<E: Into<anyhow::Error>> From<E> for Failure {
     }
 }
 
+/// Which command's options set the element budget, for messages.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum BudgetOptions {
+    /// `run`: `--max-elements` and `--initial-elements`.
+    Run,
+    /// `sweep`: `--budgets` and `--initial-fraction`.
+    Sweep,
+}
+
 /// A pipeline error: the user's (exit 2) when it comes from bad options, else the run's.
-fn run_failure(e: penumbra::RunError) -> Failure {
+fn run_failure(e: penumbra::RunError, options: BudgetOptions) -> Failure {
+    if let Some(message) = budget_message(&e, options) {
+        return usage(anyhow::anyhow!(message));
+    }
     if e.is_usage() {
         usage(e)
     } else {
         Failure::from(e)
     }
+}
+
+/// An element budget too small for the scene, told in terms of the option that set it.
+fn budget_message(e: &penumbra::RunError, options: BudgetOptions) -> Option<String> {
+    let (initial, source) = match e {
+        penumbra::RunError::Mesh(source) => (false, source),
+        penumbra::RunError::InitialBudget(source) => (true, source),
+        _ => return None,
+    };
+    let MeshError::BudgetTooSmall {
+        max_elements,
+        needed,
+        discontinuities,
+    } = source
+    else {
+        return None;
+    };
+    let what = if *discontinuities {
+        "the scene's polygons, with their discontinuities as edges,"
+    } else {
+        "the scene's polygons"
+    };
+    let need = format!("{what} need at least {needed} triangles");
+    Some(match (options, initial) {
+        (BudgetOptions::Run, false) => format!(
+            "--max-elements {max_elements} is too small: {need}; use --max-elements {needed} or \
+             more (or leave it out: by default the budget fits the scene)"
+        ),
+        (BudgetOptions::Run, true) => format!(
+            "--initial-elements {max_elements} is too small for the starting mesh of adaptive \
+             refinement (by default a tenth of --max-elements): {need}; use --initial-elements \
+             {needed} or more"
+        ),
+        (BudgetOptions::Sweep, false) => format!(
+            "--budgets: {max_elements} is too small: {need}; use budgets of {needed} or more"
+        ),
+        (BudgetOptions::Sweep, true) => format!(
+            "--initial-fraction: the starting mesh of adaptive refinement, {max_elements} \
+             triangles, is too small: {need}; use a larger --initial-fraction, or larger budgets"
+        ),
+    })
 }
 
 fn usage(error: impl Into<anyhow::Error>) -> Failure {
@@ -455,7 +523,7 @@ fn sweep(args: &SweepArgs) -> Result<(), Failure> {
     };
     let bars = Bars::new(args.quiet);
     let result = penumbra::sweep::sweep(&loaded, &options, &samples, &reference, &bars)
-        .map_err(run_failure)?;
+        .map_err(|e| run_failure(e, BudgetOptions::Sweep))?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
     let csv = penumbra::sweep::sweep_csv(&result);
@@ -611,6 +679,34 @@ fn check(spec: &str, options: ObjOptions) -> Result<(), Failure> {
     Ok(())
 }
 
+/// `--svg`: `auto`, `all`, `none`, or surface names of `scene`, comma-separated.
+fn svg_selection(spec: &str, scene: &penumbra_scenes::Scene) -> Result<SvgSelection, Failure> {
+    match spec.trim() {
+        "auto" => return Ok(SvgSelection::Auto),
+        "all" => return Ok(SvgSelection::All),
+        "none" => return Ok(SvgSelection::None),
+        _ => {}
+    }
+    let names: Vec<String> = spec.split(',').map(|n| n.trim().to_owned()).collect();
+    if names.iter().any(String::is_empty) {
+        return Err(usage(anyhow::anyhow!(
+            "--svg takes auto, all, none or surface names separated by commas, not {spec:?}"
+        )));
+    }
+    SvgSelection::named(scene, &names).map_err(|unknown| {
+        let shown: Vec<String> = unknown.iter().take(10).map(|n| format!("{n:?}")).collect();
+        let more = match unknown.len().saturating_sub(shown.len()) {
+            0 => String::new(),
+            n => format!(" and {n} more"),
+        };
+        usage(anyhow::anyhow!(
+            "--svg: the scene has no surface named {}{more} (names are exact; `penumbra check` \
+             counts the surfaces, report.json and solution.json list them)",
+            shown.join(", ")
+        ))
+    })
+}
+
 fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
     if let Some(n) = args.threads {
         if n == 0 {
@@ -671,6 +767,7 @@ fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
             eprintln!("warning: {w}");
         }
     }
+    let svgs = svg_selection(&args.svg, &loaded.scene)?;
     let interrupt = Interrupt::default();
     let received = catch_interrupts(&interrupt).context("cannot catch Ctrl-C")?;
     let options = RunOptions {
@@ -680,7 +777,9 @@ fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
             Some(MeshArg::Uniform) => MeshMethod::Uniform,
             Some(MeshArg::Discontinuity) => MeshMethod::Discontinuity,
         },
-        max_elements: args.max_elements,
+        max_elements: args
+            .max_elements
+            .map_or(DEFAULT_BUDGET, ElementBudget::AtMost),
         penumbra_density,
         time_budget: args.time_budget,
         refine: args
@@ -688,7 +787,8 @@ fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
             .map(|tolerance| penumbra::adaptive::RefineOptions {
                 tolerance,
                 initial_elements: args.initial_elements.unwrap_or(
-                    (args.max_elements as f64 * penumbra::adaptive::INITIAL_FRACTION) as usize,
+                    (args.max_elements.unwrap_or(DEFAULT_MAX_ELEMENTS) as f64
+                        * penumbra::adaptive::INITIAL_FRACTION) as usize,
                 ),
                 max_rounds: args.refine_rounds,
                 indirect: args.refine_indirect.into(),
@@ -739,14 +839,19 @@ fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
             );
             return Ok(signal_status());
         }
-        Err(e) => return Err(run_failure(e)),
+        Err(e) => return Err(run_failure(e, BudgetOptions::Run)),
     };
+    if !args.quiet
+        && let Some(w) = penumbra::energy::EnergyBalance::of(&result.solution.stats).warning()
+    {
+        eprintln!("warning: {w}");
+    }
     let extra = if args.convergence {
         penumbra::outputs::convergence_files(&result)?
     } else {
         Vec::new()
     };
-    let written = write_outputs(&result, &args.out, extra)?;
+    let written = write_outputs(&result, &args.out, &svgs, extra)?;
     if !args.quiet {
         let stats = &result.solution.stats;
         println!(

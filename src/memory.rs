@@ -41,11 +41,7 @@ impl MeshCounts {
     /// can make vertices outnumber triangles.
     pub fn predicted(scene: &Scene, max_elements: usize, elements_per_patch: usize) -> MeshCounts {
         let polygons = scene.surfaces.len() as u64;
-        let minimum: u64 = scene
-            .surfaces
-            .iter()
-            .map(|s| s.polygon.len().saturating_sub(2).max(1) as u64)
-            .sum();
+        let minimum = penumbra_meshing::polygon_minimum(scene) as u64;
         let triangles = (max_elements as u64).max(minimum);
         MeshCounts {
             triangles,
@@ -132,9 +128,14 @@ pub fn cache_bytes(requested: usize, needed: u64, limit: u64) -> usize {
     usize::try_from(spare).map_or(requested, |spare| requested.min(spare))
 }
 
-/// The largest `--max-elements` at most `max_elements` whose predicted estimate fits in
-/// `limit`, if any does.
-pub fn largest_fitting_budget(scene: &Scene, options: &RunOptions, limit: u64) -> Option<usize> {
+/// The largest element budget at most `max_elements` whose predicted estimate fits in `limit`,
+/// if any does.
+pub fn largest_fitting_budget(
+    scene: &Scene,
+    options: &RunOptions,
+    max_elements: usize,
+    limit: u64,
+) -> Option<usize> {
     let fits = |elements: usize| {
         let counts = MeshCounts::predicted(scene, elements, options.solver.elements_per_patch);
         estimate(scene, options, counts).total() <= limit
@@ -142,7 +143,7 @@ pub fn largest_fitting_budget(scene: &Scene, options: &RunOptions, limit: u64) -
     if !fits(1) {
         return None;
     }
-    let (mut lo, mut hi) = (1usize, options.max_elements.max(1));
+    let (mut lo, mut hi) = (1usize, max_elements.max(1));
     if fits(hi) {
         return Some(hi);
     }
@@ -242,7 +243,6 @@ mod tests {
     fn the_suggested_budget_fits_and_a_larger_one_does_not() {
         let scene = penumbra_scenes::builtin::builtin("cornell").expect("built in");
         let options = RunOptions {
-            max_elements: 10_000_000,
             method: SolverMethod::GaussSeidel,
             ..RunOptions::default()
         };
@@ -251,7 +251,8 @@ mod tests {
             let counts = MeshCounts::predicted(&scene, n, options.solver.elements_per_patch);
             estimate(&scene, &options, counts).total() <= limit
         };
-        let best = largest_fitting_budget(&scene, &options, limit).expect("a mesh fits in 2 GiB");
+        let best = largest_fitting_budget(&scene, &options, 10_000_000, limit)
+            .expect("a mesh fits in 2 GiB");
         assert!(fits(best) && !fits(best * 11 / 10), "{best}");
         // Gathering keeps every vertex-patch factor, which grows as the square of the mesh:
         // it fits far fewer elements than shooting.
@@ -259,8 +260,11 @@ mod tests {
             method: SolverMethod::Progressive,
             ..options.clone()
         };
-        let most = largest_fitting_budget(&scene, &shooting, limit).expect("fits");
+        let most = largest_fitting_budget(&scene, &shooting, 10_000_000, limit).expect("fits");
         assert!(most > 5 * best, "{most} vs {best}");
-        assert_eq!(largest_fitting_budget(&scene, &options, 1 << 20), None);
+        assert_eq!(
+            largest_fitting_budget(&scene, &options, 10_000_000, 1 << 20),
+            None
+        );
     }
 }

@@ -1,18 +1,19 @@
-//! The files a run writes: `solution.json`, `report.json`, `render.png` and one SVG per surface.
-//! Each file is written to a temporary name in the output directory and renamed into place, so
-//! a reader never sees half a file.
+//! The files a run writes: `solution.json`, `report.json`, `render.png` and SVGs of the
+//! surfaces worth looking at ([`SvgSelection`]). Each file is written to a temporary name in the
+//! output directory and renamed into place, so a reader never sees half a file.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 
-use penumbra_meshing::MeshQuality;
-use penumbra_scenes::Rgb;
+use penumbra_meshing::{ElementBudget, MeshQuality};
+use penumbra_scenes::{Rgb, Scene, SurfaceId};
 use penumbra_solver::SolveStats;
 use penumbra_solver::{SolverMethod, StopReason};
 use serde::Serialize;
 
+use crate::energy::EnergyBalance;
 use crate::pipeline::{RunResult, StageTimes};
 
 pub const SOLUTION_FORMAT: &str = "penumbra-solution/1";
@@ -83,7 +84,8 @@ struct Report<'a> {
     /// so far, not a converged one.
     partial: bool,
     scene: SceneSummary<'a>,
-    warnings: &'a [String],
+    /// The loader's warnings, then the run's (an energy balance that does not close).
+    warnings: Vec<String>,
     method: Method,
     counts: Counts,
     discontinuities: Option<&'a penumbra_meshing::discontinuity::DiscontinuityStats>,
@@ -94,9 +96,19 @@ struct Report<'a> {
     /// Estimated need, the limit it was checked against, and the peak after each stage.
     memory: &'a crate::pipeline::MemoryReport,
     solver: &'a SolveStats,
-    energy: Energy,
+    energy: EnergyBalance,
     mesh_quality: MeshQuality,
     render: RenderSummary,
+    svgs: SvgSummary,
+}
+
+/// Which surfaces got an SVG, and why.
+#[derive(Serialize)]
+struct SvgSummary {
+    /// `auto` (the surfaces worth looking at), `all`, `none` or `named`.
+    selection: &'static str,
+    /// The files written, relative to the output directory, in surface order.
+    written: Vec<String>,
 }
 
 #[derive(Serialize)]
@@ -114,7 +126,10 @@ struct Method {
     mesh: &'static str,
     mesh_requested: crate::pipeline::MeshMethod,
     solver: &'static str,
+    /// The element budget used: the mesh's, or the cap of adaptive refinement.
     max_elements: usize,
+    /// What was asked for: `"fit"` (the default: what the scene needs) or a number.
+    max_elements_requested: BudgetRequested,
     penumbra_density: f64,
     eee: bool,
     eee_tolerance: f64,
@@ -140,16 +155,21 @@ struct Counts {
     discontinuity_segments: usize,
 }
 
-/// Where the emitted power went, per channel, and as fractions of the emitted power (means).
+/// The element budget as asked for: `"fit"` or a number.
 #[derive(Serialize)]
-struct Energy {
-    emitted: Rgb,
-    absorbed: Rgb,
-    escaped: Rgb,
-    unshot: Rgb,
-    absorbed_fraction: f64,
-    escaped_fraction: f64,
-    unshot_fraction: f64,
+#[serde(untagged)]
+enum BudgetRequested {
+    Fit(&'static str),
+    AtMost(usize),
+}
+
+impl From<ElementBudget> for BudgetRequested {
+    fn from(b: ElementBudget) -> Self {
+        match b {
+            ElementBudget::AtMost(n) => BudgetRequested::AtMost(n),
+            ElementBudget::Fit { .. } => BudgetRequested::Fit("fit"),
+        }
+    }
 }
 
 #[derive(Serialize)]
@@ -160,11 +180,14 @@ struct RenderSummary {
     ambient: Rgb,
 }
 
-pub fn report_json(result: &RunResult) -> String {
+/// `report.json`, for a run whose SVGs are chosen by `svgs`.
+pub fn report_json(result: &RunResult, svgs: &SvgSelection) -> String {
     let scene = &result.loaded.scene;
     let stats = &result.solution.stats;
     let opts = &result.options;
-    let fraction = |p: Rgb| p.mean() / stats.emitted.mean().max(f64::MIN_POSITIVE);
+    let energy = EnergyBalance::of(stats);
+    let mut warnings = result.loaded.warnings.clone();
+    warnings.extend(energy.warning());
     let report = Report {
         format: REPORT_FORMAT,
         partial: matches!(stats.stop, StopReason::Interrupted | StopReason::TimeBudget),
@@ -175,7 +198,7 @@ pub fn report_json(result: &RunResult) -> String {
             emitters: scene.emitters().count(),
             bounding_box_diagonal: scene.diagonal(),
         },
-        warnings: &result.loaded.warnings,
+        warnings,
         method: Method {
             mesh: if result.mesh.discontinuity_stats.is_some() {
                 "discontinuity"
@@ -184,7 +207,8 @@ pub fn report_json(result: &RunResult) -> String {
             },
             mesh_requested: opts.mesh,
             solver: report_solver_name(result),
-            max_elements: opts.max_elements,
+            max_elements: result.budget,
+            max_elements_requested: opts.max_elements.into(),
             penumbra_density: opts.penumbra_density,
             eee: opts.discontinuity.eee,
             eee_tolerance: opts.discontinuity.eee_tolerance,
@@ -210,21 +234,21 @@ pub fn report_json(result: &RunResult) -> String {
         times_seconds: &result.times,
         memory: &result.memory,
         solver: stats,
-        energy: Energy {
-            emitted: stats.emitted,
-            absorbed: stats.absorbed,
-            escaped: stats.escaped,
-            unshot: stats.unshot,
-            absorbed_fraction: fraction(stats.absorbed),
-            escaped_fraction: fraction(stats.escaped),
-            unshot_fraction: fraction(stats.unshot),
-        },
+        energy,
         mesh_quality: result.mesh.quality(),
         render: RenderSummary {
             width: result.render.image.width(),
             height: result.render.image.height(),
             exposure: result.render.exposure,
             ambient: result.solution.ambient,
+        },
+        svgs: SvgSummary {
+            selection: svgs.name(),
+            written: svgs
+                .surfaces(result)
+                .into_iter()
+                .map(|i| format!("{SVG_DIR}/{}", svg_name(i, &scene.surfaces[i].name)))
+                .collect(),
         },
     };
     to_json(&report)
@@ -235,6 +259,93 @@ fn to_json<T: Serialize>(value: &T) -> String {
     let mut s = serde_json::to_string_pretty(value).expect("serializable output (this is a bug)");
     s.push('\n');
     s
+}
+
+/// The directory, inside the output directory, of the surfaces' SVGs.
+pub const SVG_DIR: &str = "surfaces";
+
+/// Surfaces that get an SVG by default, at most: a figure a person can look through, not one
+/// per face of a scanned statue or a cathedral (75,000 of them).
+pub const DEFAULT_SVG_SURFACES: usize = 24;
+
+/// Which surfaces get an SVG (`--svg`).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub enum SvgSelection {
+    /// The surfaces worth looking at: every surface of a scene of at most
+    /// [`DEFAULT_SVG_SURFACES`]; else that many, those with the most discontinuity segments
+    /// first, then the largest, then the first in the scene.
+    #[default]
+    Auto,
+    All,
+    None,
+    /// These surfaces, by index.
+    Named(Vec<SurfaceId>),
+}
+
+impl SvgSelection {
+    /// The surfaces of `scene` named in `names` (exact names), or the names it does not have.
+    pub fn named(scene: &Scene, names: &[String]) -> Result<SvgSelection, Vec<String>> {
+        let mut ids = Vec::new();
+        let mut unknown = Vec::new();
+        for name in names {
+            match scene.surface_id(name) {
+                Some(id) => ids.push(id),
+                None => unknown.push(name.clone()),
+            }
+        }
+        if !unknown.is_empty() {
+            return Err(unknown);
+        }
+        ids.sort_unstable();
+        ids.dedup();
+        Ok(SvgSelection::Named(ids))
+    }
+
+    /// How `report.json` names the selection.
+    pub fn name(&self) -> &'static str {
+        match self {
+            SvgSelection::Auto => "auto",
+            SvgSelection::All => "all",
+            SvgSelection::None => "none",
+            SvgSelection::Named(_) => "named",
+        }
+    }
+
+    /// The surfaces that get an SVG, in the scene's order.
+    pub fn surfaces(&self, result: &RunResult) -> Vec<SurfaceId> {
+        let scene = &result.loaded.scene;
+        match self {
+            SvgSelection::All => (0..scene.surfaces.len()).collect(),
+            SvgSelection::None => Vec::new(),
+            SvgSelection::Named(ids) => ids.clone(),
+            SvgSelection::Auto => {
+                let segments: Vec<usize> =
+                    result.mesh.discontinuities.iter().map(Vec::len).collect();
+                worth_looking_at(scene, &segments, DEFAULT_SVG_SURFACES)
+            }
+        }
+    }
+}
+
+/// At most `count` surfaces of `scene`, in its order: those with the most discontinuity
+/// segments (`segments[s]`), then the largest, then the first.
+pub fn worth_looking_at(scene: &Scene, segments: &[usize], count: usize) -> Vec<SurfaceId> {
+    let areas: Vec<f64> = scene
+        .surfaces
+        .iter()
+        .map(penumbra_scenes::Surface::area)
+        .collect();
+    let mut ranked: Vec<SurfaceId> = (0..scene.surfaces.len()).collect();
+    let segments_of = |s: SurfaceId| segments.get(s).copied().unwrap_or(0);
+    ranked.sort_by(|&a, &b| {
+        segments_of(b)
+            .cmp(&segments_of(a))
+            .then(areas[b].total_cmp(&areas[a]))
+            .then(a.cmp(&b))
+    });
+    ranked.truncate(count);
+    ranked.sort_unstable();
+    ranked
 }
 
 /// A file name for a surface's SVG: its index (names may clash once sanitized) and its name.
@@ -398,27 +509,34 @@ pub fn write_all_atomic(files: &[(PathBuf, Vec<u8>)]) -> anyhow::Result<()> {
 /// tens of thousands of surfaces).
 const SVG_BATCH: usize = 256;
 
-/// Writes every output of a run into `dir` (created if needed), with `extra` files (name and
-/// bytes) beside them, all or nothing (see [`Staging`]); returns the paths written.
+/// Writes every output of a run into `dir` (created if needed), the SVGs of the surfaces `svgs`
+/// chooses in `dir/surfaces`, with `extra` files (name and bytes) beside them, all or nothing
+/// (see [`Staging`]); returns the paths written.
 pub fn write_outputs(
     result: &RunResult,
     dir: &Path,
+    svgs: &SvgSelection,
     extra: Vec<(String, Vec<u8>)>,
 ) -> anyhow::Result<Vec<PathBuf>> {
     use anyhow::Context;
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    let svg_dir = dir.join("surfaces");
-    std::fs::create_dir_all(&svg_dir)
-        .with_context(|| format!("cannot create {}", svg_dir.display()))?;
+    let surfaces = svgs.surfaces(result);
+    let svg_dir = dir.join(SVG_DIR);
+    if !surfaces.is_empty() {
+        std::fs::create_dir_all(&svg_dir)
+            .with_context(|| format!("cannot create {}", svg_dir.display()))?;
+    }
     let mut staging = Staging::default();
     staging.stage(dir.join("solution.json"), solution_json(result).as_bytes())?;
-    staging.stage(dir.join("report.json"), report_json(result).as_bytes())?;
+    staging.stage(
+        dir.join("report.json"),
+        report_json(result, svgs).as_bytes(),
+    )?;
     staging.stage(
         dir.join("render.png"),
         &penumbra_viz::encode_png(&result.render.image)?,
     )?;
     let scene = &result.loaded.scene;
-    let surfaces: Vec<usize> = (0..scene.surfaces.len()).collect();
     for batch in surfaces.chunks(SVG_BATCH) {
         let svgs: Vec<String> = batch
             .par_iter()
@@ -457,6 +575,38 @@ mod tests {
             .collect();
         all.sort();
         all
+    }
+
+    /// The default SVGs: most discontinuity segments first, then the largest surface, then the
+    /// first; in the scene's order; all of a small scene.
+    #[test]
+    fn the_surfaces_worth_looking_at_are_ranked_by_segments_then_area() {
+        let scene = penumbra_scenes::builtin::boxworld(10, 1);
+        let id = |name: &str| scene.surface_id(name).expect("named");
+        let mut segments = vec![0; scene.surfaces.len()];
+        segments[id("box7_side1")] = 5;
+        segments[id("box3_top")] = 5;
+        segments[id("box2_side0")] = 2;
+        let picked = worth_looking_at(&scene, &segments, 4);
+        // The floor is the largest surface without segments.
+        let mut expected = vec![
+            id("box7_side1"),
+            id("box3_top"),
+            id("box2_side0"),
+            id("floor"),
+        ];
+        expected.sort_unstable();
+        assert_eq!(picked, expected);
+        // The textbook scene: the floor is largest; the light and the blocker are unit squares,
+        // equal in area to rounding at most, and the first in the scene wins the tie.
+        let textbook = penumbra_scenes::builtin::textbook();
+        assert_eq!(textbook.surfaces[0].area(), textbook.surfaces[1].area());
+        assert_eq!(worth_looking_at(&textbook, &[0, 0, 0], 2), [0, 2]);
+        assert_eq!(
+            worth_looking_at(&scene, &segments, 1000),
+            (0..scene.surfaces.len()).collect::<Vec<_>>()
+        );
+        assert!(worth_looking_at(&scene, &[], 0).is_empty());
     }
 
     /// A set of files whose last one cannot be written (its directory is missing, or a directory

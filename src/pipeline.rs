@@ -7,7 +7,10 @@ use crate::adaptive::{RefineOptions, RefineReport, refine_adaptively};
 use crate::memory::{self, MeshCounts};
 use penumbra_meshing::discontinuity::{DiscontinuityOptions, find_discontinuities_reporting};
 use penumbra_meshing::grading::DEFAULT_PENUMBRA_DENSITY;
-use penumbra_meshing::{MeshError, SceneMesh, mesh_scene_discontinuity, mesh_scene_uniform};
+use penumbra_meshing::{
+    ElementBudget, MeshError, SceneMesh, mesh_scene_discontinuity, mesh_scene_uniform,
+    polygon_minimum,
+};
 use penumbra_scenes::{LoadedScene, Rgb, Visibility};
 use penumbra_solver::{
     Progress, Solution, SolveError, SolverMethod, SolverOptions, solve_gathering, solve_progressive,
@@ -27,13 +30,19 @@ pub enum MeshMethod {
     Auto,
 }
 
-/// Default cap on triangles for the whole scene.
+/// Triangles for the whole scene by default: this many, or what the scene needs when that is
+/// more (its least mesh and [`penumbra_meshing::FIT_TRIANGLES_PER_SURFACE`] per surface; see
+/// [`ElementBudget::Fit`]).
 pub const DEFAULT_MAX_ELEMENTS: usize = 10_000;
+
+/// The element budget of a run when none is given.
+pub const DEFAULT_BUDGET: ElementBudget = ElementBudget::fit(DEFAULT_MAX_ELEMENTS);
 
 #[derive(Clone, Debug)]
 pub struct RunOptions {
     pub mesh: MeshMethod,
-    pub max_elements: usize,
+    /// Triangles for the whole scene: a cap, or fitted to the scene ([`DEFAULT_BUDGET`]).
+    pub max_elements: ElementBudget,
     /// How many times smaller in area discontinuity-mesh triangles are in penumbrae (1: none).
     pub penumbra_density: f64,
     /// How discontinuities are found (EEE events on or off, tolerances).
@@ -54,7 +63,7 @@ impl Default for RunOptions {
     fn default() -> Self {
         RunOptions {
             mesh: MeshMethod::Auto,
-            max_elements: DEFAULT_MAX_ELEMENTS,
+            max_elements: DEFAULT_BUDGET,
             penumbra_density: DEFAULT_PENUMBRA_DENSITY,
             discontinuity: DiscontinuityOptions::default(),
             refine: None,
@@ -114,6 +123,8 @@ pub struct RunResult {
     pub options: RunOptions,
     pub mesh: SceneMesh,
     pub refinement: Option<RefineReport>,
+    /// The element budget used, resolved: the mesh's, or the cap of adaptive refinement.
+    pub budget: usize,
     pub solution: Solution,
     pub render: Render,
     pub times: StageTimes,
@@ -125,6 +136,10 @@ pub struct RunResult {
 pub enum RunError {
     #[error(transparent)]
     Mesh(#[from] MeshError),
+    /// The starting mesh of adaptive refinement does not fit its budget
+    /// ([`RefineOptions::initial_elements`]), though the scene fits the run's budget.
+    #[error("the starting mesh of adaptive refinement: {0}")]
+    InitialBudget(MeshError),
     #[error(transparent)]
     Solve(#[from] SolveError),
     #[error(transparent)]
@@ -163,6 +178,7 @@ impl RunError {
         matches!(
             self,
             RunError::Mesh(MeshError::BudgetTooSmall { .. })
+                | RunError::InitialBudget(MeshError::BudgetTooSmall { .. })
                 | RunError::Solve(SolveError::InvalidOption { .. })
                 | RunError::Memory { .. }
         )
@@ -203,6 +219,26 @@ pub fn run(
     let mut peaks = StagePeaks::default();
     let scene = &loaded.scene;
 
+    // A cap below what the polygons alone need is refused before anything is computed (finding
+    // the discontinuities of a large scene takes minutes); what they add is checked once they
+    // are found, when the mesh is built.
+    let at_least = polygon_minimum(scene);
+    let surfaces = scene.surfaces.len();
+    let planned_elements = options.max_elements.resolve(at_least, surfaces)?;
+    let initial_budget = match (&options.refine, options.max_elements) {
+        (None, budget) => budget,
+        (Some(r), ElementBudget::AtMost(n)) => ElementBudget::AtMost(r.initial_elements.min(n)),
+        // Refinement starts from the scene's least mesh when that is more than it asks for,
+        // and spends up to the fitted budget.
+        (Some(r), ElementBudget::Fit { .. }) => ElementBudget::Fit {
+            at_least: r.initial_elements,
+            per_surface: 0,
+        },
+    };
+    initial_budget
+        .resolve(at_least, surfaces)
+        .map_err(RunError::InitialBudget)?;
+
     // Refuse at once what cannot fit, rather than be killed later.
     let limit = options.memory_limit.or_else(memory::available_bytes);
     let check = |counts: MeshCounts| -> Result<memory::MemoryEstimate, RunError> {
@@ -211,14 +247,19 @@ pub fn run(
             Some(limit) if estimate.total() > limit => Err(RunError::Memory {
                 needed: estimate.total(),
                 limit,
-                suggestion: memory::largest_fitting_budget(scene, options, limit),
+                suggestion: memory::largest_fitting_budget(
+                    scene,
+                    options,
+                    planned_elements.max(counts.triangles as usize),
+                    limit,
+                ),
             }),
             _ => Ok(estimate),
         }
     };
     let planned = check(MeshCounts::predicted(
         scene,
-        options.max_elements,
+        planned_elements,
         options.solver.elements_per_patch,
     ))?;
 
@@ -255,14 +296,40 @@ pub fn run(
 
     let t = Instant::now();
     progress.start("meshing", 1);
-    let initial = options.refine.as_ref().map_or(options.max_elements, |r| {
-        r.initial_elements.min(options.max_elements)
-    });
-    let mut mesh = match found {
+    let meshed = match found {
         Some(found) if options.mesh == MeshMethod::Discontinuity || found.stats.segments > 0 => {
-            mesh_scene_discontinuity(scene, &visibility, found, initial, options.penumbra_density)?
+            mesh_scene_discontinuity(
+                scene,
+                &visibility,
+                found,
+                initial_budget,
+                options.penumbra_density,
+            )
         }
-        _ => mesh_scene_uniform(scene, initial)?,
+        _ => mesh_scene_uniform(scene, initial_budget),
+    };
+    let mut mesh = match meshed {
+        // The scene fits the run's budget but not the starting mesh's.
+        Err(e @ MeshError::BudgetTooSmall { needed, .. })
+            if options.refine.is_some()
+                && options.max_elements.at_most().is_none_or(|n| needed <= n) =>
+        {
+            return Err(RunError::InitialBudget(e));
+        }
+        meshed => meshed?,
+    };
+    // Adaptive refinement grows the mesh up to the run's budget, resolved now that the scene's
+    // least mesh is known.
+    let budget = match options.refine {
+        None => mesh.budget,
+        Some(_) => options
+            .max_elements
+            .resolve_for(
+                mesh.minimum_triangles,
+                surfaces,
+                mesh.discontinuity_stats.is_some(),
+            )?
+            .max(mesh.triangle_count()),
     };
     progress.finish();
     times.mesh = t.elapsed().as_secs_f64();
@@ -275,10 +342,19 @@ pub fn run(
         &mesh,
         options.solver.elements_per_patch,
     ))?;
-    // Adaptive refinement grows the mesh up to the budget: the plan still holds for it.
+    // Adaptive refinement grows the mesh up to the budget: the plan for that holds for it.
     let estimate = match options.refine {
-        Some(_) if planned.total() > built.total() => planned,
-        _ => built,
+        Some(_) => {
+            let grown = check(MeshCounts::predicted(
+                scene,
+                budget,
+                options.solver.elements_per_patch,
+            ))?;
+            [planned, grown].into_iter().fold(built, |most, e| {
+                if e.total() > most.total() { e } else { most }
+            })
+        }
+        None => built,
     };
     let solver = SolverOptions {
         cache_bytes: limit.map_or(solver.cache_bytes, |limit| {
@@ -294,7 +370,7 @@ pub fn run(
                 scene,
                 &visibility,
                 &mut mesh,
-                options.max_elements,
+                budget,
                 refine,
                 &solver,
                 progress,
@@ -347,6 +423,7 @@ pub fn run(
         options: options.clone(),
         mesh,
         refinement,
+        budget,
         solution,
         render,
         times,

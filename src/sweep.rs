@@ -196,7 +196,7 @@ pub fn sweep(
             let run_options = RunOptions {
                 method: solver,
                 mesh: method.mesh(),
-                max_elements: budget,
+                max_elements: budget.into(),
                 penumbra_density: if method.adaptive() {
                     1.0
                 } else {

@@ -100,11 +100,23 @@ fn run_writes_every_output() {
 
     let png = std::fs::read(out.join("render.png")).expect("render");
     assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    // Three surfaces: by default each gets its SVG, listed in the report.
     for (i, name) in names.iter().enumerate() {
         let svg = std::fs::read_to_string(out.join("surfaces").join(format!("{i:03}-{name}.svg")))
             .expect("one SVG per surface");
         assert!(svg.contains("<svg") && svg.contains(name));
     }
+    assert_eq!(
+        report["svgs"]["written"],
+        serde_json::json!([
+            "surfaces/000-light.svg",
+            "surfaces/001-blocker.svg",
+            "surfaces/002-floor.svg"
+        ])
+    );
+    assert_eq!(report["method"]["max_elements"], 1500);
+    assert_eq!(report["method"]["max_elements_requested"], 1500);
+    assert_eq!(report["energy"]["balanced"], true);
     // Nothing half-written is left behind.
     let leftovers: Vec<_> = std::fs::read_dir(&out)
         .expect("out dir")
@@ -826,4 +838,304 @@ fn check_reports_obj_repairs_even_when_the_scene_is_refused() {
         .expect("the repair is reported");
     let error = err.find("error:").expect("the refusal is reported");
     assert!(warning < error && err.contains("no surface emits"), "{err}");
+}
+
+/// An OBJ scene of `n` x `n` small triangles hovering apart over a floor, under a lamp (and a
+/// material library beside it): n² + 2 polygons needing n² + 4 triangles, but each triangle
+/// casts its own shadow on the floor, whose discontinuities as mesh edges need many more.
+fn leaves_obj(dir: &Path, n: usize) -> std::path::PathBuf {
+    std::fs::write(
+        dir.join("leaves.mtl"),
+        "newmtl white\nKd 0.5 0.5 0.5\nnewmtl lamp\nKd 0 0 0\nKe 10 10 10\n",
+    )
+    .expect("write mtl");
+    let mut obj = String::from(
+        "mtllib leaves.mtl\nv -5 -5 0\nv 5 -5 0\nv 5 5 0\nv -5 5 0\n\
+         v -0.5 -0.5 5\nv -0.5 0.5 5\nv 0.5 0.5 5\nv 0.5 -0.5 5\n\
+         o floor\nusemtl white\nf 1 2 3 4\no lamp\nusemtl lamp\nf 5 6 7 8\no leaves\nusemtl white\n",
+    );
+    let size = 4.0 / n as f64;
+    for k in 0..n * n {
+        let x = -4.0 + 8.0 * ((k / n) as f64 + 0.5) / n as f64;
+        let y = -4.0 + 8.0 * ((k % n) as f64 + 0.5) / n as f64;
+        let v = 8 + 3 * k;
+        obj += &format!(
+            "v {x} {y} 1\nv {} {y} 1\nv {x} {} 1\nf {} {} {}\n",
+            x + size,
+            y + size,
+            v + 1,
+            v + 2,
+            v + 3
+        );
+    }
+    let path = dir.join("leaves.obj");
+    std::fs::write(&path, obj).expect("write obj");
+    path
+}
+
+/// Without `--max-elements` the budget fits the scene: 10,000 triangles, or the least mesh of
+/// its polygons with their discontinuities as edges and 4 triangles more per surface. An
+/// explicit budget one triangle short of that least mesh is refused (exit 2), naming it; one
+/// below what the polygons alone need is refused before the discontinuities are looked for,
+/// naming the polygons' own figure. Adaptive refinement starts from the least mesh and refines
+/// up to the fitted budget.
+#[test]
+fn the_default_budget_fits_the_scene() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let n = 40;
+    let scene = leaves_obj(dir.path(), n);
+    let path = scene.to_str().expect("utf-8");
+    let surfaces = n * n + 2;
+    let polygons_need = n * n + 4;
+    let out = dir.path().join("fit");
+    run_quietly(path, &out, &["--direct-only"]);
+    let report = json(&out.join("report.json"));
+    assert_eq!(report["scene"]["surfaces"], surfaces);
+    assert_eq!(report["method"]["max_elements_requested"], "fit");
+    let budget = report["method"]["max_elements"].as_u64().expect("budget") as usize;
+    let triangles = report["counts"]["triangles"].as_u64().expect("count") as usize;
+    assert!(
+        triangles > 10_000 && triangles <= budget,
+        "{triangles} of {budget}"
+    );
+    let least = budget - 4 * surfaces;
+    assert!(least > polygons_need + 4 * surfaces, "{least}");
+
+    let refused = dir.path().join("refused");
+    let try_budget = |n: usize| {
+        let o = penumbra(&[
+            "run",
+            path,
+            "--direct-only",
+            "--max-elements",
+            &n.to_string(),
+            "--out",
+            refused.to_str().expect("utf-8"),
+            "--quiet",
+        ]);
+        assert_eq!(o.status.code(), Some(2));
+        String::from_utf8_lossy(&o.stderr).into_owned()
+    };
+    let late = try_budget(least - 1);
+    assert!(
+        late.contains(&format!(
+            "--max-elements {} is too small: the scene's polygons, with their discontinuities as \
+             edges, need at least {least} triangles; use --max-elements {least} or more",
+            least - 1
+        )),
+        "{late}"
+    );
+    // The figure is the polygons' own: the discontinuities were not looked for.
+    let early = try_budget(polygons_need - 1);
+    assert!(
+        early.contains(&format!(
+            "the scene's polygons need at least {polygons_need} triangles; use --max-elements \
+             {polygons_need} or more"
+        )) && !early.contains("discontinuities"),
+        "{early}"
+    );
+    assert!(!refused.exists());
+
+    let out = dir.path().join("adaptive");
+    run_quietly(path, &out, &["--direct-only", "--refine-tol", "0.01"]);
+    let report = json(&out.join("report.json"));
+    assert_eq!(report["method"]["max_elements"], budget);
+    let rounds = report["refinement"]["rounds"].as_array().expect("rounds");
+    let first = rounds[0]["triangles"].as_u64().expect("count") as usize;
+    let last = report["counts"]["triangles"].as_u64().expect("count") as usize;
+    assert!(
+        first < least + surfaces && last > first && last <= budget,
+        "{first} -> {last} of {budget}"
+    );
+    // An explicit budget that fits the scene but not the default start (a tenth of it) names
+    // the start's option.
+    let o = penumbra(&[
+        "run",
+        path,
+        "--direct-only",
+        "--refine-tol",
+        "0.01",
+        "--max-elements",
+        &budget.to_string(),
+        "--out",
+        refused.to_str().expect("utf-8"),
+        "--quiet",
+    ]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains(&format!("use --initial-elements {least} or more")),
+        "{stderr}"
+    );
+}
+
+/// `--svg`: by default the 24 surfaces with the most discontinuity segments, then the largest
+/// (every surface of a smaller scene); `all`, `none`, or names. `report.json` lists the files
+/// written; an unknown name is refused before the run, naming it.
+#[test]
+fn svgs_are_written_for_the_surfaces_asked_for() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let svgs = |out: &Path| -> Vec<String> {
+        let mut names: Vec<String> = std::fs::read_dir(out.join("surfaces"))
+            .map(|d| {
+                d.map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+                    .collect()
+            })
+            .unwrap_or_default();
+        names.sort();
+        names
+    };
+    let listed = |out: &Path| -> Vec<String> {
+        let report = json(&out.join("report.json"));
+        report["svgs"]["written"]
+            .as_array()
+            .expect("list")
+            .iter()
+            .map(|s| {
+                s.as_str()
+                    .expect("name")
+                    .trim_start_matches("surfaces/")
+                    .to_owned()
+            })
+            .collect()
+    };
+    let base = ["--direct-only", "--max-elements", "6000"];
+    // 100 boxes: 502 surfaces.
+    let out = dir.path().join("auto");
+    run_quietly("boxworld", &out, &base);
+    let written = svgs(&out);
+    assert_eq!(written.len(), 24);
+    assert_eq!(listed(&out), written);
+    assert_eq!(json(&out.join("report.json"))["svgs"]["selection"], "auto");
+    // The floor has the most segments: every shadow falls on it.
+    assert!(written.contains(&"001-floor.svg".to_owned()), "{written:?}");
+    // The same choice every time.
+    let again = dir.path().join("again");
+    run_quietly("boxworld", &again, &base);
+    assert_eq!(svgs(&again), written);
+
+    let out = dir.path().join("all");
+    run_quietly("boxworld", &out, &[&base[..], &["--svg", "all"]].concat());
+    assert_eq!(svgs(&out).len(), 502);
+    assert_eq!(listed(&out), svgs(&out));
+
+    let out = dir.path().join("none");
+    run_quietly("boxworld", &out, &[&base[..], &["--svg", "none"]].concat());
+    assert!(!out.join("surfaces").exists());
+    assert!(listed(&out).is_empty());
+
+    let out = dir.path().join("named");
+    run_quietly(
+        "boxworld",
+        &out,
+        &[&base[..], &["--svg", "box7_top,floor"]].concat(),
+    );
+    assert_eq!(svgs(&out), ["001-floor.svg", "037-box7_top.svg"]);
+    assert_eq!(json(&out.join("report.json"))["svgs"]["selection"], "named");
+
+    let out = dir.path().join("unknown");
+    let o = penumbra(&[
+        "run",
+        "boxworld",
+        "--svg",
+        "floor,roof,box7_top,chimney",
+        "--out",
+        out.to_str().expect("utf-8"),
+        "--quiet",
+    ]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("--svg") && stderr.contains("\"roof\", \"chimney\""),
+        "{stderr}"
+    );
+    assert!(!out.exists());
+}
+
+/// A wall of few large triangles with a corner right beside a lamp: the linear interpolant of
+/// the light at its corners takes in more than the lamp gives, the escaped power is negative,
+/// and the report and stderr say so; with enough triangles the balance closes.
+#[test]
+fn an_energy_balance_that_does_not_close_is_flagged() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scene = dir.path().join("sliver.json");
+    std::fs::write(
+        &scene,
+        r#"{"name": "sliver", "surfaces": [
+            {"name": "lamp", "polygon": [[-0.5,-0.5,2],[-0.5,0.5,2],[0.5,0.5,2],[0.5,-0.5,2]],
+             "emission": [10,10,10], "reflectance": [0,0,0]},
+            {"name": "floor", "polygon": [[-5,-5,0],[5,-5,0],[5,5,0],[-5,5,0]], "reflectance": [0.5,0.5,0.5]},
+            {"name": "wall", "polygon": [[0.51,0,1.999],[0.51,4,0.5],[0.51,-4,0.5]], "reflectance": [0.5,0.5,0.5]}
+        ]}"#,
+    )
+    .expect("write scene");
+    let path = scene.to_str().expect("utf-8");
+    let coarse = ["--direct-only", "--mesh", "uniform", "--max-elements", "20"];
+    let out = dir.path().join("coarse");
+    let mut args = vec!["run", path, "--out", out.to_str().expect("utf-8")];
+    args.extend(coarse);
+    let o = penumbra(&args);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("warning: the energy balance does not close"),
+        "{stderr}"
+    );
+    let report = json(&out.join("report.json"));
+    let energy = &report["energy"];
+    assert_eq!(energy["balanced"], false);
+    assert!(
+        energy["escaped_fraction"].as_f64().expect("fraction") < -0.1,
+        "{energy}"
+    );
+    assert!(
+        report["warnings"]
+            .as_array()
+            .expect("warnings")
+            .iter()
+            .any(|w| w
+                .as_str()
+                .is_some_and(|w| w.contains("escaped power is negative"))),
+        "{report}"
+    );
+    // --quiet keeps stderr clean; the report still says it.
+    let quiet = run_quietly(path, &dir.path().join("quiet"), &coarse);
+    assert!(quiet.stderr.is_empty());
+
+    let out = dir.path().join("fine");
+    run_quietly(path, &out, &["--direct-only", "--mesh", "uniform"]);
+    let report = json(&out.join("report.json"));
+    assert_eq!(report["energy"]["balanced"], true);
+    assert!(
+        report["energy"]["escaped_fraction"]
+            .as_f64()
+            .expect("fraction")
+            > 0.0
+    );
+    assert_eq!(report["warnings"], serde_json::json!([]));
+}
+
+/// An OBJ material with `Kd 1 1 1` is clamped below 1 with one warning naming it, not refused.
+#[test]
+fn obj_reflectance_of_one_is_clamped_with_a_warning() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    std::fs::write(
+        dir.path().join("m.mtl"),
+        "newmtl bricks\nKd 1 1 1\nnewmtl lamp\nKd 0 0 0\nKe 5 5 5\n",
+    )
+    .expect("write mtl");
+    // Two floors of bricks, apart, under a lamp.
+    let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 3 0 0\nv 4 0 0\nv 4 1 0\n\
+        v 0 0 1\nv 0 1 1\nv 1 1 1\n\
+        usemtl bricks\nf 1 2 3\nf 4 5 6\nusemtl lamp\nf 7 8 9\n";
+    let scene = dir.path().join("bricks.obj");
+    std::fs::write(&scene, obj).expect("write obj");
+    let o = penumbra(&["check", scene.to_str().expect("utf-8")]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    assert_eq!(stderr.matches("Kd").count(), 1, "{stderr}");
+    assert!(
+        stderr.contains("warning: material \"bricks\" has Kd 1 1 1") && stderr.contains("0.99"),
+        "{stderr}"
+    );
 }

@@ -123,7 +123,7 @@ fn direct_error(
 ) -> (f64, usize) {
     let options = RunOptions {
         mesh: method,
-        max_elements,
+        max_elements: max_elements.into(),
         solver: SolverOptions {
             direct_only: true,
             ..SolverOptions::default()

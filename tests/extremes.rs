@@ -8,7 +8,7 @@ use penumbra_solver::{DirectLight, NoProgress, ReceivingPoint, SolverOptions};
 
 fn solve(scene: Scene, direct_only: bool) -> RunResult {
     let options = RunOptions {
-        max_elements: 3_000,
+        max_elements: 3_000.into(),
         solver: SolverOptions {
             direct_only,
             ..SolverOptions::default()

@@ -10,10 +10,17 @@ pub enum MeshError {
     #[error("triangulating surface {surface} failed: {message}")]
     Triangulation { surface: SurfaceId, message: String },
     #[error(
-        "--max-elements {max_elements} is too small: the scene's polygons need at least {needed} triangles; \
-         use --max-elements {needed} or more"
+        "an element budget of {max_elements} triangles is too small: the scene's polygons{} need at least \
+         {needed} triangles",
+        if *.discontinuities { ", with their discontinuities as edges," } else { "" }
     )]
-    BudgetTooSmall { max_elements: usize, needed: usize },
+    BudgetTooSmall {
+        max_elements: usize,
+        needed: usize,
+        /// Whether `needed` counts the discontinuity segments inserted as edges (known only
+        /// after they are found), or the polygons alone.
+        discontinuities: bool,
+    },
     #[error("mesh of surface {surface} is broken: {what} (this is a bug)")]
     SanityCheck { surface: SurfaceId, what: String },
 }

@@ -12,6 +12,7 @@
 //! mesh.sanity_check().unwrap();
 //! ```
 
+pub mod budget;
 pub mod constrained;
 pub mod error;
 pub mod fuzzing;
@@ -23,6 +24,7 @@ pub mod progress;
 pub mod scene_mesh;
 pub mod uniform;
 
+pub use budget::{ElementBudget, FIT_TRIANGLES_PER_SURFACE, polygon_minimum};
 pub use error::MeshError;
 pub use mesh::{MeshQuality, SurfaceMesh, quality_of};
 pub use scene_mesh::{SceneMesh, mesh_scene_discontinuity, mesh_scene_uniform, spread_by_area};

@@ -7,6 +7,7 @@ use rayon::prelude::*;
 use glam::DVec3;
 use penumbra_scenes::{PlaneFrame, Scene, SurfaceId, Visibility};
 
+use crate::budget::{ElementBudget, polygon_triangles};
 use crate::constrained::{ConstrainedSurface, Constraint, RefinableSurface};
 use crate::discontinuity::{
     Discontinuities, DiscontinuitySegment, DiscontinuityStats, EmitterProbe, Event,
@@ -26,6 +27,11 @@ pub struct SceneMesh {
     /// Each surface's contact lines under hovering faces, with their gaps (3D ends, gap).
     pub hovering: Vec<Vec<(DVec3, DVec3, f64)>>,
     pub discontinuity_stats: Option<DiscontinuityStats>,
+    /// The element budget the mesh was built to, resolved (see [`ElementBudget`]).
+    pub budget: usize,
+    /// The least number of triangles any mesh of the scene with these constraints has: each
+    /// surface's constrained triangulation before refinement.
+    pub minimum_triangles: usize,
 }
 
 impl SceneMesh {
@@ -85,20 +91,21 @@ impl SceneMesh {
     }
 }
 
-/// Splits `max_elements` over the surfaces in proportion to their areas, giving each at least
-/// `minimum[s]` triangles. The targets never sum to more than `max_elements`.
+/// Splits a budget over the surfaces in proportion to their areas, giving each at least
+/// `minimum[s]` triangles; `discontinuities` says whether the minima count discontinuity edges
+/// (it only words the error). A fitted budget is resolved from the minima
+/// ([`ElementBudget::resolve_for`]). Returns the resolved budget and the targets, which never
+/// sum to more than it.
 pub fn spread_by_area(
     areas: &[f64],
     minimum: &[usize],
-    max_elements: usize,
-) -> Result<Vec<usize>, MeshError> {
+    budget: impl Into<ElementBudget>,
+    discontinuities: bool,
+) -> Result<(usize, Vec<usize>), MeshError> {
     let needed: usize = minimum.iter().sum();
-    if needed > max_elements {
-        return Err(MeshError::BudgetTooSmall {
-            max_elements,
-            needed,
-        });
-    }
+    let max_elements = budget
+        .into()
+        .resolve_for(needed, minimum.len(), discontinuities)?;
     let total: f64 = areas.iter().sum();
     let mut spread = max_elements;
     loop {
@@ -109,14 +116,17 @@ pub fn spread_by_area(
             .collect();
         let sum: usize = targets.iter().sum();
         if sum <= max_elements {
-            return Ok(targets);
+            return Ok((max_elements, targets));
         }
         spread -= (sum - max_elements).min(spread);
     }
 }
 
-/// A uniform mesh of every surface, about `max_elements` triangles in all, spread by area.
-pub fn mesh_scene_uniform(scene: &Scene, max_elements: usize) -> Result<SceneMesh, MeshError> {
+/// A uniform mesh of every surface, about `budget` triangles in all, spread by area.
+pub fn mesh_scene_uniform(
+    scene: &Scene,
+    budget: impl Into<ElementBudget>,
+) -> Result<SceneMesh, MeshError> {
     let areas: Vec<f64> = scene
         .surfaces
         .iter()
@@ -126,9 +136,9 @@ pub fn mesh_scene_uniform(scene: &Scene, max_elements: usize) -> Result<SceneMes
     let minimum: Vec<usize> = scene
         .surfaces
         .iter()
-        .map(|s| s.polygon.len().saturating_sub(2).max(1))
+        .map(|s| polygon_triangles(s.polygon.len()))
         .collect();
-    let targets = spread_by_area(&areas, &minimum, max_elements)?;
+    let (budget, targets) = spread_by_area(&areas, &minimum, budget, false)?;
     let refinable = scene
         .surfaces
         .iter()
@@ -147,18 +157,20 @@ pub fn mesh_scene_uniform(scene: &Scene, max_elements: usize) -> Result<SceneMes
         surfaces,
         refinable,
         discontinuity_stats: None,
+        budget,
+        minimum_triangles: minimum.iter().sum(),
     })
 }
 
 /// Discontinuity meshes: each surface's discontinuity segments become constraint edges, then the
-/// surfaces are refined to about `max_elements` triangles in all, spread by area, with triangles
+/// surfaces are refined to about `budget` triangles in all, spread by area, with triangles
 /// `penumbra_density` times smaller in area where the light varies (1: no grading; see
 /// [`crate::grading`]).
 pub fn mesh_scene_discontinuity(
     scene: &Scene,
     visibility: &Visibility,
     found: Discontinuities,
-    max_elements: usize,
+    budget: impl Into<ElementBudget>,
     penumbra_density: f64,
 ) -> Result<SceneMesh, MeshError> {
     let constrained = scene
@@ -190,7 +202,8 @@ pub fn mesh_scene_discontinuity(
         .iter()
         .map(ConstrainedSurface::minimum_triangles)
         .collect();
-    let targets = spread_by_area(&areas, &minimum, max_elements)?;
+    let (budget, targets) = spread_by_area(&areas, &minimum, budget, true)?;
+    let minimum_triangles = minimum.iter().sum();
     let refinable: Vec<RefinableSurface> = constrained
         .into_par_iter()
         .zip(targets)
@@ -238,6 +251,8 @@ pub fn mesh_scene_discontinuity(
         discontinuities,
         hovering,
         discontinuity_stats: Some(found.stats),
+        budget,
+        minimum_triangles,
     })
 }
 
@@ -248,14 +263,21 @@ mod tests {
 
     #[test]
     fn budget_is_a_cap_and_follows_area() {
-        let t = spread_by_area(&[1.0, 1.0, 2.0, 1e-6], &[2, 2, 2, 2], 1000).expect("fits");
+        let (budget, t) =
+            spread_by_area(&[1.0, 1.0, 2.0, 1e-6], &[2, 2, 2, 2], 1000, false).expect("fits");
+        assert_eq!(budget, 1000);
         assert!(t.iter().sum::<usize>() <= 1000);
         assert!(t[2] > t[0] + t[0] / 2);
         assert_eq!(t[3], 2);
         assert!(matches!(
-            spread_by_area(&[1.0, 1.0], &[5, 5], 8),
+            spread_by_area(&[1.0, 1.0], &[5, 5], 8, false),
             Err(MeshError::BudgetTooSmall { needed: 10, .. })
         ));
+        // Fitted to the scene: the minimum and a few triangles more per surface.
+        let fit = ElementBudget::fit(8);
+        let (budget, t) = spread_by_area(&[1.0, 3.0], &[5, 5], fit, false).expect("fits");
+        assert_eq!(budget, 10 + 2 * crate::FIT_TRIANGLES_PER_SURFACE);
+        assert!(t.iter().sum::<usize>() <= budget && t[1] > t[0], "{t:?}");
     }
 
     #[test]

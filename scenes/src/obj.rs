@@ -5,8 +5,10 @@
 //! and line): repeated corners are dropped, faces that touch themselves are cut into loops,
 //! faces with no area dropped, and non-planar faces split into triangles ([`repair`]). Then
 //! coplanar adjacent faces of one material are merged into single surfaces where that is exact
-//! ([`crate::coplanar`]), unless [`ObjOptions::merge_coplanar`] is off. Anything else is left
-//! for validation to report.
+//! ([`crate::coplanar`]), unless [`ObjOptions::merge_coplanar`] is off. A material whose `Kd`
+//! reaches 1 (white in many exported scenes: Sponza's bricks are `Kd 1 1 1`) has those channels
+//! clamped to [`MAX_OBJ_REFLECTANCE`], with one warning per material. Anything else is left for
+//! validation to report.
 //!
 //! Faces are named `object/material/index` ([`faces`]); a merged surface takes the name of its
 //! first face, and a face cut into pieces names them `name.0`, `name.1`, ...
@@ -31,6 +33,13 @@ use tally::{FaceSource, Tally, thousands};
 
 /// Reflectance of faces without a material.
 pub const DEFAULT_REFLECTANCE: f64 = 0.5;
+
+/// The highest reflectance an OBJ material gets: `Kd` channels at or above 1 are clamped to it.
+/// A reflectance of 1 keeps all the light a surface receives, which the radiosity equation
+/// cannot converge with in a closed scene; 0.99 keeps the material's look (white stays white)
+/// and lets light die out after a few hundred bounces. JSON scenes state reflectance
+/// deliberately and are refused instead.
+pub const MAX_OBJ_REFLECTANCE: f64 = 0.99;
 
 /// Choices in reading OBJ files.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -192,10 +201,18 @@ fn parse(
         .collect();
     warnings.extend(repairs.warnings());
 
+    let mut used: Vec<usize> = faces.iter().filter_map(|f| f.material).collect();
+    used.sort_unstable();
+    used.dedup();
+    warnings.extend(
+        used.iter()
+            .filter_map(|&m| materials.get(m))
+            .filter_map(clamped_reflectance_warning),
+    );
     let material_of = |face: &Face| match face.material.and_then(|m| materials.get(m)) {
         Some(m) => (
             m.diffuse
-                .map(Rgb::from)
+                .map(|kd| Rgb::from(kd).map(clamp_reflectance))
                 .unwrap_or(Rgb::splat(DEFAULT_REFLECTANCE)),
             m.emissive.map(Rgb::from).unwrap_or(Rgb::ZERO),
         ),
@@ -238,6 +255,25 @@ fn parse(
             surfaces,
         },
         warnings,
+    ))
+}
+
+/// A `Kd` channel as a reflectance: at or above 1, [`MAX_OBJ_REFLECTANCE`]; anything else as it
+/// is (what is negative or not a number is validation's to refuse).
+fn clamp_reflectance(kd: f64) -> f64 {
+    if kd >= 1.0 { MAX_OBJ_REFLECTANCE } else { kd }
+}
+
+/// The warning for a material whose `Kd` reaches 1 in some channel, if it does.
+fn clamped_reflectance_warning(material: &tobj::Material) -> Option<String> {
+    let kd = material.diffuse?;
+    if !kd.iter().any(|&c| c >= 1.0) {
+        return None;
+    }
+    Some(format!(
+        "material \"{}\" has Kd {} {} {}: a surface cannot reflect all the light it receives, so \
+         its channels at or above 1 become {MAX_OBJ_REFLECTANCE}",
+        material.name, kd[0], kd[1], kd[2]
     ))
 }
 

@@ -485,3 +485,69 @@ fn names_that_collide_through_slashes_are_made_unique() {
         "{warnings:?}"
     );
 }
+
+/// `Kd` at or above 1 (Sponza's bricks are `Kd 1 1 1`) is clamped to
+/// `MAX_OBJ_REFLECTANCE` channel by channel, with one warning per material used, naming it and
+/// its value, and the scene is valid; a material no face uses is not mentioned. JSON scenes
+/// keep refusing reflectance 1.
+#[test]
+fn reflectance_of_one_or_more_is_clamped_with_a_warning_per_material() {
+    use penumbra_scenes::obj::MAX_OBJ_REFLECTANCE;
+    let mtl = "newmtl bricks\nKd 1 1 1\nnewmtl red\nKd 1.2 0.5 0.25\nnewmtl unused\nKd 1 1 1\n\
+               newmtl lamp\nKd 0 0 0\nKe 5 5 5\n";
+    // Four faces of bricks and two of red, apart so that none merge.
+    let mut obj = String::from("mtllib m.mtl\n");
+    let mut v = 0;
+    for (k, material) in ["bricks", "bricks", "bricks", "bricks", "red", "red", "lamp"]
+        .iter()
+        .enumerate()
+    {
+        let (x, z) = (2.0 * k as f64, if *material == "lamp" { 1.0 } else { 0.0 });
+        obj += &format!(
+            "v {x} 0 {z}\nv {} 0 {z}\nv {} 1 {z}\nusemtl {material}\nf {} {} {}\n",
+            x + 1.0,
+            x + 1.0,
+            v + 1,
+            v + 2,
+            v + 3
+        );
+        v += 3;
+    }
+    let (scene, warnings) = parse_obj_text(&obj, mtl, Path::new("k.obj")).expect("parses");
+    assert!(penumbra_scenes::validate(&scene).is_empty());
+    let clamped: Vec<&String> = warnings.iter().filter(|w| w.contains("Kd")).collect();
+    assert_eq!(clamped.len(), 2, "{warnings:?}");
+    assert!(
+        clamped[0].contains("\"bricks\" has Kd 1 1 1") && clamped[0].contains("0.99"),
+        "{}",
+        clamped[0]
+    );
+    assert!(
+        clamped[1].contains("\"red\" has Kd 1.2 0.5 0.25"),
+        "{}",
+        clamped[1]
+    );
+    let reflectance = |name: &str| {
+        scene
+            .surfaces
+            .iter()
+            .find(|s| s.name.contains(name))
+            .map(|s| s.reflectance.to_array())
+            .expect("surface")
+    };
+    assert_eq!(reflectance("bricks"), [MAX_OBJ_REFLECTANCE; 3]);
+    assert_eq!(reflectance("red"), [MAX_OBJ_REFLECTANCE, 0.5, 0.25]);
+
+    let json = r#"{"surfaces": [
+        {"name": "lamp", "polygon": [[0,0,2],[0,1,2],[1,1,2],[1,0,2]], "emission": [1,1,1], "reflectance": [0,0,0]},
+        {"name": "floor", "polygon": [[0,0,0],[1,0,0],[1,1,0],[0,1,0]], "reflectance": [1, 1, 1]}
+    ]}"#;
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("white.json");
+    std::fs::write(&path, json).expect("writes");
+    let refused = load_scene(path.to_str().expect("utf-8"));
+    assert!(
+        matches!(refused, Err(SceneError::Invalid { .. })),
+        "{refused:?}"
+    );
+}

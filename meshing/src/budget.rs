@@ -1,0 +1,145 @@
+//! The element budget: how many triangles a scene's mesh may have in all.
+//!
+//! A budget is either a cap the caller chose ([`ElementBudget::AtMost`]), which is an error when
+//! the scene cannot be meshed within it, or "what the scene needs" ([`ElementBudget::Fit`]),
+//! which grows with the scene. A scene's least mesh is known only once its discontinuity
+//! segments are inserted as constraint edges (each constraint can only add triangles), so a
+//! fitted budget is resolved then, inside [`crate::mesh_scene_discontinuity`] and
+//! [`crate::mesh_scene_uniform`]. Before that, [`polygon_minimum`] is a lower bound known
+//! from the polygons alone.
+//!
+//! ```
+//! use penumbra_meshing::{ElementBudget, FIT_TRIANGLES_PER_SURFACE};
+//! let fit = ElementBudget::fit(10_000);
+//! // A small scene: the floor of the fitted budget.
+//! assert_eq!(fit.resolve(40, 10).ok(), Some(10_000));
+//! // A large one: its least mesh and a few triangles more per surface.
+//! let fitted = fit.resolve(49_229, 30_000);
+//! assert_eq!(fitted.ok(), Some(49_229 + FIT_TRIANGLES_PER_SURFACE * 30_000));
+//! assert!(ElementBudget::AtMost(10_000).resolve(49_229, 30_000).is_err());
+//! ```
+
+use penumbra_scenes::Scene;
+
+use crate::error::MeshError;
+
+/// Triangles per surface that a budget fitted to the scene adds beyond the scene's least mesh,
+/// so that the larger surfaces get some refinement (the budget is spread by area) while a scene
+/// of tens of thousands of small faces stays close to its least mesh.
+pub const FIT_TRIANGLES_PER_SURFACE: usize = 4;
+
+/// How many triangles the mesh of a whole scene may have.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ElementBudget {
+    /// At most this many; a scene whose least mesh has more is refused
+    /// ([`MeshError::BudgetTooSmall`]).
+    AtMost(usize),
+    /// What the scene needs: `at_least` triangles, or the scene's least mesh plus `per_surface`
+    /// triangles per surface when that is more ([`ElementBudget::fit`]: the usual
+    /// [`FIT_TRIANGLES_PER_SURFACE`]).
+    Fit { at_least: usize, per_surface: usize },
+}
+
+impl From<usize> for ElementBudget {
+    fn from(max_elements: usize) -> Self {
+        ElementBudget::AtMost(max_elements)
+    }
+}
+
+impl ElementBudget {
+    /// What the scene needs, at least `at_least` triangles, with [`FIT_TRIANGLES_PER_SURFACE`]
+    /// beyond the least mesh.
+    pub const fn fit(at_least: usize) -> ElementBudget {
+        ElementBudget::Fit {
+            at_least,
+            per_surface: FIT_TRIANGLES_PER_SURFACE,
+        }
+    }
+
+    /// The number of triangles for a scene of `surfaces` surfaces whose least mesh has
+    /// `minimum` triangles (polygons only, or with their discontinuities as edges, as
+    /// `discontinuities` says: it only words the error).
+    pub fn resolve_for(
+        self,
+        minimum: usize,
+        surfaces: usize,
+        discontinuities: bool,
+    ) -> Result<usize, MeshError> {
+        match self {
+            ElementBudget::AtMost(max_elements) if minimum > max_elements => {
+                Err(MeshError::BudgetTooSmall {
+                    max_elements,
+                    needed: minimum,
+                    discontinuities,
+                })
+            }
+            ElementBudget::AtMost(max_elements) => Ok(max_elements),
+            ElementBudget::Fit {
+                at_least,
+                per_surface,
+            } => Ok(at_least.max(minimum.saturating_add(per_surface.saturating_mul(surfaces)))),
+        }
+    }
+
+    /// [`Self::resolve_for`] a least mesh of the polygons alone.
+    pub fn resolve(self, minimum: usize, surfaces: usize) -> Result<usize, MeshError> {
+        self.resolve_for(minimum, surfaces, false)
+    }
+
+    /// The cap, if the caller chose one.
+    pub fn at_most(self) -> Option<usize> {
+        match self {
+            ElementBudget::AtMost(n) => Some(n),
+            ElementBudget::Fit { .. } => None,
+        }
+    }
+}
+
+/// Triangles a polygon of `vertices` corners needs at least: `vertices - 2` (and one for a
+/// degenerate polygon, which validation refuses anyway).
+pub fn polygon_triangles(vertices: usize) -> usize {
+    vertices.saturating_sub(2).max(1)
+}
+
+/// The least number of triangles any mesh of `scene` has: each polygon of n corners needs
+/// n - 2. Discontinuity segments inserted as edges can only add to it.
+pub fn polygon_minimum(scene: &Scene) -> usize {
+    scene
+        .surfaces
+        .iter()
+        .map(|s| polygon_triangles(s.polygon.len()))
+        .sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_cap_refuses_what_does_not_fit_and_a_fitted_budget_grows() {
+        assert_eq!(ElementBudget::from(500), ElementBudget::AtMost(500));
+        assert_eq!(ElementBudget::AtMost(500).resolve(500, 3).ok(), Some(500));
+        assert!(matches!(
+            ElementBudget::AtMost(499).resolve_for(500, 3, true),
+            Err(MeshError::BudgetTooSmall {
+                max_elements: 499,
+                needed: 500,
+                discontinuities: true
+            })
+        ));
+        let fit = ElementBudget::fit(1000);
+        assert_eq!(fit.resolve(10, 3).ok(), Some(1000));
+        assert_eq!(fit.resolve(990, 3).ok(), Some(1002));
+        assert_eq!(fit.resolve(usize::MAX, 3).ok(), Some(usize::MAX));
+        assert_eq!(fit.at_most(), None);
+        // The least mesh itself, when that is more than `at_least`.
+        let least = ElementBudget::Fit {
+            at_least: 1000,
+            per_surface: 0,
+        };
+        assert_eq!(least.resolve(1500, 3).ok(), Some(1500));
+        let square = penumbra_scenes::builtin::textbook();
+        // Three quadrilaterals: two triangles each.
+        assert_eq!(polygon_minimum(&square), 6);
+    }
+}
