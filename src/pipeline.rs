@@ -185,6 +185,16 @@ impl RunError {
     }
 }
 
+/// The budget the mesh will have, as far as the polygons alone tell (at least one triangle).
+fn planned_budget(scene: &penumbra_scenes::Scene, options: &RunOptions) -> usize {
+    let least = polygon_minimum(scene);
+    options
+        .max_elements
+        .resolve(least, scene.surfaces.len())
+        .unwrap_or(least)
+        .max(1)
+}
+
 /// Runs the whole pipeline on a loaded scene.
 pub fn run(
     loaded: LoadedScene,
@@ -282,7 +292,7 @@ pub fn run(
             scene,
             &visibility,
             &DiscontinuityOptions {
-                element_area: Some(scene.total_area() / options.max_elements.max(1) as f64),
+                element_area: Some(scene.total_area() / planned_budget(scene, options) as f64),
                 deadline: solver.deadline,
                 interrupt: options.solver.interrupt.clone(),
                 ..options.discontinuity.clone()
