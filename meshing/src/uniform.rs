@@ -47,6 +47,10 @@ fn allowance(target: usize) -> usize {
     target + 64
 }
 
+/// Vertices quality refinement may add per triangle split adaptively: a bisection and the few
+/// flips and splits that restore the angles around it.
+const SPLIT_VERTICES_PER_FACE: usize = 8;
+
 /// Rounds of a refinement stopped before its target (see
 /// `SurfaceTriangulation::refined_capped`): each closes at least half the gap to the target
 /// left by the one before, unless the refinement is complete.
@@ -330,8 +334,10 @@ impl SurfaceTriangulation {
             let _ = self.cdt.insert(Point2::new(p.x, p.y));
         }
         let mut cdt = std::mem::take(&mut self.cdt);
-        let budget = cdt.num_vertices();
-        self.refine_cdt(&mut cdt, min_angle_deg, None, smallest, allowance(budget));
+        // Quality is restored around the splits only: a triangulation whose first refinement was
+        // stopped at its target (see `refined_capped`) would otherwise be refined all over.
+        let room = SPLIT_VERTICES_PER_FACE * faces.len();
+        self.refine_cdt(&mut cdt, min_angle_deg, None, smallest, allowance(room));
         self.cdt = cdt;
         self.find_outside();
         self.cdt.num_vertices() - before
