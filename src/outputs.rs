@@ -81,7 +81,8 @@ pub fn solution_json(result: &RunResult) -> String {
 struct Report<'a> {
     format: &'static str,
     /// The run was cut short (interrupted, or its time budget spent): the solution is the best
-    /// so far, not a converged one.
+    /// so far, not a converged one, or its mesh lacks the events of the emitter–receiver pairs
+    /// the discontinuity search had no time for.
     partial: bool,
     scene: SceneSummary<'a>,
     /// The loader's warnings, then the run's (an energy balance that does not close).
@@ -190,7 +191,12 @@ pub fn report_json(result: &RunResult, svgs: &SvgSelection) -> String {
     warnings.extend(energy.warning());
     let report = Report {
         format: REPORT_FORMAT,
-        partial: matches!(stats.stop, StopReason::Interrupted | StopReason::TimeBudget),
+        partial: matches!(stats.stop, StopReason::Interrupted | StopReason::TimeBudget)
+            || result
+                .mesh
+                .discontinuity_stats
+                .as_ref()
+                .is_some_and(|d| d.pairs_skipped > 0),
         scene: SceneSummary {
             name: &scene.name,
             source: &result.loaded.source,

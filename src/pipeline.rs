@@ -307,7 +307,11 @@ pub fn run(
     let t = Instant::now();
     progress.start("meshing", 1);
     let meshed = match found {
-        Some(found) if options.mesh == MeshMethod::Discontinuity || found.stats.segments > 0 => {
+        Some(found)
+            if options.mesh == MeshMethod::Discontinuity
+                || found.stats.segments > 0
+                || found.stats.pairs_skipped > 0 =>
+        {
             mesh_scene_discontinuity(
                 scene,
                 &visibility,

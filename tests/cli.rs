@@ -1140,3 +1140,24 @@ fn obj_reflectance_of_one_is_clamped_with_a_warning() {
         "{stderr}"
     );
 }
+
+/// A time budget spent before the discontinuity search starts its first pair leaves the mesh
+/// without events: the run still completes, its light is exact at the vertices, and
+/// `report.json` says the result is partial and how many pairs were skipped.
+#[test]
+fn a_budget_spent_in_the_discontinuity_search_makes_the_run_partial() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("out");
+    run_quietly(
+        "textbook",
+        &out,
+        &["--direct-only", "--time-budget", "1e-9"],
+    );
+    let report = json(&out.join("report.json"));
+    assert_eq!(report["partial"], true);
+    let d = &report["discontinuities"];
+    assert!(d["pairs"].as_u64().expect("pairs") > 0);
+    assert_eq!(d["pairs_skipped"], d["pairs"]);
+    assert_eq!(d["segments"], 0);
+    assert!(check_radiosity(&json(&out.join("solution.json"))) > 0);
+}
