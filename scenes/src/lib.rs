@@ -30,6 +30,7 @@ pub mod obj;
 pub mod polygon;
 pub mod rng;
 pub mod tessellated;
+pub mod union_find;
 pub mod validate;
 pub mod visibility;
 

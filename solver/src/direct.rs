@@ -109,6 +109,14 @@ struct Emitter {
     merge_distance: f64,
 }
 
+impl Emitter {
+    /// Visible pieces and shadows no wider than this, seen from `point`, are slivers of rounding:
+    /// coordinates as large as the emitter's and the point's carry this error.
+    fn sliver_width(&self, point: DVec3) -> f64 {
+        SLIVER_ULPS * f64::EPSILON * self.magnitude.max(point.abs().max_element())
+    }
+}
+
 /// Splits a surface polygon into convex pieces: itself when convex, else its triangles.
 fn convex_pieces(polygon: &[DVec3]) -> Vec<Vec<DVec3>> {
     let Some(frame) = PlaneFrame::of_polygon(polygon) else {
@@ -275,7 +283,7 @@ impl<'a> DirectLight<'a> {
         if h_x <= self.tol {
             return None;
         }
-        let min_width = SLIVER_ULPS * f64::EPSILON * e.magnitude.max(point.abs().max_element());
+        let min_width = e.sliver_width(point);
         let mut views = Vec::with_capacity(e.pieces.len());
         for full in &e.pieces {
             let mut piece: Vec<DVec2> = full.iter().map(|&p| e.frame.to_2d(p)).collect();
@@ -349,13 +357,14 @@ impl<'a> DirectLight<'a> {
             let mut sum = signed_sum(&seen);
             // What the faces through x hide on the receiver's side, as disjoint convex pieces.
             let mut hidden: Vec<Vec<DVec2>> = Vec::new();
+            let front_piece = clip_half_plane(&view.piece, &front);
             for &index in &view.touching {
                 let occ = &self.occluders[index];
                 if occ.surface == receiver {
                     continue;
                 }
                 for region in contact_shadow(x, occ, e, tol) {
-                    let mut part = clip_half_plane(&view.piece, &front);
+                    let mut part = front_piece.clone();
                     for h in &region {
                         part = clip_half_plane(&part, h);
                     }
@@ -452,7 +461,7 @@ impl<'a> DirectLight<'a> {
         h_x: f64,
     ) -> Vec<VisibleShape> {
         // The rounding scale of this evaluation: coordinates as large as these carry this error.
-        let min_width = SLIVER_ULPS * f64::EPSILON * e.magnitude.max(x.point.abs().max_element());
+        let min_width = e.sliver_width(x.point);
         let mut piece = front.iter().map(|&p| e.frame.to_2d(p)).collect::<Vec<_>>();
         if area_2d(&piece) < 0.0 {
             piece.reverse();
@@ -489,7 +498,7 @@ impl<'a> DirectLight<'a> {
         piece: &[DVec2],
     ) -> Option<Vec<Blocking>> {
         let tol = self.tol;
-        let min_width = SLIVER_ULPS * f64::EPSILON * e.magnitude.max(point.abs().max_element());
+        let min_width = e.sliver_width(point);
         // The shaft's side planes through x and each edge, oriented to contain the piece.
         let center = front.iter().copied().sum::<DVec3>() / front.len() as f64;
         let sides: Vec<DVec3> = (0..front.len())
@@ -571,7 +580,10 @@ impl<'a> DirectLight<'a> {
                     e.frame.to_2d(point + (p - point) * s)
                 })
                 .collect();
-            if tidy_shadow(&corners, e, min_width).is_some_and(|shadow| covers(&shadow, piece)) {
+            // Only a shadow whose box holds the piece's can cover it; most are far smaller.
+            if box_holds(&corners, piece)
+                && tidy_shadow(&corners, e, min_width).is_some_and(|shadow| covers(&shadow, piece))
+            {
                 return None;
             }
             blockings.push(Blocking::Shadow {
@@ -589,6 +601,16 @@ struct PieceView {
     piece: Vec<DVec2>,
     visible: Vec<VisibleShape>,
     touching: Vec<usize>,
+}
+
+/// Whether the bounding box of `outer` holds every point of `inner`.
+fn box_holds(outer: &[DVec2], inner: &[DVec2]) -> bool {
+    let (lo, hi) = outer
+        .iter()
+        .fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), &p| {
+            (lo.min(p), hi.max(p))
+        });
+    inner.iter().all(|p| p.cmpge(lo).all() && p.cmple(hi).all())
 }
 
 /// Whether a shadow (a convex counter-clockwise polygon, tidied by [`tidy_shadow`]) covers all

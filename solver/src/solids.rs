@@ -7,6 +7,7 @@ use std::collections::HashMap;
 
 use glam::DVec3;
 use penumbra_scenes::Scene;
+use penumbra_scenes::union_find::UnionFind;
 
 /// A corner identified by its exact coordinates (faces of a welded mesh share them).
 fn key(p: DVec3) -> [u64; 3] {
@@ -56,30 +57,6 @@ pub fn closed_solid_orientation(scene: &Scene) -> Vec<Option<f64>> {
             (is_closed && volume != 0.0).then(|| volume.signum())
         })
         .collect()
-}
-
-/// Disjoint sets of surfaces, by path halving.
-struct UnionFind(Vec<usize>);
-
-impl UnionFind {
-    fn new(n: usize) -> UnionFind {
-        UnionFind((0..n).collect())
-    }
-
-    fn find(&mut self, mut i: usize) -> usize {
-        while self.0[i] != i {
-            self.0[i] = self.0[self.0[i]];
-            i = self.0[i];
-        }
-        i
-    }
-
-    fn join(&mut self, a: usize, b: usize) {
-        let (a, b) = (self.find(a), self.find(b));
-        // The smaller root wins, so the grouping does not depend on the order of joins.
-        let (lo, hi) = (a.min(b), a.max(b));
-        self.0[hi] = lo;
-    }
 }
 
 #[cfg(test)]

@@ -2,6 +2,7 @@
 //! blocker edge and the VE wedges of its emitter vertices all lie in one plane.
 
 use glam::DVec2;
+use penumbra_scenes::union_find::UnionFind;
 
 /// A segment on a receiver in its plane-frame coordinates, with what generated it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -54,14 +55,7 @@ pub fn merge_collinear<T: Copy>(
         };
         on(a, b.from) && on(a, b.to) && on(b, a.from) && on(b, a.to)
     };
-    let mut parent: Vec<usize> = (0..n).collect();
-    fn find(parent: &mut [usize], mut i: usize) -> usize {
-        while parent[i] != i {
-            parent[i] = parent[parent[i]];
-            i = parent[i];
-        }
-        i
-    }
+    let mut sets = UnionFind::new(n);
     for i in 0..n {
         let (ka, ko) = keys[i];
         for da in -1..=1 {
@@ -81,8 +75,7 @@ pub fn merge_collinear<T: Copy>(
                 };
                 for &j in others {
                     if j > i && collinear(segments[i], segments[j]) {
-                        let (ri, rj) = (find(&mut parent, i), find(&mut parent, j));
-                        parent[ri.max(rj)] = ri.min(rj);
+                        sets.join(i, j);
                     }
                 }
             }
@@ -90,7 +83,7 @@ pub fn merge_collinear<T: Copy>(
     }
     let mut groups: std::collections::BTreeMap<usize, Vec<usize>> = Default::default();
     for i in 0..n {
-        let r = find(&mut parent, i);
+        let r = sets.find(i);
         groups.entry(r).or_default().push(i);
     }
 

@@ -5,6 +5,7 @@
 
 use glam::DVec3;
 use penumbra_scenes::SurfaceId;
+use penumbra_scenes::union_find::UnionFind;
 
 use super::topology::Topology;
 
@@ -27,20 +28,20 @@ pub struct Patches {
 impl Patches {
     pub fn new(topology: &Topology) -> Patches {
         let count = topology.loops.len();
-        let mut parent: Vec<usize> = (0..count).collect();
+        let mut sets = UnionFind::new(count);
         for faces in topology.edges.values() {
             if let [(s, forward_s), (t, forward_t)] = faces.as_slice()
                 && forward_s != forward_t
                 && coplanar(topology, *s, *t)
             {
-                join(&mut parent, *s, *t);
+                sets.join(*s, *t);
             }
         }
         let mut index = vec![usize::MAX; count];
         let mut faces: Vec<Vec<SurfaceId>> = Vec::new();
         let mut of_surface = vec![0; count];
         for s in 0..count {
-            let root = find(&mut parent, s);
+            let root = sets.find(s);
             if index[root] == usize::MAX {
                 index[root] = faces.len();
                 faces.push(Vec::new());
@@ -81,21 +82,6 @@ fn coplanar(topology: &Topology, s: SurfaceId, t: SurfaceId) -> bool {
     topology.loops[t]
         .iter()
         .all(|&v| ns.dot(topology.points[v] - origin).abs() <= topology.weld)
-}
-
-fn find(parent: &mut [usize], mut i: usize) -> usize {
-    while parent[i] != i {
-        parent[i] = parent[parent[i]];
-        i = parent[i];
-    }
-    i
-}
-
-/// Joins two sets; the smaller root wins, so the result does not depend on the order of joins.
-fn join(parent: &mut [usize], a: usize, b: usize) {
-    let (a, b) = (find(parent, a), find(parent, b));
-    let (lo, hi) = (a.min(b), a.max(b));
-    parent[hi] = lo;
 }
 
 impl Topology {
