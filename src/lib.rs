@@ -12,6 +12,7 @@ pub mod memory;
 pub mod outputs;
 pub mod pipeline;
 pub mod progress_bar;
+pub mod shard;
 pub mod sweep;
 
 pub use pipeline::{

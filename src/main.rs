@@ -44,6 +44,10 @@ enum Command {
     /// error against cost, point by point, the hemicube's aliasing, the 1 x 2 x 3 box's face
     /// factors and dense solutions of a unit cube; write form-factors.json and print the tables.
     FormFactors(FormFactorArgs),
+    /// Join the outputs of the shards of a run (`run --shard I/N`) into one: solution.json as
+    /// the run not split would have written it, report.json with the shards' figures joined,
+    /// render.png and the shards' SVGs.
+    Merge(MergeArgs),
     /// List the built-in scenes.
     Scenes,
     /// Load and validate a scene, reporting every problem at once.
@@ -221,6 +225,29 @@ struct RunArgs {
     #[arg(long, default_value = "auto", value_name = "auto|all|none|NAME,...")]
     svg: String,
     /// No progress bars, no summary and no warnings.
+    #[arg(long)]
+    quiet: bool,
+    /// With --direct-only: light only shard I of N (I from 0 to N - 1), the surfaces whose
+    /// index is I modulo N, and write OUT/shard.json and their SVGs for `penumbra merge`. The
+    /// discontinuities and meshes are still the whole scene's (each surface's share of the
+    /// element budget depends on all of them); the direct light is split.
+    #[arg(long, value_name = "I/N")]
+    shard: Option<String>,
+}
+
+#[derive(clap::Args, Debug)]
+struct MergeArgs {
+    /// The output directories of the shards (`run --shard I/N --out DIR`), every shard once.
+    #[arg(required = true)]
+    dirs: Vec<PathBuf>,
+    /// Output directory.
+    #[arg(long, default_value = "out")]
+    out: PathBuf,
+    /// The scene the shards were run on, to render the joined solution (default: as the shards
+    /// were given it; checked against their fingerprint).
+    #[arg(long)]
+    scene: Option<String>,
+    /// No summary.
     #[arg(long)]
     quiet: bool,
 }
@@ -406,6 +433,7 @@ fn dispatch(cli: Cli) -> Result<ExitCode, Failure> {
         Command::Check { scene, no_merge } => check(&scene, obj_options(no_merge))?,
         Command::Run(args) => return run(&args),
         Command::Sweep(args) => sweep(&args)?,
+        Command::Merge(args) => merge(&args)?,
         Command::FormFactors(args) => form_factors(&args)?,
     }
     Ok(ExitCode::SUCCESS)
@@ -707,6 +735,74 @@ fn svg_selection(spec: &str, scene: &penumbra_scenes::Scene) -> Result<SvgSelect
     })
 }
 
+/// `--shard I/N`, checked against the other options of `run`.
+fn shard_of(text: &str, args: &RunArgs) -> Result<penumbra::shard::Shard, Failure> {
+    use penumbra::shard::{Shard, ShardError};
+    let shard = Shard::parse(text).map_err(|e| usage(anyhow::anyhow!("--shard: {e}")))?;
+    let refused = |flag: &str, e: ShardError| usage(anyhow::anyhow!("--shard with {flag}: {e}"));
+    if !args.direct_only {
+        return Err(usage(anyhow::anyhow!(
+            "--shard needs --direct-only: {}",
+            ShardError::NeedsDirectOnly
+        )));
+    }
+    if args.refine_tol.is_some() {
+        return Err(refused("--refine-tol", ShardError::Refinement));
+    }
+    if args.time_budget.is_some() {
+        return Err(refused("--time-budget", ShardError::TimeBudget));
+    }
+    if args.convergence {
+        return Err(usage(anyhow::anyhow!(
+            "--shard with --convergence: a direct-only run does not iterate, so there is no \
+             convergence to write"
+        )));
+    }
+    Ok(shard)
+}
+
+fn merge(args: &MergeArgs) -> Result<(), Failure> {
+    use penumbra::shard::{MergeError, check_shards, merge, read_shard, write_merged};
+    let fail = |e: MergeError| {
+        if e.is_usage() {
+            usage(e)
+        } else {
+            Failure::from(e)
+        }
+    };
+    let mut shards = Vec::with_capacity(args.dirs.len());
+    for dir in &args.dirs {
+        shards.push((dir.clone(), read_shard(dir).map_err(fail)?));
+    }
+    let shards = check_shards(shards).map_err(fail)?;
+    let origin = shards
+        .first()
+        .map(|(_, f)| f.scene.clone())
+        .ok_or_else(|| fail(MergeError::Nothing))?;
+    let spec = args.scene.clone().unwrap_or(origin.spec);
+    let loaded = load_scene_with(&spec, &obj_options(origin.no_merge)).map_err(|e| {
+        usage(anyhow::anyhow!(
+            "{}; give the scene with --scene",
+            MergeError::Scene(e)
+        ))
+    })?;
+    let merged = merge(shards, &loaded).map_err(|e| match e {
+        MergeError::SceneChanged { .. } if args.scene.is_none() => usage(anyhow::anyhow!(
+            "{e}; give the scene the shards were run on with --scene"
+        )),
+        e => fail(e),
+    })?;
+    let written = write_merged(&merged, &args.out)?;
+    if !args.quiet {
+        println!(
+            "{}: {} shards joined: {} surfaces, {} triangles, {} vertices",
+            merged.scene_name, merged.shards, merged.surfaces, merged.triangles, merged.vertices
+        );
+        println!("wrote {} files to {}", written.len(), args.out.display());
+    }
+    Ok(())
+}
+
 fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
     if let Some(n) = args.threads {
         if n == 0 {
@@ -761,6 +857,11 @@ fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
             "--width and --height must be at least 1"
         )));
     }
+    let shard = args
+        .shard
+        .as_deref()
+        .map(|text| shard_of(text, args))
+        .transpose()?;
     let loaded = load(&args.scene, obj_options(args.no_merge))?;
     if !args.quiet {
         for w in &loaded.warnings {
@@ -825,6 +926,7 @@ fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
             ..Default::default()
         },
         memory_limit: args.memory_limit.map(|mib| (mib * 1024.0 * 1024.0) as u64),
+        shard,
     };
     let bars = Bars::new(args.quiet);
     // The conventional status of a process ended by a signal: 130 for SIGINT, 143 for SIGTERM.
@@ -845,6 +947,46 @@ fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
         && let Some(w) = penumbra::energy::EnergyBalance::of(&result.solution.stats).warning()
     {
         eprintln!("warning: {w}");
+    }
+    if let Some(shard) = shard {
+        let origin = penumbra::shard::SceneOrigin {
+            spec: args.scene.clone(),
+            no_merge: args.no_merge,
+        };
+        let written = penumbra::shard::write_shard(&result, shard, origin, &args.out, &svgs)?;
+        if !args.quiet {
+            let on = shard.surfaces(result.mesh.surfaces.len());
+            let lit = |count: fn(&penumbra_meshing::SurfaceMesh) -> usize| -> usize {
+                result
+                    .mesh
+                    .surfaces
+                    .iter()
+                    .zip(&on)
+                    .filter(|(_, on)| **on)
+                    .map(|(m, _)| count(m))
+                    .sum()
+            };
+            println!(
+                "{}: shard {shard}: {} of {} surfaces, {} triangles, {} vertices lit; direct light \
+                 {:.2} s, {:.2} s in all",
+                result.loaded.scene.name,
+                on.iter().filter(|&&b| b).count(),
+                on.len(),
+                lit(penumbra_meshing::SurfaceMesh::triangle_count),
+                lit(penumbra_meshing::SurfaceMesh::vertex_count),
+                result.times.direct,
+                result.times.total
+            );
+            println!(
+                "wrote {} files to {} (join the shards with `penumbra merge`)",
+                written.len(),
+                args.out.display()
+            );
+        }
+        if interrupt.is_set() {
+            return Ok(signal_status());
+        }
+        return Ok(ExitCode::SUCCESS);
     }
     let extra = if args.convergence {
         penumbra::outputs::convergence_files(&result)?

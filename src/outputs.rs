@@ -23,58 +23,74 @@ pub const REPORT_FORMAT: &str = "penumbra-report/1";
 struct SolutionFile<'a> {
     format: &'static str,
     scene: &'a str,
-    surfaces: Vec<SurfaceSolution<'a>>,
+    surfaces: &'a [SurfaceSolution],
 }
 
-#[derive(Serialize)]
-struct SurfaceSolution<'a> {
-    name: &'a str,
-    vertices: Vec<[f64; 3]>,
-    triangles: &'a [[u32; 3]],
-    radiosity: Vec<[f64; 3]>,
-    discontinuities: Vec<Discontinuity>,
+/// One surface of `solution.json`. A shard's part ([`crate::shard`]) carries each surface's
+/// `index` in the scene as well; `solution.json` leaves it out.
+#[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SurfaceSolution {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub index: Option<SurfaceId>,
+    pub name: String,
+    pub vertices: Vec<[f64; 3]>,
+    pub triangles: Vec<[u32; 3]>,
+    pub radiosity: Vec<[f64; 3]>,
+    pub discontinuities: Vec<Discontinuity>,
 }
 
 /// A discontinuity segment of the direct light on a surface (none for uniform meshes).
-#[derive(Debug, Serialize)]
-struct Discontinuity {
-    from: [f64; 3],
-    to: [f64; 3],
-    event: &'static str,
-    boundary: &'static str,
-    order: u8,
+#[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Discontinuity {
+    pub from: [f64; 3],
+    pub to: [f64; 3],
+    pub event: String,
+    pub boundary: String,
+    pub order: u8,
+}
+
+/// Surface `s` of a run as `solution.json` gives it.
+pub fn surface_solution(result: &RunResult, s: SurfaceId) -> SurfaceSolution {
+    let m = &result.mesh.surfaces[s];
+    SurfaceSolution {
+        index: None,
+        name: result.loaded.scene.surfaces[s].name.clone(),
+        vertices: m.points3.iter().map(|p| p.to_array()).collect(),
+        triangles: m.triangles.clone(),
+        radiosity: result.solution.radiosity[s]
+            .iter()
+            .map(|c| c.to_array())
+            .collect(),
+        discontinuities: result.mesh.discontinuities[m.surface]
+            .iter()
+            .map(|g| Discontinuity {
+                from: g.from.to_array(),
+                to: g.to.to_array(),
+                event: g.event.name().to_owned(),
+                boundary: g.boundary.name().to_owned(),
+                order: g.order,
+            })
+            .collect(),
+    }
 }
 
 /// `solution.json`: per surface, vertices, triangles and radiosity (no display-only ambient term).
 pub fn solution_json(result: &RunResult) -> String {
-    let scene = &result.loaded.scene;
-    let file = SolutionFile {
+    let surfaces: Vec<SurfaceSolution> = (0..result.mesh.surfaces.len())
+        .map(|s| surface_solution(result, s))
+        .collect();
+    solution_json_of(&result.loaded.scene.name, &surfaces)
+}
+
+/// `solution.json` of scene `scene` from its surfaces, in the scene's order.
+pub fn solution_json_of(scene: &str, surfaces: &[SurfaceSolution]) -> String {
+    to_json(&SolutionFile {
         format: SOLUTION_FORMAT,
-        scene: &scene.name,
-        surfaces: scene
-            .surfaces
-            .iter()
-            .zip(&result.mesh.surfaces)
-            .zip(&result.solution.radiosity)
-            .map(|((s, m), b)| SurfaceSolution {
-                name: &s.name,
-                vertices: m.points3.iter().map(|p| p.to_array()).collect(),
-                triangles: &m.triangles,
-                radiosity: b.iter().map(|c| c.to_array()).collect(),
-                discontinuities: result.mesh.discontinuities[m.surface]
-                    .iter()
-                    .map(|g| Discontinuity {
-                        from: g.from.to_array(),
-                        to: g.to.to_array(),
-                        event: g.event.name(),
-                        boundary: g.boundary.name(),
-                        order: g.order,
-                    })
-                    .collect(),
-            })
-            .collect(),
-    };
-    to_json(&file)
+        scene,
+        surfaces,
+    })
 }
 
 #[derive(Serialize)]

@@ -5,6 +5,7 @@ use std::time::Instant;
 
 use crate::adaptive::{RefineOptions, RefineReport, refine_adaptively};
 use crate::memory::{self, MeshCounts};
+use crate::shard::{Shard, ShardError};
 use penumbra_meshing::discontinuity::{DiscontinuityOptions, find_discontinuities_reporting};
 use penumbra_meshing::grading::DEFAULT_PENUMBRA_DENSITY;
 use penumbra_meshing::{
@@ -13,7 +14,8 @@ use penumbra_meshing::{
 };
 use penumbra_scenes::{LoadedScene, Rgb, Visibility};
 use penumbra_solver::{
-    Progress, Solution, SolveError, SolverMethod, SolverOptions, solve_gathering, solve_progressive,
+    Progress, Solution, SolveError, SolverMethod, SolverOptions, solve_direct_on, solve_gathering,
+    solve_progressive,
 };
 use penumbra_viz::{Render, RenderOptions, VizError};
 use serde::Serialize;
@@ -57,6 +59,8 @@ pub struct RunOptions {
     pub render: RenderOptions,
     /// Bytes the run may use (default: what the machine has available when it starts).
     pub memory_limit: Option<u64>,
+    /// Light only this shard's surfaces (direct light only; see [`crate::shard`]).
+    pub shard: Option<Shard>,
 }
 
 impl Default for RunOptions {
@@ -72,6 +76,7 @@ impl Default for RunOptions {
             method: SolverMethod::Progressive,
             render: RenderOptions::default(),
             memory_limit: None,
+            shard: None,
         }
     }
 }
@@ -144,6 +149,8 @@ pub enum RunError {
     Solve(#[from] SolveError),
     #[error(transparent)]
     Render(#[from] VizError),
+    #[error(transparent)]
+    Shard(#[from] ShardError),
     #[error("{}", memory_message(.needed, .limit, .suggestion))]
     Memory {
         /// Estimated bytes.
@@ -181,6 +188,7 @@ impl RunError {
                 | RunError::InitialBudget(MeshError::BudgetTooSmall { .. })
                 | RunError::Solve(SolveError::InvalidOption { .. })
                 | RunError::Memory { .. }
+                | RunError::Shard(_)
         )
     }
 }
@@ -215,6 +223,9 @@ pub fn run(
                 reason: "the hemicube gives the rows of a fixed mesh; adaptive refinement needs analytic or monte-carlo",
             }));
         }
+    }
+    if let Some(shard) = options.shard {
+        shard.check(options)?;
     }
     let started = Instant::now();
     // An anytime run: everything after meshing stops at the deadline.
@@ -390,6 +401,19 @@ pub fn run(
                 progress,
             )?;
             (Some(report), solution)
+        }
+        // Every surface is meshed as in a whole run (each one's share of the budget depends on
+        // all of them, and the direct light at a point shared by several surfaces is evaluated
+        // once for all); only the shard's vertices are lit.
+        None if options.shard.is_some() => {
+            let on = options
+                .shard
+                .map(|shard| shard.surfaces(scene.surfaces.len()))
+                .unwrap_or_default();
+            (
+                None,
+                solve_direct_on(scene, &mesh, &visibility, &solver, &on, progress)?,
+            )
         }
         None if solver.direct_only || options.method == SolverMethod::Progressive => (
             None,

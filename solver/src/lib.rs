@@ -41,5 +41,5 @@ pub use lambert::{ReceivingPoint, form_factor};
 pub use progress::{NoProgress, Progress};
 pub use progressive::{
     ConvergencePoint, Interrupt, ProgressiveSolver, Solution, SolveStats, SolverOptions,
-    StopReason, solve_progressive,
+    StopReason, solve_direct_on, solve_progressive,
 };

@@ -195,9 +195,39 @@ pub fn direct_irradiance(
     options: &SolverOptions,
     progress: &dyn Progress,
 ) -> Result<Vec<Rgb>, SolveError> {
+    direct_irradiance_on(scene, disc, visibility, options, None, progress)
+}
+
+/// [`direct_irradiance`] at the vertices of the surfaces `on` marks only (all when `None`); the
+/// other vertices get zero. Each value is the one [`direct_irradiance`] gives, to the bit: where
+/// vertices of several surfaces share a point and one evaluation, that evaluation is made for
+/// them all, as it is when every vertex is lit (see [`direct_at`]).
+pub fn direct_irradiance_on(
+    scene: &Scene,
+    disc: &Discretization,
+    visibility: &Visibility,
+    options: &SolverOptions,
+    on: Option<&[bool]>,
+    progress: &dyn Progress,
+) -> Result<Vec<Rgb>, SolveError> {
     let direct = DirectLight::new(scene, visibility);
     let all: Vec<usize> = (0..disc.receiver_count()).collect();
-    direct_at(&direct, disc, &all, options.interrupt.as_ref(), progress)
+    let wanted =
+        |v: usize| on.is_none_or(|on| on.get(disc.receiver_surface[v]).copied().unwrap_or(false));
+    let mut values = direct_at(
+        &direct,
+        disc,
+        &all,
+        &wanted,
+        options.interrupt.as_ref(),
+        progress,
+    )?;
+    for (v, h) in values.iter_mut().enumerate() {
+        if !wanted(v) {
+            *h = Rgb::ZERO;
+        }
+    }
+    Ok(values)
 }
 
 /// Receivers closer than this fraction of the scene's diagonal share one evaluation of what
@@ -207,10 +237,14 @@ const SHARED_POINT: f64 = 1e-12;
 
 /// The exact direct irradiance at `receivers`, computed once per point for receivers that
 /// share one (faces of a mesh meeting at a vertex; see [`DirectLight::irradiance_group`]).
+/// Only the groups holding a receiver that `wanted` accepts are evaluated (the others are
+/// zero); a group is always evaluated whole, so a receiver's value does not depend on which
+/// others are wanted.
 fn direct_at(
     direct: &DirectLight,
     disc: &Discretization,
     receivers: &[usize],
+    wanted: &(dyn Fn(usize) -> bool + Sync),
     interrupt: Option<&Interrupt>,
     progress: &dyn Progress,
 ) -> Result<Vec<Rgb>, SolveError> {
@@ -232,6 +266,12 @@ fn direct_at(
         });
         groups[g].push(i);
     }
+    let evaluated: Vec<bool> = groups
+        .iter()
+        .map(|g| g.iter().any(|&i| wanted(receivers[i])))
+        .collect();
+    let mut kept = evaluated.iter();
+    groups.retain(|_| kept.next().copied().unwrap_or(false));
     let per_group = par_map_with_progress(&groups, "direct light", interrupt, progress, |g| {
         let members: Vec<(ReceivingPoint, SurfaceId)> = g
             .iter()
@@ -309,6 +349,28 @@ pub fn solve_progressive(
     Ok(solver.solution())
 }
 
+/// The direct light only (`options.direct_only` must be set), at the vertices of the surfaces
+/// `on` marks; the other surfaces' vertices get their emission alone. The values on the marked
+/// surfaces are those of [`solve_progressive`] on the same mesh, to the bit; the statistics
+/// (absorbed and received power) count the marked surfaces only.
+pub fn solve_direct_on(
+    scene: &Scene,
+    mesh: &SceneMesh,
+    visibility: &Visibility,
+    options: &SolverOptions,
+    on: &[bool],
+    progress: &dyn Progress,
+) -> Result<Solution, SolveError> {
+    if !options.direct_only {
+        return Err(SolveError::InvalidOption {
+            option: "direct only",
+            reason: "the light of some surfaces alone is exact only without interreflection",
+        });
+    }
+    let solver = ProgressiveSolver::new_on(scene, mesh, visibility, options, Some(on), progress)?;
+    Ok(solver.solution())
+}
+
 /// A patch that has shot: its geometry, kept after the mesh changes, and the radiosity it shot.
 #[derive(Clone, Debug)]
 struct Shooter {
@@ -361,11 +423,25 @@ impl<'a> ProgressiveSolver<'a> {
         options: &SolverOptions,
         progress: &dyn Progress,
     ) -> Result<ProgressiveSolver<'a>, SolveError> {
+        Self::new_on(scene, mesh, visibility, options, None, progress)
+    }
+
+    /// [`Self::new`], with the direct light at the vertices of the surfaces `on` marks only
+    /// (see [`direct_irradiance_on`]).
+    fn new_on(
+        scene: &'a Scene,
+        mesh: &SceneMesh,
+        visibility: &'a Visibility,
+        options: &SolverOptions,
+        on: Option<&[bool]>,
+        progress: &dyn Progress,
+    ) -> Result<ProgressiveSolver<'a>, SolveError> {
         options.validate()?;
         check_mesh(scene, mesh)?;
         let disc = Discretization::new(scene, mesh, options.elements_per_patch);
         let started = Instant::now();
-        let direct_irradiance = direct_irradiance(scene, &disc, visibility, options, progress)?;
+        let direct_irradiance =
+            direct_irradiance_on(scene, &disc, visibility, options, on, progress)?;
         let direct_seconds = started.elapsed().as_secs_f64();
         let received = disc.integrate(&direct_irradiance, |_| Rgb::splat(1.0));
         // Methods that give whole rows compute every form factor up front.
@@ -668,7 +744,7 @@ impl<'a> ProgressiveSolver<'a> {
         let t = Instant::now();
         // Remeshing runs to its end: the refinement loop checks for interrupts between rounds,
         // and stopping here would lose the solution it has.
-        let new_direct = direct_at(&self.direct, &disc, &fresh, None, progress)?;
+        let new_direct = direct_at(&self.direct, &disc, &fresh, &|_| true, None, progress)?;
         self.direct_seconds += t.elapsed().as_secs_f64();
         let t = Instant::now();
         let rays = std::sync::atomic::AtomicU64::new(0);

@@ -1,0 +1,715 @@
+//! Sharded runs: the direct light of one scene split over processes or machines by an existing
+//! scheduler (a Slurm job array, GNU parallel), then joined.
+//!
+//! Shard `I` of `N` (`0 <= I < N`) lights the surfaces whose index in the scene is `I` modulo
+//! `N`. Everything else is computed for the whole scene, exactly as in a run that is not split,
+//! so that each surface's mesh and values are the same to the bit:
+//!
+//! - the discontinuity search and every surface's constrained triangulation: the element budget
+//!   fitted to the scene, and each surface's share of it, depend on every surface's least mesh,
+//!   which depends on its discontinuities;
+//! - the refined meshes: the exact direct light at a point shared by several surfaces (the faces
+//!   of a tessellated mesh meeting at a vertex) is evaluated once for all of them, so a vertex's
+//!   value depends on which vertices of other surfaces share its point.
+//!
+//! What is split is the direct light at the vertices, which is most of a large run (the scanned
+//! statue: 195 of 212 s). Each shard writes [`SHARD_FILE`] (its surfaces' part of
+//! `solution.json`, its report and a fingerprint of the scene and the options) and the SVGs of
+//! its surfaces; [`merge`] checks that the shards belong to one run, that none is missing or
+//! twice, and joins them into the `solution.json` the run would have written, byte for byte.
+//!
+//! A full solution cannot be split this way: light bounces between all surfaces, so every
+//! surface's radiosity depends on every other's. Adaptive refinement spends one budget over the
+//! whole scene against its mean radiosity, and a time budget would cut shards short at
+//! different points; shards refuse both ([`ShardError`]).
+
+use std::path::{Path, PathBuf};
+
+use penumbra_meshing::{SceneMesh, SurfaceMesh};
+use penumbra_scenes::{LoadedScene, PlaneFrame, Rgb, SceneError, SurfaceId};
+use serde::{Deserialize, Serialize};
+
+use crate::energy::EnergyBalance;
+use crate::outputs::{
+    SVG_DIR, Staging, SurfaceSolution, SvgSelection, report_json, solution_json_of,
+    surface_solution, svg_name,
+};
+use crate::pipeline::{RunOptions, RunResult};
+
+/// The file a shard writes into its output directory.
+pub const SHARD_FILE: &str = "shard.json";
+/// The format of [`SHARD_FILE`].
+pub const SHARD_FORMAT: &str = "penumbra-shard/1";
+
+/// One of `count` parts of a scene's surfaces: those whose index is `index` modulo `count`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Shard {
+    pub index: usize,
+    pub count: usize,
+}
+
+/// Why a shard cannot be run as asked.
+#[derive(Debug, thiserror::Error, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum ShardError {
+    #[error("a shard is written I/N with whole numbers I and N (I from 0 to N - 1), not {0:?}")]
+    Syntax(String),
+    #[error("a scene cannot be split into 0 shards")]
+    NoShards,
+    #[error("there is no shard {index} of {count}: shards are numbered from 0 to {}", .count - 1)]
+    OutOfRange { index: usize, count: usize },
+    #[error(
+        "a full solution cannot be split by surface: light bounces between all surfaces, so each \
+         one's radiosity depends on every other's; only the direct light can be split"
+    )]
+    NeedsDirectOnly,
+    #[error(
+        "adaptive refinement cannot be split by surface: it spends one element budget over the \
+         whole scene, against the scene's mean radiosity"
+    )]
+    Refinement,
+    #[error(
+        "a time budget cannot be split by surface: it would cut the shards short at different \
+         points, and their parts would not belong to one run"
+    )]
+    TimeBudget,
+}
+
+impl Shard {
+    /// Shard `index` of `count`.
+    pub fn new(index: usize, count: usize) -> Result<Shard, ShardError> {
+        if count == 0 {
+            return Err(ShardError::NoShards);
+        }
+        if index >= count {
+            return Err(ShardError::OutOfRange { index, count });
+        }
+        Ok(Shard { index, count })
+    }
+
+    /// `I/N`, as a scheduler's task number gives it (`0/8` to `7/8`).
+    pub fn parse(text: &str) -> Result<Shard, ShardError> {
+        let syntax = || ShardError::Syntax(text.to_owned());
+        let (i, n) = text.trim().split_once('/').ok_or_else(syntax)?;
+        let number = |s: &str| s.trim().parse::<usize>().map_err(|_| syntax());
+        Shard::new(number(i)?, number(n)?)
+    }
+
+    /// Whether surface `s` is this shard's.
+    pub fn contains(self, s: SurfaceId) -> bool {
+        s % self.count == self.index
+    }
+
+    /// For each of `surfaces` surfaces, whether it is this shard's.
+    pub fn surfaces(self, surfaces: usize) -> Vec<bool> {
+        (0..surfaces).map(|s| self.contains(s)).collect()
+    }
+
+    /// Refuses options whose results cannot be split by surface.
+    pub fn check(self, options: &RunOptions) -> Result<(), ShardError> {
+        Shard::new(self.index, self.count)?;
+        if !options.solver.direct_only {
+            return Err(ShardError::NeedsDirectOnly);
+        }
+        if options.refine.is_some() {
+            return Err(ShardError::Refinement);
+        }
+        if options.time_budget.is_some() {
+            return Err(ShardError::TimeBudget);
+        }
+        Ok(())
+    }
+}
+
+impl std::fmt::Display for Shard {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}/{}", self.index, self.count)
+    }
+}
+
+/// How the scene was given, so that `merge` can load it again to render the joined solution.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneOrigin {
+    /// The scene as given on the command line: a built-in name or a path.
+    pub spec: String,
+    /// OBJ files: whether coplanar faces were left unmerged.
+    pub no_merge: bool,
+}
+
+/// [`SHARD_FILE`]: what a shard hands to [`merge`].
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShardFile {
+    pub format: String,
+    pub shard: Shard,
+    /// Of the scene and every option that changes an output: shards of one run share it.
+    pub fingerprint: String,
+    /// Of the scene alone.
+    pub scene_fingerprint: String,
+    pub scene: SceneOrigin,
+    /// Surfaces in the scene.
+    pub scene_surfaces: usize,
+    pub render_width: u32,
+    pub render_height: u32,
+    /// The loader's warnings.
+    pub warnings: Vec<String>,
+    /// The shard's `report.json`: the whole scene's discontinuities, mesh and counts (every shard
+    /// builds them), and the power this shard's surfaces absorbed and received.
+    pub report: serde_json::Value,
+    /// The SVGs written beside this file, relative to its directory.
+    pub svgs: Vec<String>,
+    /// This shard's surfaces, each with its `index` in the scene, in the scene's order.
+    pub surfaces: Vec<SurfaceSolution>,
+}
+
+/// FNV-1a, 64 bits: a fingerprint against mixing up runs, not a cryptographic hash.
+fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
+    })
+}
+
+fn hex(bytes: &[u8]) -> String {
+    format!("{:016x}", fnv1a(bytes))
+}
+
+/// The fingerprint of a scene: of its JSON form, so of every number in it.
+pub fn scene_fingerprint(loaded: &LoadedScene) -> String {
+    hex(serde_json::to_string(&loaded.scene)
+        .unwrap_or_default()
+        .as_bytes())
+}
+
+/// The fingerprint of a run: its scene, and the options `report.json` records (the thread
+/// count aside, which changes no output), the render's size and the SVG selection.
+fn run_fingerprint(report: &serde_json::Value, scene: &str, svgs: &SvgSelection) -> String {
+    let mut method = report.get("method").cloned().unwrap_or_default();
+    if let Some(m) = method.as_object_mut() {
+        m.remove("threads");
+    }
+    let render = report
+        .get("render")
+        .map(|r| (r.get("width"), r.get("height")));
+    let key = serde_json::json!({
+        "scene": scene,
+        "method": method,
+        "render": render,
+        "svgs": format!("{svgs:?}"),
+    });
+    hex(key.to_string().as_bytes())
+}
+
+/// Writes a shard's outputs into `dir` (created if needed): [`SHARD_FILE`] and the SVGs of its
+/// surfaces that `svgs` chooses (the selection is the whole run's), all or nothing. Returns the
+/// paths written.
+pub fn write_shard(
+    result: &RunResult,
+    shard: Shard,
+    origin: SceneOrigin,
+    dir: &Path,
+    svgs: &SvgSelection,
+) -> anyhow::Result<Vec<PathBuf>> {
+    use anyhow::Context;
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let scene = &result.loaded.scene;
+    let report: serde_json::Value = serde_json::from_str(&report_json(result, svgs))?;
+    let ours: Vec<SurfaceId> = svgs
+        .surfaces(result)
+        .into_iter()
+        .filter(|&s| shard.contains(s))
+        .collect();
+    let svg_dir = dir.join(SVG_DIR);
+    if !ours.is_empty() {
+        std::fs::create_dir_all(&svg_dir)
+            .with_context(|| format!("cannot create {}", svg_dir.display()))?;
+    }
+    let mut staging = Staging::default();
+    let mut written = Vec::new();
+    for &s in &ours {
+        let svg = penumbra_viz::surface_svg(
+            scene,
+            &result.mesh.surfaces[s],
+            Some(&result.solution.radiosity[s]),
+            &result.mesh.discontinuities[s],
+        );
+        let name = svg_name(s, &scene.surfaces[s].name);
+        staging.stage(svg_dir.join(&name), svg.as_bytes())?;
+        written.push(format!("{SVG_DIR}/{name}"));
+    }
+    let scene_print = scene_fingerprint(&result.loaded);
+    let file = ShardFile {
+        format: SHARD_FORMAT.to_owned(),
+        shard,
+        fingerprint: run_fingerprint(&report, &scene_print, svgs),
+        scene_fingerprint: scene_print,
+        scene: origin,
+        scene_surfaces: scene.surfaces.len(),
+        render_width: result.render.image.width(),
+        render_height: result.render.image.height(),
+        warnings: result.loaded.warnings.clone(),
+        report,
+        svgs: written,
+        surfaces: (0..scene.surfaces.len())
+            .filter(|&s| shard.contains(s))
+            .map(|s| SurfaceSolution {
+                index: Some(s),
+                ..surface_solution(result, s)
+            })
+            .collect(),
+    };
+    let mut json = serde_json::to_string(&file)?;
+    json.push('\n');
+    staging.stage(dir.join(SHARD_FILE), json.as_bytes())?;
+    staging.commit()
+}
+
+/// Why shards cannot be joined.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum MergeError {
+    #[error("no shard directories given")]
+    Nothing,
+    #[error("cannot read {}: {source} (is it the output directory of a sharded run?)", .path.display())]
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{} is not a shard file: {message}", .path.display())]
+    NotAShard { path: PathBuf, message: String },
+    #[error("{} is not from the same run as {}: {what} differ", .dir.display(), .first.display())]
+    Mixed {
+        first: PathBuf,
+        dir: PathBuf,
+        what: &'static str,
+    },
+    #[error("shard {shard} is given twice: {} and {}", .first.display(), .second.display())]
+    Duplicate {
+        shard: Shard,
+        first: PathBuf,
+        second: PathBuf,
+    },
+    #[error("missing {} of {count}: {}", if .missing.len() == 1 { "shard" } else { "shards" }, list(.missing))]
+    Missing { missing: Vec<usize>, count: usize },
+    #[error("{}: surface {index} ({name:?}) is not this shard's, or not the scene's", .path.display())]
+    StraySurface {
+        path: PathBuf,
+        index: usize,
+        name: String,
+    },
+    #[error("cannot load the scene to render the joined solution: {0}")]
+    Scene(#[source] SceneError),
+    #[error(
+        "the scene loaded from {spec:?} is not the one the shards were run on (it has changed, \
+         or names another file from here)"
+    )]
+    SceneChanged { spec: String },
+    #[error(transparent)]
+    Render(#[from] penumbra_viz::VizError),
+}
+
+fn list(indices: &[usize]) -> String {
+    let shown: Vec<String> = indices.iter().take(20).map(usize::to_string).collect();
+    match indices.len().saturating_sub(shown.len()) {
+        0 => shown.join(", "),
+        more => format!("{} and {more} more", shown.join(", ")),
+    }
+}
+
+impl MergeError {
+    /// Whether the error is the user's to fix (wrong or missing directories, mixed runs) rather
+    /// than a failure of the merge.
+    pub fn is_usage(&self) -> bool {
+        !matches!(self, MergeError::Render(_))
+    }
+}
+
+/// Reads the [`SHARD_FILE`] of a shard's output directory.
+pub fn read_shard(dir: &Path) -> Result<ShardFile, MergeError> {
+    let path = dir.join(SHARD_FILE);
+    let text = std::fs::read_to_string(&path).map_err(|source| MergeError::Read {
+        path: path.clone(),
+        source,
+    })?;
+    let file: ShardFile = serde_json::from_str(&text).map_err(|e| MergeError::NotAShard {
+        path: path.clone(),
+        message: e.to_string(),
+    })?;
+    if file.format != SHARD_FORMAT {
+        return Err(MergeError::NotAShard {
+            path,
+            message: format!("its format is {:?}, not {SHARD_FORMAT:?}", file.format),
+        });
+    }
+    if let Err(e) = Shard::new(file.shard.index, file.shard.count) {
+        return Err(MergeError::NotAShard {
+            path,
+            message: e.to_string(),
+        });
+    }
+    Ok(file)
+}
+
+/// Checks that the shards are of one run, each once, none missing; returns them in shard order.
+pub fn check_shards(
+    mut shards: Vec<(PathBuf, ShardFile)>,
+) -> Result<Vec<(PathBuf, ShardFile)>, MergeError> {
+    let Some((first_dir, first)) = shards.first() else {
+        return Err(MergeError::Nothing);
+    };
+    for (dir, file) in &shards[1..] {
+        let mixed = |what| MergeError::Mixed {
+            first: first_dir.clone(),
+            dir: dir.clone(),
+            what,
+        };
+        if file.scene_fingerprint != first.scene_fingerprint {
+            return Err(mixed("their scenes"));
+        }
+        if file.fingerprint != first.fingerprint {
+            return Err(mixed("their options"));
+        }
+        if file.shard.count != first.shard.count {
+            return Err(mixed("their shard counts"));
+        }
+    }
+    let count = first.shard.count;
+    shards.sort_by_key(|(_, f)| f.shard.index);
+    for pair in shards.windows(2) {
+        if pair[0].1.shard.index == pair[1].1.shard.index {
+            return Err(MergeError::Duplicate {
+                shard: pair[0].1.shard,
+                first: pair[0].0.clone(),
+                second: pair[1].0.clone(),
+            });
+        }
+    }
+    let missing: Vec<usize> = (0..count)
+        .filter(|&i| {
+            shards
+                .binary_search_by_key(&i, |(_, f)| f.shard.index)
+                .is_err()
+        })
+        .collect();
+    if !missing.is_empty() {
+        return Err(MergeError::Missing { missing, count });
+    }
+    for (dir, file) in &shards {
+        if let Some(s) = file.surfaces.iter().find(|s| {
+            s.index
+                .is_none_or(|i| i >= file.scene_surfaces || !file.shard.contains(i))
+        }) {
+            return Err(MergeError::StraySurface {
+                path: dir.join(SHARD_FILE),
+                index: s.index.unwrap_or(usize::MAX),
+                name: s.name.clone(),
+            });
+        }
+    }
+    Ok(shards)
+}
+
+/// Shards joined: the files of the run they were split from.
+#[derive(Debug)]
+pub struct Merged {
+    pub scene_name: String,
+    pub shards: usize,
+    pub surfaces: usize,
+    pub triangles: usize,
+    pub vertices: usize,
+    /// `solution.json`, as the run not split would have written it.
+    pub solution_json: String,
+    pub report_json: String,
+    pub render_png: Vec<u8>,
+    /// Each SVG: where a shard wrote it, and its place relative to the output directory.
+    pub svgs: Vec<(PathBuf, String)>,
+}
+
+/// Joins checked shards ([`check_shards`]). `loaded` is the scene they were run on (checked
+/// against their fingerprint), needed to render the joined solution.
+pub fn merge(
+    shards: Vec<(PathBuf, ShardFile)>,
+    loaded: &LoadedScene,
+) -> Result<Merged, MergeError> {
+    let started = std::time::Instant::now();
+    let Some((_, first)) = shards.first() else {
+        return Err(MergeError::Nothing);
+    };
+    if scene_fingerprint(loaded) != first.scene_fingerprint {
+        return Err(MergeError::SceneChanged {
+            spec: first.scene.spec.clone(),
+        });
+    }
+    let mut report = first.report.clone();
+    let (width, height) = (first.render_width, first.render_height);
+    let warnings = first.warnings.clone();
+    let count = first.shard.count;
+    let scene = &loaded.scene;
+
+    // Solutions in the scene's order; report figures summed.
+    let mut surfaces: Vec<Option<SurfaceSolution>> = vec![None; scene.surfaces.len()];
+    let mut svgs = Vec::new();
+    let mut parts = Vec::new();
+    // Patches lie within one surface, so what is left unshot, its magnitude and the ambient
+    // term made from it (linear in it: every shard has the whole mesh's area and mean
+    // reflectance) add up over the shards, to rounding.
+    let mut absorbed = Rgb::ZERO;
+    let mut received = Rgb::ZERO;
+    let mut unshot = Rgb::ZERO;
+    let mut ambient = Rgb::ZERO;
+    let mut residual = 0.0;
+    let mut times = serde_json::Map::new();
+    let emitted = rgb_at(&report, &["solver", "emitted"]);
+    for (dir, file) in shards {
+        absorbed += rgb_at(&file.report, &["solver", "absorbed"]);
+        received += emitted - rgb_at(&file.report, &["solver", "escaped"]);
+        unshot += rgb_at(&file.report, &["solver", "unshot"]);
+        ambient += rgb_at(&file.report, &["render", "ambient"]);
+        residual += file
+            .report
+            .pointer("/solver/residual")
+            .and_then(serde_json::Value::as_f64)
+            .unwrap_or(0.0);
+        if let Some(t) = file.report.get("times_seconds").and_then(|t| t.as_object()) {
+            for (stage, seconds) in t {
+                let sum = times.get(stage).and_then(serde_json::Value::as_f64);
+                let add = seconds.as_f64().unwrap_or(0.0);
+                times.insert(stage.clone(), (sum.unwrap_or(0.0) + add).into());
+            }
+        }
+        let vertices: usize = file.surfaces.iter().map(|s| s.vertices.len()).sum();
+        parts.push(serde_json::json!({
+            "shard": file.shard.to_string(),
+            "directory": dir.display().to_string(),
+            "surfaces": file.surfaces.len(),
+            "vertices_lit": vertices,
+            "threads": file.report.pointer("/method/threads"),
+            "times_seconds": file.report.get("times_seconds"),
+            "peak_bytes": file.report.pointer("/memory/peak_bytes"),
+        }));
+        for svg in file.svgs {
+            svgs.push((dir.join(&svg), svg));
+        }
+        for s in file.surfaces {
+            if let Some(i) = s.index
+                && let Some(slot) = surfaces.get_mut(i)
+            {
+                *slot = Some(SurfaceSolution { index: None, ..s });
+            }
+        }
+    }
+    let surfaces: Vec<SurfaceSolution> = surfaces
+        .into_iter()
+        .enumerate()
+        .map(|(i, s)| {
+            s.ok_or_else(|| MergeError::Missing {
+                missing: vec![i % count],
+                count,
+            })
+        })
+        .collect::<Result<_, _>>()?;
+    svgs.sort_by(|a, b| a.1.cmp(&b.1));
+
+    // The render, from the joined meshes (their 3D vertices and triangles).
+    let render_started = std::time::Instant::now();
+    let mesh = joined_mesh(loaded, &surfaces)?;
+    let display: Vec<Vec<Rgb>> = surfaces
+        .iter()
+        .zip(&scene.surfaces)
+        .map(|(s, surface)| {
+            let extra = surface.reflectance.mul_rgb(ambient);
+            s.radiosity.iter().map(|&c| Rgb::from(c) + extra).collect()
+        })
+        .collect();
+    let render = penumbra_viz::render(
+        scene,
+        &mesh,
+        &display,
+        &penumbra_viz::RenderOptions {
+            width,
+            height,
+            ..Default::default()
+        },
+    )?;
+    let render_png = penumbra_viz::encode_png(&render.image)?;
+    times.insert(
+        "render".to_owned(),
+        render_started.elapsed().as_secs_f64().into(),
+    );
+
+    // The report: the first shard's (its scene, options, discontinuities, mesh and counts are
+    // every shard's), with the light's figures joined.
+    let solver_absorbed = serde_json::to_value(absorbed).unwrap_or_default();
+    let escaped = emitted - received;
+    let energy = EnergyBalance::new(emitted, absorbed, escaped, unshot);
+    let mut all_warnings = warnings;
+    all_warnings.extend(energy.warning());
+    let triangles = surfaces.iter().map(|s| s.triangles.len()).sum();
+    let vertices = surfaces.iter().map(|s| s.vertices.len()).sum();
+    if let Some(r) = report.as_object_mut() {
+        r.insert("partial".to_owned(), false.into());
+        r.insert("warnings".to_owned(), all_warnings.into());
+        r.insert(
+            "energy".to_owned(),
+            serde_json::to_value(&energy).unwrap_or_default(),
+        );
+        if let Some(solver) = r.get_mut("solver").and_then(|s| s.as_object_mut()) {
+            solver.insert("absorbed".to_owned(), solver_absorbed);
+            solver.insert(
+                "escaped".to_owned(),
+                serde_json::to_value(escaped).unwrap_or_default(),
+            );
+            let json = |rgb: Rgb| serde_json::to_value(rgb).unwrap_or_default();
+            solver.insert("unshot".to_owned(), json(unshot));
+            solver.insert("unshot_fraction".to_owned(), residual.into());
+            solver.insert("residual".to_owned(), residual.into());
+            if let Some(t) = times.get("direct") {
+                solver.insert("direct_seconds".to_owned(), t.clone());
+            }
+        }
+        if let Some(render_summary) = r.get_mut("render").and_then(|s| s.as_object_mut()) {
+            render_summary.insert("exposure".to_owned(), render.exposure.into());
+            render_summary.insert(
+                "ambient".to_owned(),
+                serde_json::to_value(ambient).unwrap_or_default(),
+            );
+        }
+        if let Some(s) = r.get_mut("svgs").and_then(|s| s.as_object_mut()) {
+            let written: Vec<&String> = svgs.iter().map(|(_, name)| name).collect();
+            s.insert(
+                "written".to_owned(),
+                serde_json::to_value(written).unwrap_or_default(),
+            );
+        }
+        times.insert("merge".to_owned(), started.elapsed().as_secs_f64().into());
+        r.insert("times_seconds".to_owned(), times.into());
+        r.insert(
+            "shards".to_owned(),
+            serde_json::json!({"count": count, "parts": parts}),
+        );
+    }
+    let mut report_json = serde_json::to_string_pretty(&report).unwrap_or_default();
+    report_json.push('\n');
+    Ok(Merged {
+        scene_name: scene.name.clone(),
+        shards: count,
+        surfaces: surfaces.len(),
+        triangles,
+        vertices,
+        solution_json: solution_json_of(&scene.name, &surfaces),
+        report_json,
+        render_png,
+        svgs,
+    })
+}
+
+/// An RGB triple at `path` in a report, zero if absent.
+fn rgb_at(report: &serde_json::Value, path: &[&str]) -> Rgb {
+    path.iter()
+        .try_fold(report, |v, key| v.get(key))
+        .and_then(|v| serde_json::from_value::<Rgb>(v.clone()).ok())
+        .unwrap_or(Rgb::ZERO)
+}
+
+/// Meshes to render, from the joined surfaces' 3D vertices and triangles (in each surface's
+/// plane frame; the render uses the 3D positions).
+fn joined_mesh(
+    loaded: &LoadedScene,
+    surfaces: &[SurfaceSolution],
+) -> Result<SceneMesh, MergeError> {
+    let scene = &loaded.scene;
+    let meshes = surfaces
+        .iter()
+        .zip(&scene.surfaces)
+        .enumerate()
+        .map(|(id, (s, surface))| {
+            // A loaded scene is validated: every polygon has a frame.
+            let frame = PlaneFrame::of_polygon(&surface.polygon).ok_or_else(|| {
+                MergeError::SceneChanged {
+                    spec: loaded.source.clone(),
+                }
+            })?;
+            let points3: Vec<glam::DVec3> =
+                s.vertices.iter().map(|&p| glam::DVec3::from(p)).collect();
+            Ok(SurfaceMesh {
+                surface: id,
+                frame,
+                scale: 1.0,
+                local: points3.iter().map(|&p| frame.to_2d(p)).collect(),
+                points3,
+                triangles: s.triangles.clone(),
+                boundary: Vec::new(),
+                constraints: Vec::new(),
+                polygon_area: surface.area(),
+            })
+        })
+        .collect::<Result<Vec<_>, MergeError>>()?;
+    let n = meshes.len();
+    Ok(SceneMesh {
+        surfaces: meshes,
+        refinable: Vec::new(),
+        discontinuities: vec![Vec::new(); n],
+        hovering: vec![Vec::new(); n],
+        discontinuity_stats: None,
+        budget: 0,
+        minimum_triangles: 0,
+    })
+}
+
+/// Writes the joined run into `dir` (created if needed), all or nothing; returns the paths
+/// written.
+pub fn write_merged(merged: &Merged, dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
+    use anyhow::Context;
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    if !merged.svgs.is_empty() {
+        let svg_dir = dir.join(SVG_DIR);
+        std::fs::create_dir_all(&svg_dir)
+            .with_context(|| format!("cannot create {}", svg_dir.display()))?;
+    }
+    let mut staging = Staging::default();
+    staging.stage(dir.join("solution.json"), merged.solution_json.as_bytes())?;
+    staging.stage(dir.join("report.json"), merged.report_json.as_bytes())?;
+    staging.stage(dir.join("render.png"), &merged.render_png)?;
+    for (from, name) in &merged.svgs {
+        let bytes =
+            std::fs::read(from).with_context(|| format!("cannot read {}", from.display()))?;
+        staging.stage(dir.join(name), &bytes)?;
+    }
+    staging.commit()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shards_are_parsed_and_checked() {
+        assert_eq!(Shard::parse("0/1"), Ok(Shard { index: 0, count: 1 }));
+        assert_eq!(Shard::parse(" 7/8 "), Ok(Shard { index: 7, count: 8 }));
+        assert_eq!(
+            Shard::parse("8/8"),
+            Err(ShardError::OutOfRange { index: 8, count: 8 })
+        );
+        assert_eq!(Shard::parse("0/0"), Err(ShardError::NoShards));
+        for bad in ["", "1", "1/", "/2", "-1/2", "a/b", "1/2/3", "1.0/2"] {
+            assert_eq!(Shard::parse(bad), Err(ShardError::Syntax(bad.to_owned())));
+        }
+        let s = Shard::new(1, 3).expect("valid");
+        assert_eq!(
+            s.surfaces(7),
+            [false, true, false, false, true, false, false]
+        );
+        assert_eq!(s.to_string(), "1/3");
+    }
+
+    #[test]
+    fn only_direct_light_is_split() {
+        let shard = Shard::new(0, 2).expect("valid");
+        let mut options = RunOptions::default();
+        assert_eq!(shard.check(&options), Err(ShardError::NeedsDirectOnly));
+        options.solver.direct_only = true;
+        assert_eq!(shard.check(&options), Ok(()));
+        options.time_budget = Some(10.0);
+        assert_eq!(shard.check(&options), Err(ShardError::TimeBudget));
+    }
+}
