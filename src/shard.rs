@@ -289,7 +289,7 @@ pub enum MergeError {
         first: PathBuf,
         second: PathBuf,
     },
-    #[error("missing {} of {count}: {}", if .missing.len() == 1 { "shard" } else { "shards" }, list(.missing))]
+    #[error("missing {} {} of {count}", if .missing.len() == 1 { "shard" } else { "shards" }, list(.missing))]
     Missing { missing: Vec<usize>, count: usize },
     #[error("{}: surface {index} ({name:?}) is not this shard's, or not the scene's", .path.display())]
     StraySurface {

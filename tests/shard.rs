@@ -1,0 +1,264 @@
+//! Sharded runs (`run --shard I/N`) joined by `penumbra merge` give the run not split, byte for
+//! byte; mixed, missing and duplicate shards are refused.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn penumbra(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_penumbra"))
+        .args(args)
+        .output()
+        .expect("the penumbra binary runs")
+}
+
+fn succeeds(args: &[&str]) -> Output {
+    let o = penumbra(args);
+    assert!(
+        o.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    o
+}
+
+/// Fails with exit 2 and a message holding every one of `words`; returns the message.
+fn refused(args: &[&str], words: &[&str]) -> String {
+    let o = penumbra(args);
+    let stderr = String::from_utf8_lossy(&o.stderr).into_owned();
+    assert_eq!(o.status.code(), Some(2), "{args:?}: {stderr}");
+    for w in words {
+        assert!(stderr.contains(w), "{args:?}: {w:?} not in {stderr}");
+    }
+    stderr
+}
+
+fn path(p: &Path) -> &str {
+    p.to_str().expect("utf-8")
+}
+
+/// A small direct-only run of `scene` into `out`, with `extra` options.
+fn run(scene: &str, out: &Path, extra: &[&str]) {
+    let mut args = vec![
+        "run",
+        scene,
+        "--direct-only",
+        "--max-elements",
+        "2500",
+        "--width",
+        "96",
+        "--height",
+        "96",
+        "--quiet",
+        "--out",
+        path(out),
+    ];
+    args.extend(extra);
+    succeeds(&args);
+}
+
+/// Runs shards 0..count of `scene` into `root/shard-I`; returns their directories.
+fn shards(scene: &str, root: &Path, count: usize, extra: &[&str]) -> Vec<PathBuf> {
+    (0..count)
+        .map(|i| {
+            let dir = root.join(format!("shard-{i}"));
+            let shard = format!("{i}/{count}");
+            let mut args = vec!["--shard", shard.as_str()];
+            args.extend(extra);
+            run(scene, &dir, &args);
+            dir
+        })
+        .collect()
+}
+
+fn merge(dirs: &[PathBuf], out: &Path) -> Output {
+    let mut args = vec!["merge", "--quiet", "--out", path(out)];
+    args.extend(dirs.iter().map(|d| path(d)));
+    penumbra(&args)
+}
+
+/// Every file under `dir`, relative, with its bytes.
+fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut all = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).expect("readable") {
+            let p = e.expect("entry").path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                let rel = p.strip_prefix(dir).expect("inside").display().to_string();
+                all.push((rel, std::fs::read(&p).expect("readable")));
+            }
+        }
+    }
+    all.sort();
+    all
+}
+
+#[test]
+fn shards_merge_into_the_run_not_split_byte_for_byte() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    for scene in ["cornell", "boxworld-12", "tessellated-2"] {
+        let whole = dir.path().join(format!("{scene}-whole"));
+        run(scene, &whole, &[]);
+        let expected = files(&whole);
+        for count in [1, 2, 3] {
+            let root = dir.path().join(format!("{scene}-{count}"));
+            let dirs = shards(scene, &root, count, &[]);
+            let out = root.join("merged");
+            let o = merge(&dirs, &out);
+            assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+            let merged = files(&out);
+            // solution.json, render.png and every SVG are the same bytes; report.json differs in
+            // its times and shards, and in the last digits of summed energies.
+            let same = |(name, _): &&(String, Vec<u8>)| name != "report.json";
+            let want: Vec<_> = expected.iter().filter(same).collect();
+            let got: Vec<_> = merged.iter().filter(same).collect();
+            assert_eq!(
+                want.iter().map(|f| &f.0).collect::<Vec<_>>(),
+                got.iter().map(|f| &f.0).collect::<Vec<_>>(),
+                "{scene}, {count} shards: the files"
+            );
+            for (w, g) in want.iter().zip(&got) {
+                assert!(w.1 == g.1, "{scene}, {count} shards: {} differs", w.0);
+            }
+            let report: serde_json::Value =
+                serde_json::from_slice(&std::fs::read(out.join("report.json")).expect("report"))
+                    .expect("JSON");
+            let whole_report: serde_json::Value =
+                serde_json::from_slice(&std::fs::read(whole.join("report.json")).expect("report"))
+                    .expect("JSON");
+            assert_eq!(report["shards"]["count"], count);
+            assert_eq!(report["counts"], whole_report["counts"]);
+            assert_eq!(
+                report["method"]["max_elements"],
+                whole_report["method"]["max_elements"]
+            );
+            assert_eq!(
+                report["energy"]["balanced"],
+                whole_report["energy"]["balanced"]
+            );
+            let fraction = |r: &serde_json::Value| {
+                r["energy"]["absorbed_fraction"].as_f64().expect("a number")
+            };
+            assert!((fraction(&report) - fraction(&whole_report)).abs() < 1e-12);
+        }
+    }
+}
+
+/// More shards than surfaces: some shards light nothing, and the merge is still the whole run.
+#[test]
+fn empty_shards_merge_too() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let whole = dir.path().join("whole");
+    run("textbook", &whole, &[]);
+    let dirs = shards("textbook", dir.path(), 5, &[]);
+    let shard: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dirs[4].join("shard.json")).expect("written"))
+            .expect("JSON");
+    assert_eq!(shard["surfaces"].as_array().map(Vec::len), Some(0));
+    let out = dir.path().join("merged");
+    // The directories in any order.
+    let mut shuffled = dirs.clone();
+    shuffled.reverse();
+    let o = merge(&shuffled, &out);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        std::fs::read(out.join("solution.json")).expect("merged")
+            == std::fs::read(whole.join("solution.json")).expect("whole")
+    );
+}
+
+#[test]
+fn merge_refuses_missing_duplicate_and_mixed_shards() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let dirs = shards("textbook", &dir.path().join("a"), 3, &[]);
+    let out = dir.path().join("merged");
+    let out_s = path(&out);
+    let (d0, d1, d2) = (path(&dirs[0]), path(&dirs[1]), path(&dirs[2]));
+    refused(
+        &["merge", "--out", out_s, d0, d2],
+        &["missing shard 1 of 3"],
+    );
+    refused(
+        &["merge", "--out", out_s, d0, d1, d2, d1],
+        &["shard 1/3 is given twice"],
+    );
+    // Other options: another element budget.
+    let other = shards(
+        "textbook",
+        &dir.path().join("b"),
+        3,
+        &["--penumbra-density", "4"],
+    );
+    refused(
+        &["merge", "--out", out_s, d0, path(&other[1]), d2],
+        &["not from the same run", "options differ"],
+    );
+    // Another scene.
+    let scene = shards("cornell", &dir.path().join("c"), 3, &[]);
+    refused(
+        &["merge", "--out", out_s, d0, path(&scene[1]), d2],
+        &["not from the same run", "scenes differ"],
+    );
+    // Another count.
+    let two = shards("textbook", &dir.path().join("d"), 2, &[]);
+    refused(
+        &["merge", "--out", out_s, path(&two[0]), path(&two[1]), d2],
+        &["shard counts differ"],
+    );
+    // Not a shard: a run not split.
+    let whole = dir.path().join("whole");
+    run("textbook", &whole, &[]);
+    refused(&["merge", "--out", out_s, path(&whole)], &["shard.json"]);
+    refused(&["merge", "--out", out_s], &["DIRS"]);
+    assert!(!out.exists(), "nothing written");
+}
+
+#[test]
+fn run_refuses_shards_it_cannot_split() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("out");
+    let out_s = path(&out);
+    refused(
+        &["run", "textbook", "--shard", "0/2", "--out", out_s],
+        &["--shard needs --direct-only", "bounces"],
+    );
+    for bad in ["2/2", "0/0", "x", "1", "-1/2", ""] {
+        let flag = format!("--shard={bad}");
+        let message = refused(
+            &["run", "textbook", "--direct-only", &flag, "--out", out_s],
+            &["--shard: "],
+        );
+        assert!(message.contains(if bad == "2/2" { "0 to 1" } else { "I/N" }) || bad == "0/0");
+    }
+    refused(
+        &[
+            "run",
+            "textbook",
+            "--direct-only",
+            "--shard",
+            "0/2",
+            "--refine-tol",
+            "0.01",
+            "--out",
+            out_s,
+        ],
+        &["--shard with --refine-tol"],
+    );
+    refused(
+        &[
+            "run",
+            "textbook",
+            "--direct-only",
+            "--shard",
+            "0/2",
+            "--time-budget",
+            "5",
+            "--out",
+            out_s,
+        ],
+        &["--shard with --time-budget"],
+    );
+    assert!(!out.exists(), "nothing written");
+}
