@@ -297,6 +297,12 @@ pub enum MergeError {
         index: usize,
         name: String,
     },
+    #[error(
+        "{} was cut short (interrupted: its discontinuity search skipped pairs), so its mesh is \
+         not the run's; run that shard again",
+        .dir.display()
+    )]
+    Partial { dir: PathBuf },
     #[error("cannot load the scene to render the joined solution: {0}")]
     Scene(#[source] SceneError),
     #[error(
@@ -395,6 +401,9 @@ pub fn check_shards(
         return Err(MergeError::Missing { missing, count });
     }
     for (dir, file) in &shards {
+        if file.report.get("partial") == Some(&serde_json::Value::Bool(true)) {
+            return Err(MergeError::Partial { dir: dir.clone() });
+        }
         if let Some(s) = file.surfaces.iter().find(|s| {
             s.index
                 .is_none_or(|i| i >= file.scene_surfaces || !file.shard.contains(i))
