@@ -14,13 +14,14 @@ use std::f64::consts::PI;
 
 use glam::{DVec2, DVec3};
 use penumbra_scenes::polygon::{is_convex_ccw, triangulate_ccw};
-use penumbra_scenes::{Bounds, PlaneFrame, Rgb, Scene, SurfaceId, Visibility};
+use penumbra_scenes::{PlaneFrame, Rgb, Scene, SurfaceId, Visibility};
 
 use crate::clip::{
     HalfPlane, area_2d, clip_half_plane, clip_polygon_3d, clip_to_convex, inside_convex,
     merge_close_vertices, subtract_convex, subtract_half_planes, wider_than,
 };
 use crate::lambert::{ReceivingPoint, contour_sum};
+use crate::occluder_tree::{OccluderTree, Reached, ShaftTest, TreeFace};
 use crate::shadow_union::{CornerKey, ShadowUnion, VisibleShape};
 use crate::solids::closed_solid_orientation;
 
@@ -36,6 +37,9 @@ pub const SEQUENTIAL_SHADOWS: usize = 16;
 /// Occluder faces whose corners are all at least this fraction of x's height from x (towards
 /// the emitter) project within this many times the shaft's width, and go whole into the union.
 const PROJECTION_REACH: f64 = 16.0;
+/// A node of the occluder tree stands for its faces by its outline only when each face turns
+/// towards (or away from) x by more than this many contact distances: never a face through x.
+const OUTLINE_MARGIN: f64 = 2.0;
 
 /// A planar convex polygon of a surface, with its plane.
 #[derive(Clone, Debug)]
@@ -94,6 +98,12 @@ enum Blocking {
         corners: Vec<DVec2>,
         keys: Option<Vec<CornerKey>>,
     },
+    /// The faces of a node of the occluder tree, projected whole: their outline's edges
+    /// (corner keys and the projection of the first), all turned one way.
+    Outline {
+        node: usize,
+        edges: Vec<(CornerKey, CornerKey, DVec2)>,
+    },
 }
 
 #[derive(Clone, Debug)]
@@ -134,11 +144,12 @@ fn convex_pieces(polygon: &[DVec3]) -> Vec<Vec<DVec3>> {
 
 /// The exact direct-light evaluator of a scene.
 pub struct DirectLight<'a> {
-    visibility: &'a Visibility,
+    /// The occluders are built from the visibility index's triangles, which stay borrowed.
+    visibility: std::marker::PhantomData<&'a Visibility>,
     emitters: Vec<Emitter>,
     occluders: Vec<ConvexPiece>,
-    /// For each visibility triangle, the occluder piece that contains it.
-    piece_of_triangle: Vec<usize>,
+    /// The occluders' bounding-volume tree, for the shafts.
+    tree: OccluderTree,
     tol: f64,
     /// Occluders per shaft up to which shadows are subtracted one by one.
     sequential_shadows: usize,
@@ -192,30 +203,35 @@ impl<'a> DirectLight<'a> {
                 ));
             }
         }
-        let piece_of_triangle = visibility
-            .triangles()
-            .iter()
-            .map(|t| match whole[t.surface] {
-                Some(piece) => piece,
-                None => {
-                    occluders.push(ConvexPiece::new(
-                        t.surface,
-                        t.vertices.to_vec(),
-                        (t.vertices[1] - t.vertices[0])
-                            .cross(t.vertices[2] - t.vertices[0])
-                            .normalize_or_zero(),
-                        orientation[t.surface],
-                        &mut corners,
-                    ));
-                    occluders.len() - 1
-                }
-            })
-            .collect();
+        for t in visibility.triangles() {
+            if whole[t.surface].is_none() {
+                occluders.push(ConvexPiece::new(
+                    t.surface,
+                    t.vertices.to_vec(),
+                    (t.vertices[1] - t.vertices[0])
+                        .cross(t.vertices[2] - t.vertices[0])
+                        .normalize_or_zero(),
+                    orientation[t.surface],
+                    &mut corners,
+                ));
+            }
+        }
+        let tree = OccluderTree::build(
+            &occluders
+                .iter()
+                .map(|o| TreeFace {
+                    polygon: &o.polygon,
+                    keys: &o.keys,
+                    facing: o.outward.unwrap_or(o.normal).normalize_or_zero(),
+                    closed: o.outward.is_some(),
+                })
+                .collect::<Vec<_>>(),
+        );
         DirectLight {
-            visibility,
+            visibility: std::marker::PhantomData,
             emitters,
             occluders,
-            piece_of_triangle,
+            tree,
             tol: visibility.contact_distance(),
             sequential_shadows: SEQUENTIAL_SHADOWS,
         }
@@ -293,7 +309,11 @@ impl<'a> DirectLight<'a> {
             let (visible, touching) = match self.blockings(point, None, e, full, h_x, &piece) {
                 None => (Vec::new(), Vec::new()),
                 Some(blockings) => {
-                    if blockings.len() <= self.sequential_shadows {
+                    if blockings.len() <= self.sequential_shadows
+                        && !blockings
+                            .iter()
+                            .any(|b| matches!(b, Blocking::Outline { .. }))
+                    {
                         return None;
                     }
                     let touching = blockings
@@ -475,11 +495,14 @@ impl<'a> DirectLight<'a> {
                 *b = Blocking::Contact(contact_shadow(x, &self.occluders[index], e, self.tol));
             }
         }
-        if blockings.len() > self.sequential_shadows
-            && let Some(visible) = subtract_at_once(&piece, &blockings, e, min_width)
-        {
+        let at_once = blockings.len() > self.sequential_shadows
+            || blockings
+                .iter()
+                .any(|b| matches!(b, Blocking::Outline { .. }));
+        if at_once && let Some(visible) = subtract_at_once(&piece, &blockings, e, min_width) {
             return visible;
         }
+        let blockings = self.faces_of_outlines(blockings, x.point, e, h_x);
         subtract_one_by_one(piece, blockings, e, min_width)
             .into_iter()
             .map(|p| vec![p])
@@ -508,14 +531,30 @@ impl<'a> DirectLight<'a> {
             })
             .collect();
 
+        // Faces wholly between the two planes and not too close to x are projected whole.
+        let reach = h_x * (1.0 - 1.0 / PROJECTION_REACH);
+        let project = |p: DVec3| {
+            let s = h_x / (h_x - e.frame.height(p));
+            e.frame.to_2d(point + (p - point) * s)
+        };
         let mut candidates = Vec::new();
-        self.visibility.triangles_overlapping_between(
-            Bounds::from_points([&point]),
-            Bounds::from_points(front),
-            |t| candidates.push(self.piece_of_triangle[t]),
+        let mut outlines = Vec::new();
+        self.tree.walk(
+            &ShaftTest {
+                point,
+                sides: &sides,
+                emitter_origin: e.frame.origin,
+                emitter_normal: e.frame.normal,
+                lowest: tol,
+                highest: reach,
+                margin: OUTLINE_MARGIN * tol,
+            },
+            &mut |reached| match reached {
+                Reached::Face(index) => candidates.push(index),
+                Reached::Outline { node, reversed } => outlines.push((node, reversed)),
+            },
         );
         candidates.sort_unstable();
-        candidates.dedup();
         candidates.retain(|&index| {
             let occ = &self.occluders[index];
             // A face of a closed solid turned away from x is behind another face of it.
@@ -525,9 +564,18 @@ impl<'a> DirectLight<'a> {
                     .outward
                     .is_some_and(|n| n.dot(point - occ.polygon[0]) < -tol)
         });
-        let at_once = candidates.len() > self.sequential_shadows;
+        let at_once = !outlines.is_empty() || candidates.len() > self.sequential_shadows;
 
-        let mut blockings = Vec::with_capacity(candidates.len());
+        let mut blockings = Vec::with_capacity(candidates.len() + outlines.len());
+        for (node, reversed) in outlines {
+            let edges = self.tree.outline(node).iter();
+            let edges = if reversed {
+                edges.map(|e| (e.to, e.from, project(e.to_at))).collect()
+            } else {
+                edges.map(|e| (e.from, e.to, project(e.from_at))).collect()
+            };
+            blockings.push(Blocking::Outline { node, edges });
+        }
         for index in candidates {
             let occ = &self.occluders[index];
             // A plane through x is seen edge-on: it hides nothing, unless x lies on the occluder
@@ -553,11 +601,7 @@ impl<'a> DirectLight<'a> {
                     .all(|&p| sides.iter().all(|m| m.dot(p - point) >= 0.0));
             // Shadows subtracted at once may reach past the piece: a face between the two
             // planes and not too close to x is projected whole, keeping its own corners.
-            let whole = inside
-                || (at_once
-                    && heights
-                        .iter()
-                        .all(|&h| h >= 0.0 && h <= h_x * (1.0 - 1.0 / PROJECTION_REACH)));
+            let whole = inside || (at_once && heights.iter().all(|&h| h >= 0.0 && h <= reach));
             let poly = if whole {
                 occ.polygon.clone()
             } else {
@@ -573,13 +617,7 @@ impl<'a> DirectLight<'a> {
             if poly.len() < 3 {
                 continue;
             }
-            let corners: Vec<DVec2> = poly
-                .iter()
-                .map(|&p| {
-                    let s = h_x / (h_x - e.frame.height(p));
-                    e.frame.to_2d(point + (p - point) * s)
-                })
-                .collect();
+            let corners: Vec<DVec2> = poly.iter().map(|&p| project(p)).collect();
             // Only a shadow whose box holds the piece's can cover it; most are far smaller.
             if box_holds(&corners, piece)
                 && tidy_shadow(&corners, e, min_width).is_some_and(|shadow| covers(&shadow, piece))
@@ -592,6 +630,41 @@ impl<'a> DirectLight<'a> {
             });
         }
         Some(blockings)
+    }
+}
+
+impl DirectLight<'_> {
+    /// The blockings with each outline replaced by its node's faces, projected whole, for the
+    /// one-by-one subtraction.
+    fn faces_of_outlines(
+        &self,
+        blockings: Vec<Blocking>,
+        point: DVec3,
+        e: &Emitter,
+        h_x: f64,
+    ) -> Vec<Blocking> {
+        let mut out = Vec::with_capacity(blockings.len());
+        for b in blockings {
+            let Blocking::Outline { node, .. } = b else {
+                out.push(b);
+                continue;
+            };
+            for &index in self.tree.faces_of(node) {
+                let corners = self.occluders[index]
+                    .polygon
+                    .iter()
+                    .map(|&p| {
+                        let s = h_x / (h_x - e.frame.height(p));
+                        e.frame.to_2d(point + (p - point) * s)
+                    })
+                    .collect();
+                out.push(Blocking::Shadow {
+                    corners,
+                    keys: None,
+                });
+            }
+        }
+        out
     }
 }
 
@@ -654,6 +727,7 @@ fn subtract_one_by_one(
                     std::mem::swap(&mut visible, &mut next);
                 }
             }
+            Blocking::Outline { .. } => unreachable!("outlines are expanded into faces"),
             Blocking::Shadow { corners, .. } => {
                 let Some(shadow) = tidy_shadow(&corners, e, min_width) else {
                     continue;
@@ -703,6 +777,7 @@ fn subtract_at_once(
                     union.add_contour(shadow);
                 }
             }
+            Blocking::Outline { edges, .. } => union.add_edges(edges),
         }
     }
     union.subtract_from(piece)

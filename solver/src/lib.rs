@@ -27,6 +27,7 @@ pub mod gathering;
 pub mod hemicube;
 pub mod lambert;
 pub mod measure;
+mod occluder_tree;
 pub mod path_trace;
 pub mod progress;
 pub mod progressive;

@@ -68,6 +68,16 @@ impl ShadowUnion {
         }
     }
 
+    /// Adds edges of shadows already fused (a node's outline): corner keys, and the projection
+    /// of the first corner.
+    pub fn add_edges(&mut self, edges: &[(CornerKey, CornerKey, DVec2)]) {
+        self.sheet.extend(
+            edges
+                .iter()
+                .map(|&(from, to, at)| SheetEdge { from, to, at }),
+        );
+    }
+
     /// Adds a shadow given as a counter-clockwise contour.
     pub fn add_contour(&mut self, contour: Vec<DVec2>) {
         self.contours.push(contour);
@@ -128,33 +138,46 @@ fn to_arrays(contour: &[DVec2]) -> Vec<[f64; 2]> {
     contour.iter().map(|p| [p.x, p.y]).collect()
 }
 
-/// The closed outlines of the sheet's edges once each edge met in both directions cancels
-/// (the winding number of what remains is that of the faces). `None` if the edges do not close,
-/// which faces of distinct corners always do.
-fn outlines(mut edges: Vec<SheetEdge>) -> Option<Vec<Vec<DVec2>>> {
-    // Group each corner pair's edges, forward ones (from the smaller key) first, and keep only
-    // their surplus in one direction.
-    edges.sort_by(|a, b| {
-        let key = |e: &SheetEdge| (e.from.min(e.to), e.from.max(e.to), e.from > e.to);
-        key(a).cmp(&key(b))
-    });
-    let mut kept: Vec<SheetEdge> = Vec::with_capacity(edges.len() / 4);
+/// The directed edges left once each edge met in both directions cancels (only the surplus in
+/// one direction stays), in a fixed order.
+pub(crate) fn cancel_opposite<E: Copy>(
+    mut edges: Vec<E>,
+    ends: impl Fn(&E) -> (CornerKey, CornerKey),
+) -> Vec<E> {
+    let pair = |e: &E| {
+        let (from, to) = ends(e);
+        (from.min(to), from.max(to))
+    };
+    let forward = |e: &E| {
+        let (from, to) = ends(e);
+        from < to
+    };
+    // Each corner pair's edges together, forward ones (from the smaller key) first.
+    edges.sort_by_key(|e| (pair(e), !forward(e)));
+    let mut kept = Vec::with_capacity(edges.len() / 4);
     let mut i = 0;
     while i < edges.len() {
-        let pair = |e: &SheetEdge| (e.from.min(e.to), e.from.max(e.to));
         let j = i + edges[i..]
             .iter()
             .take_while(|e| pair(e) == pair(&edges[i]))
             .count();
-        let forward = edges[i..j].iter().filter(|e| e.from < e.to).count();
-        let backward = (j - i) - forward;
-        if forward > backward {
-            kept.extend_from_slice(&edges[i..i + forward - backward]);
+        let ahead = edges[i..j].iter().filter(|e| forward(e)).count();
+        let back = (j - i) - ahead;
+        if ahead > back {
+            kept.extend_from_slice(&edges[i..i + ahead - back]);
         } else {
-            kept.extend_from_slice(&edges[i + forward..i + forward + backward - forward]);
+            kept.extend_from_slice(&edges[i + ahead..i + back]);
         }
         i = j;
     }
+    kept
+}
+
+/// The closed outlines of the sheet's edges once each edge met in both directions cancels
+/// (the winding number of what remains is that of the faces). `None` if the edges do not close,
+/// which faces of distinct corners always do.
+fn outlines(edges: Vec<SheetEdge>) -> Option<Vec<Vec<DVec2>>> {
+    let kept = cancel_opposite(edges, |e| (e.from, e.to));
     // Walk the surviving edges into closed loops: every corner has as many edges in as out.
     let mut leaving: HashMap<CornerKey, Vec<usize>> = HashMap::new();
     for (k, e) in kept.iter().enumerate().rev() {

@@ -1,0 +1,462 @@
+//! A bounding-volume tree over the occluder pieces, walked once per shaft.
+//!
+//! Two things make the cost of a shaft follow its shadow rather than the tessellation:
+//! - a node wholly outside one side of the shaft, or beyond the emitter's plane, is dropped with
+//!   all its faces (a point in full light meets a few nodes, not every face in a bounding box);
+//! - a node whose faces all lie between the two planes, within projection reach, and all turn
+//!   the same way to the point, casts the shadow of its *outline*: projecting every face and
+//!   letting the welded inner edges cancel ([`crate::shadow_union`]) leaves the node's boundary
+//!   edges, which are known in advance. A face-on sheet of ten thousand faces costs its rim.
+//!   When the node belongs to closed solids and turns away from the point, it is skipped.
+//!
+//! Faces are oriented by their *facing normal*: outward for faces of closed solids, else as
+//! listed. Whether a node turns towards the point is decided conservatively from a cone holding
+//! its facing normals and a sphere holding its corners; faces of an undecided node are visited
+//! one by one.
+
+use std::f64::consts::PI;
+
+use glam::DVec3;
+use penumbra_scenes::polygon::newell_normal;
+
+use crate::shadow_union::{CornerKey, cancel_opposite};
+
+/// Nodes with at most this many faces are leaves.
+const LEAF_FACES: usize = 4;
+/// Nodes with fewer faces than this keep no outline: visiting their faces costs as little.
+const OUTLINE_MIN_FACES: usize = 8;
+
+/// One occluder face as the tree sees it.
+pub(crate) struct TreeFace<'a> {
+    pub polygon: &'a [DVec3],
+    pub keys: &'a [CornerKey],
+    /// The facing normal (unit): outward for a face of a closed solid.
+    pub facing: DVec3,
+    /// Whether the face belongs to a closed solid.
+    pub closed: bool,
+}
+
+/// A directed boundary edge of a node's faces, along their facing orientation.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct OutlineEdge {
+    pub from: CornerKey,
+    pub to: CornerKey,
+    pub from_at: DVec3,
+    pub to_at: DVec3,
+}
+
+/// What a node's faces look like from afar: the cone of their facing normals (every one within
+/// `deviation` of `axis`, at most `spread` radians from it), a sphere around their corners, and
+/// their outline.
+#[derive(Debug)]
+struct Sheet {
+    axis: DVec3,
+    deviation: f64,
+    spread: f64,
+    center: DVec3,
+    radius: f64,
+    closed: bool,
+    outline: Vec<OutlineEdge>,
+}
+
+#[derive(Debug)]
+struct Node {
+    min: DVec3,
+    max: DVec3,
+    /// The node's faces: `items[start..end]`.
+    start: usize,
+    end: usize,
+    children: Option<(usize, usize)>,
+    sheet: Option<Sheet>,
+}
+
+/// The shaft from a point to a convex piece of an emitter, as the tree tests it.
+pub(crate) struct ShaftTest<'a> {
+    pub point: DVec3,
+    /// Normals of the side planes through the point, pointing into the shaft.
+    pub sides: &'a [DVec3],
+    pub emitter_origin: DVec3,
+    pub emitter_normal: DVec3,
+    /// Faces whose corners' heights above the emitter's plane lie in `(lowest, highest)` go
+    /// whole into the union; the outline of a node may stand for them.
+    pub lowest: f64,
+    pub highest: f64,
+    /// A face turns towards (or away from) the point when its facing normal's product with the
+    /// direction to the point exceeds this distance.
+    pub margin: f64,
+}
+
+/// What a walk of the tree reaches.
+pub(crate) enum Reached {
+    /// An occluder, by index, to be examined on its own.
+    Face(usize),
+    /// A node whose faces all turn one way to the point: its outline, reversed when they turn
+    /// away.
+    Outline { node: usize, reversed: bool },
+}
+
+/// The tree over a scene's occluder pieces.
+#[derive(Debug, Default)]
+pub(crate) struct OccluderTree {
+    nodes: Vec<Node>,
+    items: Vec<usize>,
+}
+
+impl OccluderTree {
+    pub fn build(faces: &[TreeFace]) -> OccluderTree {
+        let mut tree = OccluderTree {
+            nodes: Vec::new(),
+            items: (0..faces.len()).collect(),
+        };
+        if !faces.is_empty() {
+            let centroids: Vec<DVec3> = faces
+                .iter()
+                .map(|f| f.polygon.iter().sum::<DVec3>() / f.polygon.len() as f64)
+                .collect();
+            tree.split(faces, &centroids, 0, faces.len());
+        }
+        tree
+    }
+
+    /// Builds the node over `items[start..end]` and its subtree; returns its index.
+    fn split(
+        &mut self,
+        faces: &[TreeFace],
+        centroids: &[DVec3],
+        start: usize,
+        end: usize,
+    ) -> usize {
+        let (mut min, mut max) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+        for &i in &self.items[start..end] {
+            for &p in faces[i].polygon {
+                min = min.min(p);
+                max = max.max(p);
+            }
+        }
+        let index = self.nodes.len();
+        let members = &self.items[start..end];
+        let sheet = (end - start >= OUTLINE_MIN_FACES)
+            .then(|| sheet_of(members.iter().map(|&i| &faces[i])))
+            .flatten();
+        self.nodes.push(Node {
+            min,
+            max,
+            start,
+            end,
+            children: None,
+            sheet,
+        });
+        if end - start > LEAF_FACES {
+            // Median split of the centroids along their widest axis; ties by index, so the tree
+            // does not depend on the sort's stability.
+            let (lo, hi) = self.items[start..end]
+                .iter()
+                .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &i| {
+                    (lo.min(centroids[i]), hi.max(centroids[i]))
+                });
+            let axis = (hi - lo).max_position();
+            let mid = (start + end) / 2;
+            self.items[start..end].select_nth_unstable_by(mid - start, |&a, &b| {
+                centroids[a][axis]
+                    .total_cmp(&centroids[b][axis])
+                    .then(a.cmp(&b))
+            });
+            let left = self.split(faces, centroids, start, mid);
+            let right = self.split(faces, centroids, mid, end);
+            self.nodes[index].children = Some((left, right));
+        }
+        index
+    }
+
+    /// The faces of node `node`.
+    pub fn faces_of(&self, node: usize) -> &[usize] {
+        let n = &self.nodes[node];
+        &self.items[n.start..n.end]
+    }
+
+    /// The outline of node `node` (empty for a node that keeps none).
+    pub fn outline(&self, node: usize) -> &[OutlineEdge] {
+        self.nodes[node]
+            .sheet
+            .as_ref()
+            .map_or(&[], |s| s.outline.as_slice())
+    }
+
+    /// Visits what the shaft may hold: whole nodes by their outline where that is exact, else
+    /// faces, in a fixed order.
+    pub fn walk(&self, shaft: &ShaftTest, visit: &mut impl FnMut(Reached)) {
+        if !self.nodes.is_empty() {
+            self.walk_from(0, shaft, visit);
+        }
+    }
+
+    fn walk_from(&self, index: usize, shaft: &ShaftTest, visit: &mut impl FnMut(Reached)) {
+        let node = &self.nodes[index];
+        // Heights above the emitter's plane over the box.
+        let (low, high) = box_range(node.min, node.max, shaft.emitter_normal);
+        let base = shaft.emitter_normal.dot(shaft.emitter_origin);
+        let (low, high) = (low - base, high - base);
+        if high < 0.0
+            || shaft
+                .sides
+                .iter()
+                .any(|&m| box_range(node.min, node.max, m).1 < m.dot(shaft.point))
+        {
+            return;
+        }
+        if let Some(sheet) = &node.sheet
+            && low > shaft.lowest
+            && high < shaft.highest
+            && let Some(away) = sheet.turns_away(shaft.point, node.min, node.max, shaft.margin)
+        {
+            if !(away && sheet.closed) {
+                visit(Reached::Outline {
+                    node: index,
+                    reversed: away,
+                });
+            }
+            return;
+        }
+        match node.children {
+            Some((left, right)) => {
+                self.walk_from(left, shaft, visit);
+                self.walk_from(right, shaft, visit);
+            }
+            None => self.items[node.start..node.end]
+                .iter()
+                .for_each(|&i| visit(Reached::Face(i))),
+        }
+    }
+}
+
+/// The least and greatest of `m . p` over the box `[min, max]`.
+fn box_range(min: DVec3, max: DVec3, m: DVec3) -> (f64, f64) {
+    let lo = DVec3::select(m.cmpge(DVec3::ZERO), min, max);
+    let hi = DVec3::select(m.cmpge(DVec3::ZERO), max, min);
+    (m.dot(lo), m.dot(hi))
+}
+
+impl Sheet {
+    /// `Some(false)` when every face (within the box `[min, max]`) turns towards `point` by
+    /// more than `margin`, `Some(true)` when every face turns away, `None` when the cone and the
+    /// box cannot tell.
+    fn turns_away(&self, point: DVec3, min: DVec3, max: DVec3, margin: f64) -> Option<bool> {
+        // Flat and nearly flat nodes: for a facing normal n and a corner v, n . (point - v) lies
+        // within deviation * |point - v| of axis . (point - v).
+        let (low, high) = box_range(min, max, self.axis);
+        let along = self.axis.dot(point);
+        let far = point.distance((min + max) / 2.0) + (max - min).length() / 2.0;
+        let slack = self.deviation * far + margin;
+        if along - high > slack {
+            return Some(false);
+        } else if low - along > slack {
+            return Some(true);
+        }
+        // Curved nodes seen from afar: the direction to the point from anywhere in the sphere
+        // is within asin(radius / distance) of the direction to its centre.
+        let to_point = point - self.center;
+        let distance = to_point.length();
+        if distance <= self.radius {
+            return None;
+        }
+        let angle = self.axis.angle_between(to_point);
+        let blur = self.spread + (self.radius / distance).asin();
+        // The least of n . (point - v) is at least (distance - radius) cos(angle + blur).
+        let least = |angle: f64| (distance - self.radius) * (angle + blur).min(PI).cos();
+        if least(angle) > margin {
+            Some(false)
+        } else if least(PI - angle) > margin {
+            Some(true)
+        } else {
+            None
+        }
+    }
+}
+
+/// The sheet of a group of faces, or `None` when their facing normals spread over a half space
+/// or more (they can never all turn one way) or their outline saves nothing.
+fn sheet_of<'a>(faces: impl Iterator<Item = &'a TreeFace<'a>> + Clone) -> Option<Sheet> {
+    let axis = faces
+        .clone()
+        .map(|f| f.facing)
+        .sum::<DVec3>()
+        .try_normalize()?;
+    let deviation = faces
+        .clone()
+        .map(|f| f.facing.distance(axis))
+        .fold(0.0, f64::max);
+    // At a right angle or more, no point sees all the faces turn one way.
+    if deviation >= std::f64::consts::SQRT_2 {
+        return None;
+    }
+    let spread = 2.0 * (deviation / 2.0).min(1.0).asin();
+    let (mut min, mut max) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+    for f in faces.clone() {
+        for &p in f.polygon {
+            min = min.min(p);
+            max = max.max(p);
+        }
+    }
+    let center = (min + max) / 2.0;
+    let radius = (max - min).length() / 2.0;
+    let mut edges = Vec::new();
+    let mut count = 0;
+    let mut closed = true;
+    for f in faces {
+        count += 1;
+        closed &= f.closed;
+        let n = f.polygon.len();
+        // The listed order turns the face's own normal; the facing normal may be its opposite.
+        let listed = newell_normal(f.polygon);
+        let reversed = listed.dot(f.facing) < 0.0;
+        for i in 0..n {
+            let (a, b) = if reversed {
+                ((i + 1) % n, i)
+            } else {
+                (i, (i + 1) % n)
+            };
+            if f.keys[a] != f.keys[b] {
+                edges.push(OutlineEdge {
+                    from: f.keys[a],
+                    to: f.keys[b],
+                    from_at: f.polygon[a],
+                    to_at: f.polygon[b],
+                });
+            }
+        }
+    }
+    let outline = cancel_opposite(edges, |e| (e.from, e.to));
+    // An outline as long as the faces' own edges saves nothing.
+    (outline.len() * 2 < count * 3).then_some(Sheet {
+        axis,
+        deviation,
+        spread,
+        center,
+        radius,
+        closed,
+        outline,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A welded n x n grid of unit squares at height z, each split into two triangles listed
+    /// counter-clockwise from above.
+    fn grid(n: u32, z: f64) -> (Vec<Vec<DVec3>>, Vec<Vec<CornerKey>>) {
+        let corner = |i: u32, j: u32| {
+            (
+                i * (n + 1) + j,
+                DVec3::new(i as f64 - n as f64 / 2.0, j as f64 - n as f64 / 2.0, z),
+            )
+        };
+        let (mut polygons, mut keys) = (Vec::new(), Vec::new());
+        for i in 0..n {
+            for j in 0..n {
+                let c = [
+                    corner(i, j),
+                    corner(i + 1, j),
+                    corner(i + 1, j + 1),
+                    corner(i, j + 1),
+                ];
+                for t in [[c[0], c[1], c[2]], [c[0], c[2], c[3]]] {
+                    polygons.push(t.iter().map(|c| c.1).collect());
+                    keys.push(t.iter().map(|c| c.0).collect());
+                }
+            }
+        }
+        (polygons, keys)
+    }
+
+    fn walk(
+        tree: &OccluderTree,
+        point: DVec3,
+        sides: &[DVec3],
+    ) -> (Vec<usize>, Vec<(usize, bool)>) {
+        let (mut faces, mut outlines) = (Vec::new(), Vec::new());
+        tree.walk(
+            &ShaftTest {
+                point,
+                sides,
+                emitter_origin: DVec3::new(0.0, 0.0, 10.0),
+                emitter_normal: -DVec3::Z,
+                lowest: 1e-9,
+                highest: 9.0,
+                margin: 1e-9,
+            },
+            &mut |r| match r {
+                Reached::Face(i) => faces.push(i),
+                Reached::Outline { node, reversed } => outlines.push((node, reversed)),
+            },
+        );
+        (faces, outlines)
+    }
+
+    /// Under an emitter at z = 10, a point below a 16 x 16 sheet at z = 5 meets the sheet as one
+    /// outline: its rim of 64 edges, the inner edges cancelled.
+    #[test]
+    fn a_sheet_facing_the_point_is_one_outline() {
+        let (polygons, keys) = grid(16, 5.0);
+        for (facing, closed, expect_reversed) in
+            [(-DVec3::Z, false, false), (DVec3::Z, false, true)]
+        {
+            let faces: Vec<TreeFace> = polygons
+                .iter()
+                .zip(&keys)
+                .map(|(p, k)| TreeFace {
+                    polygon: p,
+                    keys: k,
+                    facing,
+                    closed,
+                })
+                .collect();
+            let tree = OccluderTree::build(&faces);
+            // A shaft with no side planes holds everything between the planes.
+            let (loose, outlines) = walk(&tree, DVec3::ZERO, &[]);
+            assert!(loose.is_empty(), "{loose:?}");
+            assert_eq!(outlines.len(), 1);
+            let (node, reversed) = outlines[0];
+            assert_eq!(reversed, expect_reversed);
+            assert_eq!(tree.outline(node).len(), 64);
+            assert_eq!(tree.faces_of(node).len(), 512);
+            // The rim turns counter-clockwise around +z in the facing order.
+            let turn: f64 = tree
+                .outline(node)
+                .iter()
+                .map(|e| e.from_at.x * e.to_at.y - e.to_at.x * e.from_at.y)
+                .sum();
+            assert!(if facing.z > 0.0 {
+                turn > 0.0
+            } else {
+                turn < 0.0
+            });
+        }
+    }
+
+    /// Faces through the point, closed solids turned away, and nodes outside the shaft.
+    #[test]
+    fn the_walk_skips_what_cannot_cast_and_opens_what_it_cannot_decide() {
+        let (polygons, keys) = grid(16, 5.0);
+        let faces: Vec<TreeFace> = polygons
+            .iter()
+            .zip(&keys)
+            .map(|(p, k)| TreeFace {
+                polygon: p,
+                keys: k,
+                facing: DVec3::Z,
+                closed: true,
+            })
+            .collect();
+        let tree = OccluderTree::build(&faces);
+        // Below the sheet, a closed solid's faces turned away cast nothing.
+        let (loose, outlines) = walk(&tree, DVec3::ZERO, &[]);
+        assert!(loose.is_empty() && outlines.is_empty());
+        // In the sheet's plane no face turns either way: every face is examined on its own.
+        let (loose, outlines) = walk(&tree, DVec3::new(0.1, 0.2, 5.0), &[]);
+        assert_eq!((loose.len(), outlines.len()), (512, 0));
+        // A shaft leaning to x > 20 misses the sheet altogether.
+        let (loose, outlines) = walk(&tree, DVec3::new(20.0, 0.0, 0.0), &[DVec3::X]);
+        assert!(loose.is_empty() && outlines.is_empty());
+    }
+}
