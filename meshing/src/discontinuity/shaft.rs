@@ -142,7 +142,7 @@ impl<'a> SearchContext<'a> {
         let tol = self.tol;
         let mut ends = emitter.polygon.clone();
         ends.extend(&receiver.polygon);
-        let hull = hull::hull_planes(&ends, tol);
+        let hull = hull::HullPlanes::new(&ends, tol, self.reach);
         // A blocker must have a vertex in front of both and must not lie wholly beyond one of
         // the hull's faces.
         let blockers = shaft_blockers(
@@ -155,7 +155,7 @@ impl<'a> SearchContext<'a> {
                 polygon
                     .iter()
                     .any(|&p| ef.height(p) > tol && rf.height(p) > tol)
-                    && !hull::beyond_a_face(&hull, polygon, tol)
+                    && !hull.beyond_a_face(polygon, tol)
             },
         );
         if blockers.is_empty() {
