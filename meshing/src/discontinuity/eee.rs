@@ -16,7 +16,7 @@
 use std::collections::{BTreeSet, HashMap};
 
 use glam::DVec3;
-use penumbra_scenes::{Bounds, PlaneFrame, SurfaceId, Visibility};
+use penumbra_scenes::{Bounds, IndexBox, PlaneFrame, SurfaceId, Visibility};
 
 use super::topology::Topology;
 
@@ -61,6 +61,9 @@ pub(crate) struct EeeSearch<'a> {
     /// Greatest distance of a chord from its arc.
     pub chord_tolerance: f64,
     pub receiver_polygon: &'a [DVec3],
+    /// Each surface's leaf boxes in the visibility index ([`Visibility::leaf_boxes`], deduplicated),
+    /// when the index has them.
+    pub surface_leaves: Option<&'a [Vec<IndexBox>]>,
     /// Samples along a pencil's line when trimming it, and the length its trim points are
     /// located to.
     pub trim_samples: usize,
@@ -77,8 +80,60 @@ struct Transversal {
     receiver: DVec3,
 }
 
-/// Shafts with at most this many blockers test them one by one rather than query the BVH.
+/// Shafts with at most this many blockers test their boxes one by one.
 const FEW_BLOCKERS: usize = 64;
+
+/// How a shaft finds its blockers near a region (by their place in the shaft's list).
+enum NearBlockers {
+    /// Few blockers: each blocker's box, grown by the tolerance, against the region's.
+    Few(Vec<Bounds>),
+    /// Many: the boxes of the visibility index's leaves holding each blocker's triangles,
+    /// against the index's box of the region. A blocker is found exactly when the index's box
+    /// query would visit one of its triangles (see [`Visibility::leaf_boxes`]), without
+    /// walking the scene's other triangles that the region's box holds.
+    Leaves(Vec<(IndexBox, usize)>),
+    /// Many, where the index's leaves do not decide alone: the index's box query, its surfaces
+    /// looked up among the blockers.
+    Index(HashMap<SurfaceId, usize>),
+}
+
+impl NearBlockers {
+    /// Calls `found` with each blocker near the box `region` (some maybe more than once).
+    fn find(
+        &self,
+        visibility: &Visibility,
+        region: Bounds,
+        tol: f64,
+        mut found: impl FnMut(usize),
+    ) {
+        match self {
+            NearBlockers::Few(boxes) => {
+                let padded = Bounds {
+                    min: region.min - tol,
+                    max: region.max + tol,
+                };
+                for (b, bounds) in boxes.iter().enumerate() {
+                    if bounds.overlaps(&padded) {
+                        found(b);
+                    }
+                }
+            }
+            NearBlockers::Leaves(boxes) => {
+                let query = visibility.query_box(region);
+                for (leaf, b) in boxes {
+                    if leaf.overlaps(&query) {
+                        found(*b);
+                    }
+                }
+            }
+            NearBlockers::Index(place) => visibility.triangles_overlapping(region, |k| {
+                if let Some(&b) = place.get(&visibility.triangles()[k].surface) {
+                    found(b);
+                }
+            }),
+        }
+    }
+}
 
 impl EeeSearch<'_> {
     /// The EEE curves of emitter edges `emitter_edges` with the blocker edges `edges` (welded
@@ -102,36 +157,27 @@ impl EeeSearch<'_> {
             at_vertex.entry(u).or_default().push(i);
             at_vertex.entry(w).or_default().push(i);
         }
-        let along_surface: HashMap<SurfaceId, Vec<usize>> = blockers
+        // Along each blocker (by its place in `blockers`): its edges and its polygon.
+        let along_blocker: Vec<Vec<usize>> = blockers
             .iter()
             .map(|&s| {
                 let l = &t.loops[s];
-                let ids = (0..l.len())
+                (0..l.len())
                     .filter_map(|k| {
                         let (u, w) = (l[k], l[(k + 1) % l.len()]);
                         index.get(&(u.min(w), u.max(w))).copied()
                     })
-                    .collect();
-                (s, ids)
+                    .collect()
             })
             .collect();
-        // A small receiver's shaft holds few blockers: their boxes are tested directly. The
-        // region beyond an edge can reach far along a receiver's plane (light grazing it), and
-        // the scene's triangles in its box would then be most of a large scene.
-        let few: Option<Vec<(SurfaceId, Bounds)>> = (blockers.len() <= FEW_BLOCKERS).then(|| {
-            blockers
-                .iter()
-                .map(|&s| {
-                    (
-                        s,
-                        Bounds::from_points(t.loops[s].iter().map(|&v| &t.points[v])),
-                    )
-                })
-                .collect()
-        });
-        let mut near: Vec<SurfaceId> = Vec::new();
-        // Surfaces and edges already taken for the current first edge, stamped to skip repeats.
-        let mut surface_stamp = vec![usize::MAX; t.loops.len()];
+        let polygons: Vec<Vec<DVec3>> = blockers
+            .iter()
+            .map(|&s| t.loops[s].iter().map(|&v| t.points[v]).collect())
+            .collect();
+        let near_finder = self.near_finder(blockers);
+        let mut near: Vec<usize> = Vec::new();
+        // Blockers and edges already taken for the current first edge, stamped to skip repeats.
+        let mut blocker_stamp = vec![usize::MAX; blockers.len()];
         let mut edge_stamp = vec![usize::MAX; list.len()];
         let mut partners: Vec<usize> = Vec::new();
         let mut round = 0usize;
@@ -162,7 +208,6 @@ impl EeeSearch<'_> {
                 let hull = super::hull::hull_planes(&corners, self.tol);
                 let outside =
                     |points: &[DVec3]| super::hull::beyond_a_face(&hull, points, self.tol);
-                let mut polygon: Vec<DVec3> = Vec::new();
                 partners.clear();
                 let mut take = |i: usize, partners: &mut Vec<usize>| {
                     if edge_stamp[i] != round && i != i1 && regions[i].is_some() {
@@ -175,38 +220,23 @@ impl EeeSearch<'_> {
                         take(i, &mut partners);
                     }
                 }
-                let region = Bounds::from_points(corners.iter());
                 near.clear();
-                match &few {
-                    Some(few) => {
-                        let padded = Bounds {
-                            min: region.min - self.tol,
-                            max: region.max + self.tol,
-                        };
-                        near.extend(
-                            few.iter()
-                                .filter(|(_, b)| b.overlaps(&padded))
-                                .map(|&(s, _)| s),
-                        );
-                    }
-                    None => self.visibility.triangles_overlapping(region, |k| {
-                        let s = self.visibility.triangles()[k].surface;
-                        if surface_stamp[s] != round {
-                            surface_stamp[s] = round;
-                            near.push(s);
+                near_finder.find(
+                    self.visibility,
+                    Bounds::from_points(corners.iter()),
+                    self.tol,
+                    |b| {
+                        if blocker_stamp[b] != round {
+                            blocker_stamp[b] = round;
+                            near.push(b);
                         }
-                    }),
-                }
-                for &s in &near {
-                    let Some(ids) = along_surface.get(&s) else {
-                        continue;
-                    };
-                    polygon.clear();
-                    polygon.extend(t.loops[s].iter().map(|&v| t.points[v]));
-                    if outside(&polygon) {
+                    },
+                );
+                for &b in &near {
+                    if outside(&polygons[b]) {
                         continue;
                     }
-                    for &i in ids {
+                    for &i in &along_blocker[b] {
                         take(i, &mut partners);
                     }
                 }
@@ -230,6 +260,33 @@ impl EeeSearch<'_> {
             }
         }
         (curves, count)
+    }
+
+    /// How this shaft finds the blockers near a region ([`NearBlockers`]).
+    fn near_finder(&self, blockers: &[SurfaceId]) -> NearBlockers {
+        let t = self.topology;
+        if blockers.len() <= FEW_BLOCKERS {
+            return NearBlockers::Few(
+                blockers
+                    .iter()
+                    .map(|&s| Bounds::from_points(t.loops[s].iter().map(|&v| &t.points[v])))
+                    .collect(),
+            );
+        }
+        match self.surface_leaves {
+            Some(leaves) => {
+                let mut boxes: Vec<(IndexBox, usize)> = blockers
+                    .iter()
+                    .enumerate()
+                    .flat_map(|(b, &s)| leaves[s].iter().map(move |&x| (x, b)))
+                    .collect();
+                boxes.shrink_to_fit();
+                NearBlockers::Leaves(boxes)
+            }
+            None => {
+                NearBlockers::Index(blockers.iter().enumerate().map(|(b, &s)| (s, b)).collect())
+            }
+        }
     }
 
     /// Whether blocker edge `(u, w)` is on the silhouette of its faces as seen from some point of
@@ -703,6 +760,7 @@ mod tests {
             receiver_polygon: &scene.surfaces[3].polygon,
             trim_samples: 16,
             trim_tolerance: 1e-9 * scene.diagonal(),
+            surface_leaves: None,
         };
         let l = &topology.loops[0];
         let emitter_edges: Vec<(usize, usize)> =

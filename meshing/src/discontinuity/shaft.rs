@@ -5,7 +5,7 @@
 use std::collections::BTreeSet;
 
 use glam::DVec3;
-use penumbra_scenes::{Bounds, PlaneFrame, Scene, SurfaceId, Visibility};
+use penumbra_scenes::{Bounds, IndexBox, PlaneFrame, Scene, SurfaceId, Visibility};
 
 use super::patches::Patches;
 use super::strength::Pair;
@@ -27,6 +27,9 @@ pub(crate) struct SearchContext<'a> {
     /// Vertices inside a straight stretch of edges: no corner, so no EV event.
     pub straight: Vec<bool>,
     pub frames: Vec<Option<PlaneFrame>>,
+    /// Each surface's distinct leaf boxes in the visibility index, if it has them
+    /// ([`Visibility::leaf_boxes`]).
+    pub surface_leaves: Option<Vec<Vec<IndexBox>>>,
     pub options: &'a DiscontinuityOptions,
     /// Points closer than this count as coincident.
     pub tol: f64,
@@ -75,6 +78,7 @@ impl<'a> SearchContext<'a> {
                 .iter()
                 .map(|s| PlaneFrame::of_polygon(&s.polygon))
                 .collect(),
+            surface_leaves: surface_leaves(scene, visibility),
             options,
             tol,
             reach: 4.0 * scene.diagonal(),
@@ -359,6 +363,7 @@ impl Shaft<'_> {
             reach: context.reach,
             chord_tolerance: self.on_receiver(context.options.eee_tolerance),
             receiver_polygon,
+            surface_leaves: context.surface_leaves.as_deref(),
             trim_samples: context.options.trim_samples,
             trim_tolerance: self.on_receiver(context.options.trim_tolerance),
         };
@@ -426,6 +431,19 @@ impl Shaft<'_> {
             order,
         }
     }
+}
+
+/// Each surface's distinct leaf boxes in the visibility index, if it has them.
+fn surface_leaves(scene: &Scene, visibility: &Visibility) -> Option<Vec<Vec<IndexBox>>> {
+    let leaves = visibility.leaf_boxes()?;
+    let mut out: Vec<Vec<IndexBox>> = vec![Vec::new(); scene.surfaces.len()];
+    for (t, leaf) in visibility.triangles().iter().zip(leaves) {
+        let boxes = &mut out[t.surface];
+        if !boxes.contains(leaf) {
+            boxes.push(*leaf);
+        }
+    }
+    Some(out)
 }
 
 /// Surfaces other than `e` and `r` with a triangle in the shaft between two boxes for which
