@@ -13,6 +13,7 @@
 //! unobstructed. Samples along the edge find the runs where this holds, bisection places their
 //! ends, and each run's arc is split until every chord is within the tolerance.
 
+use std::cell::OnceCell;
 use std::collections::{BTreeSet, HashMap};
 
 use glam::DVec3;
@@ -174,6 +175,11 @@ impl EeeSearch<'_> {
             .iter()
             .map(|&s| t.loops[s].iter().map(|&v| t.points[v]).collect())
             .collect();
+        let not_pair = |s: SurfaceId| s != self.emitter && s != self.receiver;
+        let faces: Vec<Vec<DVec3>> = list
+            .iter()
+            .map(|&(u, w)| t.edge_faces(u, w, not_pair))
+            .collect();
         let near_finder = self.near_finder(blockers);
         let mut near: Vec<usize> = Vec::new();
         // Blockers and edges already taken for the current first edge, stamped to skip repeats.
@@ -241,6 +247,7 @@ impl EeeSearch<'_> {
                     }
                 }
                 partners.sort_unstable();
+                let planes = OnceCell::new();
                 for &i2 in &partners {
                     let second = list[i2];
                     let b2 = [t.points[second.0], t.points[second.1]];
@@ -251,7 +258,8 @@ impl EeeSearch<'_> {
                         continue;
                     }
                     count.considered += 1;
-                    let found = self.triple(source, first, second);
+                    let found =
+                        self.triple(source, [first, second], [&faces[i1], &faces[i2]], &planes);
                     if !found.is_empty() {
                         count.events += 1;
                         curves.extend(found);
@@ -366,11 +374,14 @@ impl EeeSearch<'_> {
     }
 
     /// The curves of one triple.
+    /// `faces` are the blocker edges' faces ([`Topology::edge_faces`]); `planes` the first edge's
+    /// [`SamplePlanes`], made when first needed.
     fn triple(
         &self,
         source: [DVec3; 2],
-        first: (usize, usize),
-        second: (usize, usize),
+        [first, second]: [(usize, usize); 2],
+        faces: [&[DVec3]; 2],
+        planes: &OnceCell<SamplePlanes>,
     ) -> Vec<EeeCurve> {
         let t = self.topology;
         let b1 = [t.points[first.0], t.points[first.1]];
@@ -383,7 +394,7 @@ impl EeeSearch<'_> {
             || plane_normal(b1, b2)
                 .is_some_and(|n| b2.iter().all(|&p| n.dot(p - b1[0]).abs() <= self.tol));
         if coplanar {
-            return self.pencil(source, b1, b2, first, second);
+            return self.pencil(source, b1, b2, [first, second], faces);
         }
         // With the emitter edge parallel to a blocker edge, every line through the three lies in
         // the plane of those two: an edge–edge event, found as EV and VE wedges already.
@@ -393,12 +404,18 @@ impl EeeSearch<'_> {
             return Vec::new();
         }
         let line = |u: f64| self.transversal(source, b1, b2, u);
-        let event =
-            |u: f64| line(u).filter(|x| self.grazes(x, first, second) && self.unobstructed(x));
-        let params: Vec<f64> = (0..SAMPLES)
-            .map(|k| (k as f64 + 0.5) / SAMPLES as f64)
-            .collect();
-        let states: Vec<bool> = params.iter().map(|&u| event(u).is_some()).collect();
+        let holds =
+            |x: &Transversal| self.grazes(x, [first, second], faces) && self.unobstructed(x);
+        let event = |u: f64| line(u).filter(holds);
+        let params = sample_parameters();
+        // At the samples, the planes through the first edge's points are the same for every
+        // second edge.
+        let planes = planes.get_or_init(|| sample_planes(source, b1));
+        let states: [bool; SAMPLES] = std::array::from_fn(|k| {
+            let (first, n) = planes[k];
+            n.and_then(|n| self.transversal_in(source, first, n, b2))
+                .is_some_and(|x| holds(&x))
+        });
         if !states.iter().any(|&s| s) {
             return Vec::new();
         }
@@ -468,8 +485,8 @@ impl EeeSearch<'_> {
         source: [DVec3; 2],
         b1: [DVec3; 2],
         b2: [DVec3; 2],
-        first: (usize, usize),
-        second: (usize, usize),
+        edges: [(usize, usize); 2],
+        faces: [&[DVec3]; 2],
     ) -> Vec<EeeCurve> {
         let Some(n) = plane_normal(b1, b2) else {
             return Vec::new();
@@ -516,7 +533,7 @@ impl EeeSearch<'_> {
             self.emitter_frame.height(x) > self.tol
                 && self
                     .pencil_line(apex, x, b1, b2)
-                    .is_some_and(|l| self.grazes(&l, first, second))
+                    .is_some_and(|l| self.grazes(&l, edges, faces))
         };
         let mut runs: Vec<(f64, f64)> = Vec::new();
         for w in cuts.windows(2) {
@@ -611,11 +628,21 @@ impl EeeSearch<'_> {
         b2: [DVec3; 2],
         u: f64,
     ) -> Option<Transversal> {
-        let first = b1[0].lerp(b1[1], u);
+        let (first, n) = plane_through(source, b1, u);
+        self.transversal_in(source, first, n?, b2)
+    }
+
+    /// [`Self::transversal`] through the point `first` of the first blocker edge, with `n` the
+    /// unit normal of the plane through it and the emitter edge's line ([`plane_through`]).
+    fn transversal_in(
+        &self,
+        source: [DVec3; 2],
+        first: DVec3,
+        n: DVec3,
+        b2: [DVec3; 2],
+    ) -> Option<Transversal> {
         let e = source[1] - source[0];
         // The plane through `first` and the emitter edge's line cuts `b2`'s line at `second`.
-        let n = e.cross(first - source[0]);
-        let n = n.try_normalize()?;
         let d2 = b2[1] - b2[0];
         let den = n.dot(d2);
         if den.abs() <= f64::EPSILON * d2.length() {
@@ -665,16 +692,16 @@ impl EeeSearch<'_> {
 
     /// Whether the line grazes both blocker edges: their faces stay on one side of the plane
     /// through each edge and the line.
-    fn grazes(&self, x: &Transversal, first: (usize, usize), second: (usize, usize)) -> bool {
+    /// `faces` are the edges' faces ([`Topology::edge_faces`], emitter and receiver excepted).
+    fn grazes(&self, x: &Transversal, edges: [(usize, usize); 2], faces: [&[DVec3]; 2]) -> bool {
         let t = self.topology;
-        let not_pair = |s: SurfaceId| s != self.emitter && s != self.receiver;
         let d = x.receiver - x.source;
-        [first, second].into_iter().all(|(a, b)| {
+        edges.into_iter().zip(faces).all(|((a, b), faces)| {
             let along = t.points[b] - t.points[a];
             along
                 .cross(d)
                 .try_normalize()
-                .is_some_and(|n| t.edge_is_tangent(a, b, n, not_pair))
+                .is_some_and(|n| t.faces_are_tangent(faces, n))
         })
     }
 
@@ -686,6 +713,27 @@ impl EeeSearch<'_> {
             && !v.occluded(x.second, x.first, [r, e])
             && !v.occluded(x.first, x.source, [e, e])
     }
+}
+
+/// The point at `u` along the blocker edge `b1`, and the unit normal of the plane through it and
+/// the line of the emitter edge `source` (`None` when they are collinear).
+fn plane_through(source: [DVec3; 2], b1: [DVec3; 2], u: f64) -> (DVec3, Option<DVec3>) {
+    let first = b1[0].lerp(b1[1], u);
+    let e = source[1] - source[0];
+    (first, e.cross(first - source[0]).try_normalize())
+}
+
+/// The sample parameters along a first blocker edge.
+fn sample_parameters() -> [f64; SAMPLES] {
+    std::array::from_fn(|k| (k as f64 + 0.5) / SAMPLES as f64)
+}
+
+/// [`plane_through`] at every sample parameter: shared by all the second edges paired with one
+/// first edge.
+type SamplePlanes = [(DVec3, Option<DVec3>); SAMPLES];
+
+fn sample_planes(source: [DVec3; 2], b1: [DVec3; 2]) -> SamplePlanes {
+    sample_parameters().map(|u| plane_through(source, b1, u))
 }
 
 /// Whether, for some point `p` of the emitter edge `source`, segment `b` crosses the plane through
