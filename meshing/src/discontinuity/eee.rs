@@ -411,9 +411,10 @@ impl EeeSearch<'_> {
         // At the samples, the planes through the first edge's points are the same for every
         // second edge.
         let planes = planes.get_or_init(|| sample_planes(source, b1));
+        let second_edge = SecondEdge::new(source, b2);
         let states: [bool; SAMPLES] = std::array::from_fn(|k| {
             let (first, n) = planes[k];
-            n.and_then(|n| self.transversal_in(source, first, n, b2))
+            n.and_then(|n| self.transversal_in(source, first, n, &second_edge))
                 .is_some_and(|x| holds(&x))
         });
         if !states.iter().any(|&s| s) {
@@ -629,7 +630,7 @@ impl EeeSearch<'_> {
         u: f64,
     ) -> Option<Transversal> {
         let (first, n) = plane_through(source, b1, u);
-        self.transversal_in(source, first, n?, b2)
+        self.transversal_in(source, first, n?, &SecondEdge::new(source, b2))
     }
 
     /// [`Self::transversal`] through the point `first` of the first blocker edge, with `n` the
@@ -639,20 +640,20 @@ impl EeeSearch<'_> {
         source: [DVec3; 2],
         first: DVec3,
         n: DVec3,
-        b2: [DVec3; 2],
+        b2: &SecondEdge,
     ) -> Option<Transversal> {
         let e = source[1] - source[0];
         // The plane through `first` and the emitter edge's line cuts `b2`'s line at `second`.
-        let d2 = b2[1] - b2[0];
+        let d2 = b2.along;
         let den = n.dot(d2);
-        if den.abs() <= f64::EPSILON * d2.length() {
+        if den.abs() <= b2.flat {
             return None;
         }
-        let s = n.dot(source[0] - b2[0]) / den;
+        let s = n.dot(b2.to_source) / den;
         if !(0.0..=1.0).contains(&s) {
             return None;
         }
-        let second = b2[0] + d2 * s;
+        let second = b2.start + d2 * s;
         let d = second - first;
         if d.length() <= self.tol {
             return None;
@@ -712,6 +713,29 @@ impl EeeSearch<'_> {
         !v.occluded(x.receiver, x.second, [r, r])
             && !v.occluded(x.second, x.first, [r, e])
             && !v.occluded(x.first, x.source, [e, e])
+    }
+}
+
+/// What [`EeeSearch::transversal_in`] needs of the second blocker edge, the same at every sample.
+struct SecondEdge {
+    start: DVec3,
+    along: DVec3,
+    /// Planes through the emitter edge's line closer to parallel to the edge than this (a dot
+    /// product of the plane's unit normal with `along`) do not cut it.
+    flat: f64,
+    /// From the edge's start to the emitter edge's start.
+    to_source: DVec3,
+}
+
+impl SecondEdge {
+    fn new(source: [DVec3; 2], b2: [DVec3; 2]) -> SecondEdge {
+        let along = b2[1] - b2[0];
+        SecondEdge {
+            start: b2[0],
+            along,
+            flat: f64::EPSILON * along.length(),
+            to_source: source[0] - b2[0],
+        }
     }
 }
 
