@@ -52,6 +52,8 @@ struct Shaft<'a> {
     emitter_frame: PlaneFrame,
     receiver_frame: PlaneFrame,
     blockers: Vec<SurfaceId>,
+    /// The receiver polygon's diameter (quadratic in its vertex count: found once).
+    receiver_diameter: f64,
     /// The blockers' welded vertices and edges (vertex pairs, smaller index first).
     vertices: BTreeSet<usize>,
     edges: BTreeSet<(usize, usize)>,
@@ -185,6 +187,7 @@ impl<'a> SearchContext<'a> {
             receiver: r,
             emitter_frame: ef,
             receiver_frame: rf,
+            receiver_diameter: penumbra_scenes::polygon::diameter(&receiver.polygon),
             blockers,
             vertices,
             edges,
@@ -344,8 +347,7 @@ impl Shaft<'_> {
 
     /// The receiver's diameter times `fraction`: tolerances of this pair.
     fn on_receiver(&self, fraction: f64) -> f64 {
-        let polygon = &self.context.scene.surfaces[self.receiver].polygon;
-        fraction * penumbra_scenes::polygon::diameter(polygon)
+        fraction * self.receiver_diameter
     }
 
     /// EEE: each emitter edge with two blocker edges, as polylines on the receiver.
