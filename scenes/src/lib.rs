@@ -41,4 +41,4 @@ pub use load::{LoadedScene, load_scene, load_scene_with};
 pub use model::{Bounds, Camera, Scene, Surface, SurfaceId};
 pub use obj::ObjOptions;
 pub use validate::{Problem, ProblemKind, validate};
-pub use visibility::{CONTACT_TOLERANCE, Hit, SceneTriangle, Visibility};
+pub use visibility::{CONTACT_TOLERANCE, Hit, IndexBox, SceneTriangle, Visibility};

@@ -66,6 +66,9 @@ pub struct Visibility {
     rays: Option<CwBvh>,
     /// Box queries (obvhs has them on the binary BVH only).
     boxes: Option<Bvh2>,
+    /// For each triangle, the box of the leaf of `boxes` that holds it, when every node's box
+    /// holds its children's (then a leaf is visited exactly when its own box overlaps a query).
+    leaf_boxes: Option<Vec<IndexBox>>,
     center: DVec3,
     /// Scene units per f32-world unit (the scene diagonal).
     unit: f64,
@@ -145,6 +148,9 @@ impl Visibility {
                 )),
             )
         };
+        let leaf_boxes = box_bvh
+            .as_ref()
+            .and_then(|bvh| leaf_box_of_each(bvh, triangles.len()));
         let normals = triangles
             .iter()
             .map(|t| {
@@ -157,6 +163,7 @@ impl Visibility {
             normals,
             rays,
             boxes: box_bvh,
+            leaf_boxes,
             center,
             unit,
             padding,
@@ -291,6 +298,62 @@ impl Visibility {
             }
             true
         });
+    }
+}
+
+/// A box in the precision of the visibility index (f32, padded outward), as box queries test
+/// them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct IndexBox(Aabb);
+
+impl IndexBox {
+    /// Whether the boxes overlap, as the index's traversal decides it (touching counts).
+    #[inline]
+    pub fn overlaps(&self, other: &IndexBox) -> bool {
+        self.0.intersect_aabb(&other.0)
+    }
+}
+
+/// For each of `count` triangles, the box of the leaf holding it, if every inner node's box holds
+/// its children's boxes and each triangle lies in one leaf.
+fn leaf_box_of_each(bvh: &Bvh2, count: usize) -> Option<Vec<IndexBox>> {
+    let holds = |outer: &Aabb, inner: &Aabb| {
+        outer.min.cmple(inner.min).all() && inner.max.cmple(outer.max).all()
+    };
+    let mut boxes: Vec<Option<IndexBox>> = vec![None; count];
+    for node in &bvh.nodes {
+        if node.is_leaf() {
+            let first = node.first_index as usize;
+            for &p in &bvh.primitive_indices[first..first + node.prim_count as usize] {
+                let slot = boxes.get_mut(p as usize)?;
+                if slot.is_some() {
+                    return None;
+                }
+                *slot = Some(IndexBox(*node.aabb()));
+            }
+        } else {
+            let first = node.first_index as usize;
+            for child in &bvh.nodes[first..first + 2] {
+                if !holds(node.aabb(), child.aabb()) {
+                    return None;
+                }
+            }
+        }
+    }
+    boxes.into_iter().collect()
+}
+
+impl Visibility {
+    /// The box that [`Self::triangles_overlapping`] tests the index with for `bounds`.
+    pub fn query_box(&self, bounds: Bounds) -> IndexBox {
+        IndexBox(to_f32_box(bounds, self.center, self.unit, self.padding))
+    }
+
+    /// For each triangle, the box of the index's leaf that holds it: a query for `bounds` visits
+    /// exactly the triangles whose leaf box overlaps [`Self::query_box`]. `None` when the
+    /// index's boxes are not nested (the leaf alone would not decide) or it has no triangles.
+    pub fn leaf_boxes(&self) -> Option<&[IndexBox]> {
+        self.leaf_boxes.as_deref()
     }
 }
 
@@ -516,6 +579,34 @@ mod tests {
             match hit {
                 Some(h) => assert!((h.t - brute).abs() <= 1e-12 * brute, "{} vs {brute}", h.t),
                 None => assert!(brute.is_infinite()),
+            }
+        }
+    }
+
+    #[test]
+    fn leaf_boxes_tell_which_triangles_a_box_query_visits() {
+        let scene = builtin::builtin("boxworld-100").expect("a built-in scene");
+        let vis = Visibility::build(&scene);
+        let leaves = vis.leaf_boxes().expect("obvhs nests its boxes");
+        assert_eq!(leaves.len(), vis.triangles().len());
+        let bounds = scene.bounds();
+        let mut rng = SplitMix64::new(13);
+        let mut visited = vec![false; leaves.len()];
+        for _ in 0..500 {
+            let mut corner = || {
+                let s = DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64());
+                bounds.min + (bounds.max - bounds.min) * s
+            };
+            let (a, b) = (corner(), corner());
+            let query = Bounds {
+                min: a.min(b),
+                max: a.max(b),
+            };
+            visited.fill(false);
+            vis.triangles_overlapping(query, |t| visited[t] = true);
+            let q = vis.query_box(query);
+            for (t, leaf) in leaves.iter().enumerate() {
+                assert_eq!(visited[t], leaf.overlaps(&q), "triangle {t}");
             }
         }
     }

@@ -104,12 +104,15 @@ pub const HOVER: f64 = 1e-3;
 /// within [`HOVER`] of its diameter.
 fn hovering(poly: &[DVec3], h: &[f64], tol: f64) -> Option<f64> {
     let gap = h.first().copied()?;
+    if !(gap > 0.0 && h.iter().all(|&x| (x - gap).abs() <= tol)) {
+        return None;
+    }
+    // The diameter (quadratic in the vertex count) only for the rare parallel face.
     let diameter = poly
         .iter()
         .flat_map(|a| poly.iter().map(move |b| a.distance(*b)))
         .fold(0.0, f64::max);
-    let parallel = h.iter().all(|&x| (x - gap).abs() <= tol);
-    (parallel && gap > 0.0 && gap <= HOVER * diameter).then_some(gap)
+    (gap <= HOVER * diameter).then_some(gap)
 }
 
 /// Where a planar polygon meets a plane, given its vertices' heights above it (zero: on it):

@@ -5,7 +5,7 @@
 use std::collections::BTreeSet;
 
 use glam::DVec3;
-use penumbra_scenes::{Bounds, PlaneFrame, Scene, SurfaceId, Visibility};
+use penumbra_scenes::{Bounds, IndexBox, PlaneFrame, Scene, SurfaceId, Visibility};
 
 use super::patches::Patches;
 use super::strength::Pair;
@@ -27,6 +27,9 @@ pub(crate) struct SearchContext<'a> {
     /// Vertices inside a straight stretch of edges: no corner, so no EV event.
     pub straight: Vec<bool>,
     pub frames: Vec<Option<PlaneFrame>>,
+    /// Each surface's distinct leaf boxes in the visibility index, if it has them
+    /// ([`Visibility::leaf_boxes`]).
+    pub surface_leaves: Option<Vec<Vec<IndexBox>>>,
     pub options: &'a DiscontinuityOptions,
     /// Points closer than this count as coincident.
     pub tol: f64,
@@ -49,6 +52,8 @@ struct Shaft<'a> {
     emitter_frame: PlaneFrame,
     receiver_frame: PlaneFrame,
     blockers: Vec<SurfaceId>,
+    /// The receiver polygon's diameter (quadratic in its vertex count: found once).
+    receiver_diameter: f64,
     /// The blockers' welded vertices and edges (vertex pairs, smaller index first).
     vertices: BTreeSet<usize>,
     edges: BTreeSet<(usize, usize)>,
@@ -75,6 +80,7 @@ impl<'a> SearchContext<'a> {
                 .iter()
                 .map(|s| PlaneFrame::of_polygon(&s.polygon))
                 .collect(),
+            surface_leaves: surface_leaves(scene, visibility),
             options,
             tol,
             reach: 4.0 * scene.diagonal(),
@@ -142,7 +148,7 @@ impl<'a> SearchContext<'a> {
         let tol = self.tol;
         let mut ends = emitter.polygon.clone();
         ends.extend(&receiver.polygon);
-        let hull = hull::hull_planes(&ends, tol);
+        let hull = hull::HullPlanes::new(&ends, tol, self.reach);
         // A blocker must have a vertex in front of both and must not lie wholly beyond one of
         // the hull's faces.
         let blockers = shaft_blockers(
@@ -155,7 +161,7 @@ impl<'a> SearchContext<'a> {
                 polygon
                     .iter()
                     .any(|&p| ef.height(p) > tol && rf.height(p) > tol)
-                    && !hull::beyond_a_face(&hull, polygon, tol)
+                    && !hull.beyond_a_face(polygon, tol)
             },
         );
         if blockers.is_empty() {
@@ -181,6 +187,7 @@ impl<'a> SearchContext<'a> {
             receiver: r,
             emitter_frame: ef,
             receiver_frame: rf,
+            receiver_diameter: penumbra_scenes::polygon::diameter(&receiver.polygon),
             blockers,
             vertices,
             edges,
@@ -340,8 +347,7 @@ impl Shaft<'_> {
 
     /// The receiver's diameter times `fraction`: tolerances of this pair.
     fn on_receiver(&self, fraction: f64) -> f64 {
-        let polygon = &self.context.scene.surfaces[self.receiver].polygon;
-        fraction * penumbra_scenes::polygon::diameter(polygon)
+        fraction * self.receiver_diameter
     }
 
     /// EEE: each emitter edge with two blocker edges, as polylines on the receiver.
@@ -359,6 +365,7 @@ impl Shaft<'_> {
             reach: context.reach,
             chord_tolerance: self.on_receiver(context.options.eee_tolerance),
             receiver_polygon,
+            surface_leaves: context.surface_leaves.as_deref(),
             trim_samples: context.options.trim_samples,
             trim_tolerance: self.on_receiver(context.options.trim_tolerance),
         };
@@ -426,6 +433,19 @@ impl Shaft<'_> {
             order,
         }
     }
+}
+
+/// Each surface's distinct leaf boxes in the visibility index, if it has them.
+fn surface_leaves(scene: &Scene, visibility: &Visibility) -> Option<Vec<Vec<IndexBox>>> {
+    let leaves = visibility.leaf_boxes()?;
+    let mut out: Vec<Vec<IndexBox>> = vec![Vec::new(); scene.surfaces.len()];
+    for (t, leaf) in visibility.triangles().iter().zip(leaves) {
+        let boxes = &mut out[t.surface];
+        if !boxes.contains(leaf) {
+            boxes.push(*leaf);
+        }
+    }
+    Some(out)
 }
 
 /// Surfaces other than `e` and `r` with a triangle in the shaft between two boxes for which

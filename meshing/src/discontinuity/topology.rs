@@ -147,28 +147,53 @@ impl Topology {
         n: DVec3,
         include: impl Fn(SurfaceId) -> bool,
     ) -> bool {
-        let Some(faces) = self.edges.get(&(a.min(b), a.max(b))) else {
-            return true;
-        };
-        let (pa, pb) = (self.points[a.min(b)], self.points[a.max(b)]);
         let mut seen = 0i8;
-        for &(surface, forward) in faces {
-            if !include(surface) {
-                continue;
-            }
-            // Into the face from its edge: left of the edge as the face runs it.
-            let along = if forward { pb - pa } else { pa - pb };
-            let inward = self.normals[surface].cross(along);
-            let s = self.side(
-                n,
-                DVec3::ZERO,
-                inward.normalize_or_zero() * (pa - pb).length(),
-            );
-            if !keeps_side(&mut seen, s) {
-                return false;
-            }
-        }
-        true
+        self.edge_face_vectors(a, b, include)
+            .all(|inward| keeps_side(&mut seen, self.side(n, DVec3::ZERO, inward)))
+    }
+
+    /// The faces along the edge `(a, b)` for which `include` holds, each as the vector from the
+    /// edge into the face, at right angles to the edge and as long as it: what
+    /// [`Self::faces_are_tangent`] compares with a plane through the edge.
+    pub fn edge_faces(
+        &self,
+        a: usize,
+        b: usize,
+        include: impl Fn(SurfaceId) -> bool,
+    ) -> Vec<DVec3> {
+        self.edge_face_vectors(a, b, include).collect()
+    }
+
+    /// [`Self::edge_faces`], one at a time.
+    fn edge_face_vectors(
+        &self,
+        a: usize,
+        b: usize,
+        include: impl Fn(SurfaceId) -> bool,
+    ) -> impl Iterator<Item = DVec3> {
+        let faces = self
+            .edges
+            .get(&(a.min(b), a.max(b)))
+            .map_or(&[][..], Vec::as_slice);
+        let (pa, pb) = (self.points[a.min(b)], self.points[a.max(b)]);
+        faces
+            .iter()
+            .filter(move |&&(surface, _)| include(surface))
+            .map(move |&(surface, forward)| {
+                // Into the face from its edge: left of the edge as the face runs it.
+                let along = if forward { pb - pa } else { pa - pb };
+                let inward = self.normals[surface].cross(along);
+                inward.normalize_or_zero() * (pa - pb).length()
+            })
+    }
+
+    /// Whether the faces of an edge ([`Self::edge_faces`]) lie on one side of the plane through
+    /// the edge with unit normal `n`.
+    pub fn faces_are_tangent(&self, faces: &[DVec3], n: DVec3) -> bool {
+        let mut seen = 0i8;
+        faces
+            .iter()
+            .all(|&inward| keeps_side(&mut seen, self.side(n, DVec3::ZERO, inward)))
     }
 
     /// Whether the plane through vertex `v` with unit normal `n` contains one of the edges of the
