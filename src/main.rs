@@ -943,10 +943,15 @@ fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
         }
         Err(e) => return Err(run_failure(e, BudgetOptions::Run)),
     };
-    if !args.quiet
-        && let Some(w) = penumbra::energy::EnergyBalance::of(&result.solution.stats).warning()
-    {
-        eprintln!("warning: {w}");
+    if !args.quiet {
+        let stats = &result.solution.stats;
+        let energy = penumbra::energy::EnergyBalance::of(stats).warning();
+        for w in energy
+            .into_iter()
+            .chain(penumbra::outputs::estimated_direct_warning(stats))
+        {
+            eprintln!("warning: {w}");
+        }
     }
     if let Some(shard) = shard {
         let origin = penumbra::shard::SceneOrigin {

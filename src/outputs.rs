@@ -197,6 +197,17 @@ struct RenderSummary {
     ambient: Rgb,
 }
 
+/// What to say when the deadline came before the exact direct light was done.
+pub fn estimated_direct_warning(stats: &SolveStats) -> Option<String> {
+    (stats.direct_estimated > 0).then(|| {
+        format!(
+            "the time budget ran out during the exact direct light: {} of {} vertices were \
+             estimated with rays instead (solver.direct_estimated)",
+            stats.direct_estimated, stats.receivers
+        )
+    })
+}
+
 /// `report.json`, for a run whose SVGs are chosen by `svgs`.
 pub fn report_json(result: &RunResult, svgs: &SvgSelection) -> String {
     let scene = &result.loaded.scene;
@@ -205,6 +216,7 @@ pub fn report_json(result: &RunResult, svgs: &SvgSelection) -> String {
     let energy = EnergyBalance::of(stats);
     let mut warnings = result.loaded.warnings.clone();
     warnings.extend(energy.warning());
+    warnings.extend(estimated_direct_warning(stats));
     let report = Report {
         format: REPORT_FORMAT,
         partial: matches!(stats.stop, StopReason::Interrupted | StopReason::TimeBudget)

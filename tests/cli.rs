@@ -1142,8 +1142,9 @@ fn obj_reflectance_of_one_is_clamped_with_a_warning() {
 }
 
 /// A time budget spent before the discontinuity search starts its first pair leaves the mesh
-/// without events: the run still completes, its light is exact at the vertices, and
-/// `report.json` says the result is partial and how many pairs were skipped.
+/// without events, and the direct light estimated by rays at every vertex: the run still
+/// completes, and `report.json` says the result is partial, how many pairs were skipped and how
+/// many vertices were estimated, with a warning.
 #[test]
 fn a_budget_spent_in_the_discontinuity_search_makes_the_run_partial() {
     let dir = tempfile::tempdir().expect("temp dir");
@@ -1160,4 +1161,16 @@ fn a_budget_spent_in_the_discontinuity_search_makes_the_run_partial() {
     assert_eq!(d["pairs_skipped"], d["pairs"]);
     assert_eq!(d["segments"], 0);
     assert!(check_radiosity(&json(&out.join("solution.json"))) > 0);
+    let solver = &report["solver"];
+    assert_eq!(solver["stop"], "time_budget");
+    assert_eq!(solver["direct_estimated"], solver["receivers"]);
+    let warned = report["warnings"]
+        .as_array()
+        .expect("warnings")
+        .iter()
+        .any(|w| {
+            w.as_str()
+                .is_some_and(|w| w.contains("estimated with rays"))
+        });
+    assert!(warned, "{}", report["warnings"]);
 }

@@ -348,6 +348,8 @@ pub fn solve_gathering(
         escaped: emitted + sent - received,
         unshot_fraction: unshot.mean().abs() / emitted.mean().max(f64::MIN_POSITIVE),
         direct_seconds: system.direct_seconds,
+        // The gathering solvers compute the direct light exactly whatever the clock says.
+        direct_estimated: 0,
         // Everything after the direct light: the form factors, K and the sweeps.
         shooting_seconds: started.elapsed().as_secs_f64() - system.direct_seconds,
         remeshes: 0,

@@ -151,6 +151,9 @@ pub struct SolveStats {
     /// after a remesh a patch may owe negative power).
     pub unshot_fraction: f64,
     pub direct_seconds: f64,
+    /// Vertices whose direct light was estimated by rays, not computed exactly, because the
+    /// deadline came first.
+    pub direct_estimated: usize,
     pub shooting_seconds: f64,
     /// Iterations of the solver (shots for progressive refinement, sweeps for gathering) and
     /// its final residual relative to the light put in: the unshot fraction for progressive
@@ -211,23 +214,41 @@ pub fn direct_irradiance_on(
     progress: &dyn Progress,
 ) -> Result<Vec<Rgb>, SolveError> {
     let direct = DirectLight::new(scene, visibility);
+    let limits = Limits {
+        interrupt: options.interrupt.as_ref(),
+        deadline: None,
+        rays: options.visibility_rays,
+    };
+    Ok(direct_on(&direct, disc, on, &limits, progress)?.0)
+}
+
+/// The direct irradiance at the vertices of the surfaces `on` marks (all when `None`; the others
+/// get zero), and how many vertices were estimated by rays because the deadline came first.
+fn direct_on(
+    direct: &DirectLight,
+    disc: &Discretization,
+    on: Option<&[bool]>,
+    limits: &Limits,
+    progress: &dyn Progress,
+) -> Result<(Vec<Rgb>, usize), SolveError> {
     let all: Vec<usize> = (0..disc.receiver_count()).collect();
     let wanted =
         |v: usize| on.is_none_or(|on| on.get(disc.receiver_surface[v]).copied().unwrap_or(false));
-    let mut values = direct_at(
-        &direct,
-        disc,
-        &all,
-        &wanted,
-        options.interrupt.as_ref(),
-        progress,
-    )?;
+    let (mut values, estimated) = direct_at(direct, disc, &all, &wanted, limits, progress)?;
     for (v, h) in values.iter_mut().enumerate() {
         if !wanted(v) {
             *h = Rgb::ZERO;
         }
     }
-    Ok(values)
+    Ok((values, estimated))
+}
+
+/// When the exact direct light must stop: at an interrupt (an error: no solution yet), or at a
+/// deadline, after which the vertices not done yet are estimated with `rays` rays per emitter.
+struct Limits<'o> {
+    interrupt: Option<&'o Interrupt>,
+    deadline: Option<Instant>,
+    rays: usize,
 }
 
 /// Receivers closer than this fraction of the scene's diagonal share one evaluation of what
@@ -245,9 +266,9 @@ fn direct_at(
     disc: &Discretization,
     receivers: &[usize],
     wanted: &(dyn Fn(usize) -> bool + Sync),
-    interrupt: Option<&Interrupt>,
+    limits: &Limits,
     progress: &dyn Progress,
-) -> Result<Vec<Rgb>, SolveError> {
+) -> Result<(Vec<Rgb>, usize), SolveError> {
     // Groups in order of first appearance, so the work and its result do not depend on hashing.
     let mut groups: Vec<Vec<usize>> = Vec::new();
     let mut at_point: HashMap<[i64; 3], usize> = HashMap::new();
@@ -272,23 +293,38 @@ fn direct_at(
         .collect();
     let mut kept = evaluated.iter();
     groups.retain(|_| kept.next().copied().unwrap_or(false));
-    let per_group = par_map_with_progress(&groups, "direct light", interrupt, progress, |g| {
-        let members: Vec<(ReceivingPoint, SurfaceId)> = g
-            .iter()
+    let members = |g: &[usize]| -> Vec<(ReceivingPoint, SurfaceId)> {
+        g.iter()
             .map(|&i| {
                 let v = receivers[i];
                 (disc.receivers[v], disc.receiver_surface[v])
             })
-            .collect();
-        direct.irradiance_group(&members)
+            .collect()
+    };
+    let late = || limits.deadline.is_some_and(|d| Instant::now() >= d);
+    let exact = par_map_with_progress(&groups, "direct light", limits.interrupt, progress, |g| {
+        (!late()).then(|| direct.irradiance_group(&members(g)))
     })?;
+    // Past the deadline, what is left is estimated (quickly, and whatever the clock says, so
+    // every vertex has a value).
+    let left: Vec<usize> = (0..groups.len()).filter(|&g| exact[g].is_none()).collect();
+    let estimates =
+        par_map_with_progress(&left, "direct light, estimated", None, progress, |&g| {
+            members(&groups[g])
+                .iter()
+                .map(|(x, r)| direct.irradiance_sampled(x, *r, limits.rays))
+                .collect::<Vec<Rgb>>()
+        })?;
+    let estimated = left.iter().map(|&g| groups[g].len()).sum();
+    let mut estimates = estimates.into_iter();
     let mut out = vec![Rgb::ZERO; receivers.len()];
-    for (g, values) in groups.iter().zip(per_group) {
+    for (g, exact) in groups.iter().zip(exact) {
+        let values = exact.or_else(|| estimates.next()).unwrap_or_default();
         for (&i, h) in g.iter().zip(values) {
             out[i] = h;
         }
     }
-    Ok(out)
+    Ok((out, estimated))
 }
 
 /// `f` at each of `receivers`, in parallel, with a progress bar; stops early, with
@@ -387,6 +423,8 @@ pub struct ProgressiveSolver<'a> {
     scene: &'a Scene,
     visibility: &'a Visibility,
     direct: DirectLight<'a>,
+    /// Vertices whose direct light was estimated at the deadline ([`SolveStats::direct_estimated`]).
+    direct_estimated: usize,
     options: SolverOptions,
     /// The surface meshes the state below belongs to.
     meshes: Vec<SurfaceMesh>,
@@ -440,8 +478,14 @@ impl<'a> ProgressiveSolver<'a> {
         check_mesh(scene, mesh)?;
         let disc = Discretization::new(scene, mesh, options.elements_per_patch);
         let started = Instant::now();
-        let direct_irradiance =
-            direct_irradiance_on(scene, &disc, visibility, options, on, progress)?;
+        let direct = DirectLight::new(scene, visibility);
+        let limits = Limits {
+            interrupt: options.interrupt.as_ref(),
+            deadline: options.deadline,
+            rays: options.visibility_rays,
+        };
+        let (direct_irradiance, direct_estimated) =
+            direct_on(&direct, &disc, on, &limits, progress)?;
         let direct_seconds = started.elapsed().as_secs_f64();
         let received = disc.integrate(&direct_irradiance, |_| Rgb::splat(1.0));
         // Methods that give whole rows compute every form factor up front.
@@ -457,7 +501,8 @@ impl<'a> ProgressiveSolver<'a> {
         Ok(ProgressiveSolver {
             scene,
             visibility,
-            direct: DirectLight::new(scene, visibility),
+            direct,
+            direct_estimated,
             options: options.clone(),
             meshes: mesh.surfaces.clone(),
             element_shot: vec![Rgb::ZERO; disc.elements.len()],
@@ -470,7 +515,9 @@ impl<'a> ProgressiveSolver<'a> {
             columns,
             shot_power: Rgb::ZERO,
             escaped: scene.emitted_power() - received,
-            stop: if options.direct_only {
+            stop: if direct_estimated > 0 {
+                StopReason::TimeBudget
+            } else if options.direct_only {
                 StopReason::DirectOnly
             } else {
                 StopReason::ShotLimit
@@ -744,7 +791,12 @@ impl<'a> ProgressiveSolver<'a> {
         let t = Instant::now();
         // Remeshing runs to its end: the refinement loop checks for interrupts between rounds,
         // and stopping here would lose the solution it has.
-        let new_direct = direct_at(&self.direct, &disc, &fresh, &|_| true, None, progress)?;
+        let limits = Limits {
+            interrupt: None,
+            deadline: None,
+            rays: self.options.visibility_rays,
+        };
+        let (new_direct, _) = direct_at(&self.direct, &disc, &fresh, &|_| true, &limits, progress)?;
         self.direct_seconds += t.elapsed().as_secs_f64();
         let t = Instant::now();
         let rays = std::sync::atomic::AtomicU64::new(0);
@@ -858,6 +910,7 @@ impl<'a> ProgressiveSolver<'a> {
             iterations: self.shots,
             residual,
             direct_seconds: self.direct_seconds,
+            direct_estimated: self.direct_estimated,
             shooting_seconds: self.shooting_seconds,
             remeshes: self.remeshes,
             gathered: self.gathered,
