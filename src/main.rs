@@ -21,7 +21,7 @@ use penumbra_solver::{Interrupt, SolverOptions};
 
 // The help texts below give these figures in words.
 const _: () = assert!(
-    DEFAULT_MAX_ELEMENTS == 10_000 && FIT_TRIANGLES_PER_SURFACE == 4 && DEFAULT_SVG_SURFACES == 24
+    DEFAULT_MAX_ELEMENTS == 10_000 && FIT_TRIANGLES_PER_SURFACE == 1 && DEFAULT_SVG_SURFACES == 24
 );
 
 #[derive(Parser, Debug)]
@@ -129,7 +129,7 @@ struct RunArgs {
     mesh: Option<MeshArg>,
     /// Cap on triangles for the whole scene, spread over the surfaces by area. Default: what the
     /// scene needs: 10,000, or, when that is too few, the least mesh of its polygons with their
-    /// discontinuities as edges and 4 triangles more per surface.
+    /// discontinuities as edges and 1 triangle more per surface.
     #[arg(long)]
     max_elements: Option<usize>,
     /// Discontinuity meshes: how many times smaller in area triangles are in partial shadow than
