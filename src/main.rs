@@ -176,8 +176,9 @@ struct RunArgs {
     /// convergence-iterations.svg/.png and convergence-time.svg/.png.
     #[arg(long)]
     convergence: bool,
-    /// Stop adaptive refinement and shooting after this many seconds (from the start of the run)
-    /// and write the best solution so far; report.json says so.
+    /// Stop after this many seconds (from the start of the run) and write the best solution so
+    /// far; report.json says so. The discontinuity search skips the pairs left, the direct light
+    /// estimates the vertices left by rays, and refinement and shooting stop.
     #[arg(long)]
     time_budget: Option<f64>,
     /// Discontinuity meshes: leave out EEE events (emitter edge with two blocker edges).
