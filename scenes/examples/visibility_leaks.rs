@@ -5,6 +5,7 @@
 //! `cargo run --release -p penumbra-scenes --example visibility_leaks SCENE [SEGMENTS] [RAYS]`
 //! (SEGMENTS of each kind, 20,000 by default; RAYS 2,000)
 use std::error::Error;
+use std::io::Write;
 use std::time::Instant;
 
 use penumbra_scenes::rng::SplitMix64;
@@ -18,16 +19,18 @@ fn main() -> Result<(), Box<dyn Error>> {
         .ok_or("usage: visibility_leaks SCENE [SEGMENTS] [RAYS]")?;
     let segments: usize = args.get(2).map_or(Ok(20_000), |s| s.parse())?;
     let rays: usize = args.get(3).map_or(Ok(2_000), |s| s.parse())?;
+    let mut out = std::io::stdout().lock();
     let scene = load_scene(spec)?.scene;
     let diagonal = scene.bounds().diagonal();
     let start = Instant::now();
     let visibility = Visibility::build(&scene);
-    println!(
+    writeln!(
+        out,
         "{}: {} triangles, diagonal {diagonal}, index built in {:.2} s",
         spec,
         visibility.triangles().len(),
         start.elapsed().as_secs_f64()
-    );
+    )?;
     let mut rng = SplitMix64::new(1);
     let mut total_leaks = 0;
     for kind in ProbeKind::ALL {
@@ -45,15 +48,16 @@ fn main() -> Result<(), Box<dyn Error>> {
                 leaks += 1;
                 blocked += 1;
                 if leaks <= 3 {
-                    println!("  leak: {segment:?}");
+                    writeln!(out, "  leak: {segment:?}")?;
                 }
             }
         }
         total_leaks += leaks;
-        println!(
+        writeln!(
+            out,
             "{kind:?}: {segments} segments, {blocked} blocked, {leaks} leaks ({:.1} s)",
             start.elapsed().as_secs_f64()
-        );
+        )?;
     }
     let start = Instant::now();
     let mut hit_mismatches = 0;
@@ -65,14 +69,15 @@ fn main() -> Result<(), Box<dyn Error>> {
         if closest_hit_mismatch(&visibility, &segment) {
             hit_mismatches += 1;
             if hit_mismatches <= 3 {
-                println!("  closest hit differs: {segment:?}");
+                writeln!(out, "  closest hit differs: {segment:?}")?;
             }
         }
     }
-    println!(
+    writeln!(
+        out,
         "closest hit: {rays} rays, {hit_mismatches} differ ({:.1} s)",
         start.elapsed().as_secs_f64()
-    );
-    println!("leaks in all: {total_leaks}");
+    )?;
+    writeln!(out, "leaks in all: {total_leaks}")?;
     Ok(())
 }

@@ -398,10 +398,10 @@ impl Visibility {
         }
         let mut best: Option<(f64, usize)> = None;
         for index in 0..self.triangles.len() {
-            if let Some(t) = self.hit_parameter(index, origin, direction, t_min, t_max, ignore) {
-                if best.is_none_or(|(bt, _)| t < bt) {
-                    best = Some((t, index));
-                }
+            if let Some(t) = self.hit_parameter(index, origin, direction, t_min, t_max, ignore)
+                && best.is_none_or(|(bt, _)| t < bt)
+            {
+                best = Some((t, index));
             }
         }
         best.map(|(t, triangle)| self.hit(origin, direction, t, triangle))

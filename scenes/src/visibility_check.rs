@@ -102,7 +102,7 @@ pub fn sample_segment(
         }
         ProbeKind::BetweenEdges => (on_edge(rng, &a.vertices), on_edge(rng, &b.vertices)),
     };
-    let (from, to) = if rng.next_u64() % 2 == 0 {
+    let (from, to) = if rng.next_u64().is_multiple_of(2) {
         (from, to)
     } else {
         (to, from)
