@@ -1,10 +1,17 @@
 //! Visibility: a BVH over every surface, triangulated, answering segment and ray queries in f64.
 //!
-//! `obvhs` stores f32 boxes. Coordinates are re-centred on the scene before rounding, every box is
-//! padded outward by more than the rounding of box and ray, and every candidate triangle is then
-//! tested in f64 with the watertight ray–triangle test of Woop, Benthin & Wald (2013): a ray
-//! through an edge shared by two triangles hits at least one of them, so light does not leak
-//! through the seams of closed geometry.
+//! `obvhs` stores f32 boxes. Coordinates are re-centred on the scene and scaled to a unit
+//! diagonal before rounding, every box is padded by [`BOX_PADDING`] (more than the rounding of
+//! the rays tested against it) and rounded outward, and every candidate triangle is then tested
+//! in f64 with the watertight ray–triangle test of Woop, Benthin & Wald (2013): a ray through an
+//! edge shared by two triangles hits at least one of them, so light does not leak through the
+//! seams of closed geometry.
+//!
+//! The f32 walk may offer too many triangles, never too few: a query is clipped to the scene's
+//! box, then walked with an f32 ray that starts [`RAY_LEAD`] before it (obvhs does not enter boxes
+//! that a ray leaves within [`TRAVERSAL_BOX_START`] of its origin) and has no negative zeros in
+//! its direction. [`Visibility::occluded_exhaustive`] and [`Visibility::closest_hit_exhaustive`]
+//! decide the same queries over every triangle; [`crate::visibility_check`] compares the two.
 
 use std::time::Duration;
 
@@ -36,14 +43,14 @@ pub const JUNCTION_OFFSET: f64 = 1e-7;
 /// scene, and obvhs's slab test rounds three terms under 2 in size: together under 5e-7. The
 /// slab test also replaces direction components under `f32::EPSILON` by `f32::EPSILON`, which
 /// moves the ray by under 1.2e-7 over that length. Boxes themselves are rounded outward.
-const BOX_PADDING: f64 = 1e-6;
+pub const BOX_PADDING: f64 = 1e-6;
 /// The ray parameter at which obvhs starts every box of its ray traversal (`cwbvh::node::EPSILON`,
 /// in f32-world units: scene diagonals). Its slab test ignores the ray's own `tmin`, so a box that
 /// the ray leaves before this parameter is never entered.
-const TRAVERSAL_BOX_START: f64 = 1e-4;
+pub const TRAVERSAL_BOX_START: f64 = 1e-4;
 /// How far before the start of a query the f32 ray starts, in scene diagonals: everything the
 /// query can meet then lies past [`TRAVERSAL_BOX_START`] along the f32 ray, with room to spare.
-const RAY_LEAD: f64 = 2.0 * TRAVERSAL_BOX_START;
+pub const RAY_LEAD: f64 = 2.0 * TRAVERSAL_BOX_START;
 
 /// One triangle of a scene surface, with the surface's own (unrounded) vertices.
 #[derive(Clone, Copy, Debug, PartialEq)]
