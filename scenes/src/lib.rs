@@ -33,6 +33,7 @@ pub mod tessellated;
 pub mod union_find;
 pub mod validate;
 pub mod visibility;
+pub mod visibility_check;
 
 pub use color::Rgb;
 pub use error::SceneError;

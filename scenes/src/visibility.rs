@@ -1,10 +1,17 @@
 //! Visibility: a BVH over every surface, triangulated, answering segment and ray queries in f64.
 //!
-//! `obvhs` stores f32 boxes. Coordinates are re-centred on the scene before rounding, every box is
-//! padded outward by more than the rounding of box and ray, and every candidate triangle is then
-//! tested in f64 with the watertight ray–triangle test of Woop, Benthin & Wald (2013): a ray
-//! through an edge shared by two triangles hits at least one of them, so light does not leak
-//! through the seams of closed geometry.
+//! `obvhs` stores f32 boxes. Coordinates are re-centred on the scene and scaled to a unit
+//! diagonal before rounding, every box is padded by [`BOX_PADDING`] (more than the rounding of
+//! the rays tested against it) and rounded outward, and every candidate triangle is then tested
+//! in f64 with the watertight ray–triangle test of Woop, Benthin & Wald (2013): a ray through an
+//! edge shared by two triangles hits at least one of them, so light does not leak through the
+//! seams of closed geometry.
+//!
+//! The f32 walk may offer too many triangles, never too few: a query is clipped to the scene's
+//! box, then walked with an f32 ray that starts [`RAY_LEAD`] before it (obvhs does not enter boxes
+//! that a ray leaves within [`TRAVERSAL_BOX_START`] of its origin) and has no negative zeros in
+//! its direction. [`Visibility::occluded_exhaustive`] and [`Visibility::closest_hit_exhaustive`]
+//! decide the same queries over every triangle; [`crate::visibility_check`] compares the two.
 
 use std::time::Duration;
 
@@ -28,8 +35,22 @@ pub const CONTACT_TOLERANCE: f64 = 1e-9;
 /// scene diagonal: a ray that leaves a vertex on the edge where a wall meets a floor must pass
 /// above the floor, not through its plane, or its fate is decided by rounding.
 pub const JUNCTION_OFFSET: f64 = 1e-7;
-/// Outward padding of the f32 boxes, relative to the scene diagonal (f32 rounding is ~6e-8).
-const BOX_PADDING: f64 = 1e-6;
+/// Outward padding of the f32 boxes, relative to the scene diagonal.
+///
+/// It covers the distance between the f32 ray the index walks and the exact segment: the ray
+/// starts inside the scene's box (within 2^-24 of its exact start), its unit direction is
+/// rounded by 2^-24 per component, it is at most about one diagonal long once clipped to the
+/// scene, and obvhs's slab test rounds three terms under 2 in size: together under 5e-7. The
+/// slab test also replaces direction components under `f32::EPSILON` by `f32::EPSILON`, which
+/// moves the ray by under 1.2e-7 over that length. Boxes themselves are rounded outward.
+pub const BOX_PADDING: f64 = 1e-6;
+/// The ray parameter at which obvhs starts every box of its ray traversal (`cwbvh::node::EPSILON`,
+/// in f32-world units: scene diagonals). Its slab test ignores the ray's own `tmin`, so a box that
+/// the ray leaves before this parameter is never entered.
+pub const TRAVERSAL_BOX_START: f64 = 1e-4;
+/// How far before the start of a query the f32 ray starts, in scene diagonals: everything the
+/// query can meet then lies past [`TRAVERSAL_BOX_START`] along the f32 ray, with room to spare.
+pub const RAY_LEAD: f64 = 2.0 * TRAVERSAL_BOX_START;
 
 /// One triangle of a scene surface, with the surface's own (unrounded) vertices.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -51,6 +72,35 @@ pub struct Hit {
 #[derive(Clone, Copy)]
 struct PaddedBox(Aabb);
 
+/// A segment query of [`Visibility::occluded`]: hits at `from + t * d` with `t` in
+/// `(t_min, t_max)` block it.
+struct Segment {
+    from: DVec3,
+    to: DVec3,
+    d: DVec3,
+    t_min: f64,
+    t_max: f64,
+    ignore: [SurfaceId; 2],
+}
+
+/// A query ray in the f32 world of the index, starting [`RAY_LEAD`] before the part of the
+/// caller's ray that lies in the scene's box.
+struct IndexRay {
+    ray: Ray,
+    /// The caller's parameter at which that part starts.
+    t_start: f64,
+    /// f32-ray parameter per unit of the caller's parameter.
+    scale: f64,
+}
+
+impl IndexRay {
+    /// The f32-ray parameter of the caller's `t`, rounded up: the traversal enters every box
+    /// that holds the point at `t` before it.
+    fn parameter_rounded_up(&self, t: f64) -> f32 {
+        round_up(RAY_LEAD + (t - self.t_start) * self.scale)
+    }
+}
+
 impl Boundable for PaddedBox {
     fn aabb(&self) -> Aabb {
         self.0
@@ -69,6 +119,8 @@ pub struct Visibility {
     /// For each triangle, the box of the leaf of `boxes` that holds it, when every node's box
     /// holds its children's (then a leaf is visited exactly when its own box overlaps a query).
     leaf_boxes: Option<Vec<IndexBox>>,
+    /// The box of every triangle, padded by [`BOX_PADDING`]: rays are clipped to it.
+    extent: Bounds,
     center: DVec3,
     /// Scene units per f32-world unit (the scene diagonal).
     unit: f64,
@@ -109,6 +161,10 @@ impl Visibility {
     }
 
     pub fn from_triangles(triangles: Vec<SceneTriangle>, bounds: Bounds) -> Visibility {
+        let extent = triangles.iter().fold(Bounds::EMPTY, |b, t| {
+            b.union(Bounds::from_points(&t.vertices))
+        });
+        let bounds = bounds.union(extent);
         let center = if bounds.is_empty() {
             DVec3::ZERO
         } else {
@@ -164,6 +220,10 @@ impl Visibility {
             rays,
             boxes: box_bvh,
             leaf_boxes,
+            extent: Bounds {
+                min: extent.min - DVec3::splat(padding * unit),
+                max: extent.max + DVec3::splat(padding * unit),
+            },
             center,
             unit,
             padding,
@@ -185,23 +245,46 @@ impl Visibility {
         self.contact * (JUNCTION_OFFSET / CONTACT_TOLERANCE)
     }
 
-    /// The ray in the f32 world, with a unit direction, and the factor that turns the caller's
-    /// ray parameter into the f32 ray's.
-    fn f32_ray(&self, origin: DVec3, direction: DVec3, t_max: f64) -> (Ray, f64) {
+    /// The part of the ray `origin + t * direction`, `t` in `[t_min, t_max]`, that lies in the
+    /// (padded) box of the scene's triangles, as an f32 ray with a unit direction that starts
+    /// [`RAY_LEAD`] before it; `None` when that part is empty.
+    fn f32_ray(&self, origin: DVec3, direction: DVec3, t_min: f64, t_max: f64) -> Option<IndexRay> {
+        let (mut start, mut end) = (t_min, t_max);
+        for axis in 0..3 {
+            let (o, d) = (origin[axis], direction[axis]);
+            let (lo, hi) = (self.extent.min[axis], self.extent.max[axis]);
+            if d == 0.0 {
+                if o < lo || o > hi {
+                    return None;
+                }
+                continue;
+            }
+            let (a, b) = ((lo - o) / d, (hi - o) / d);
+            start = start.max(a.min(b));
+            end = end.min(a.max(b));
+        }
+        if !(start <= end) {
+            return None;
+        }
         let length = direction.length();
+        let unit_direction = direction / length;
         let scale = length / self.unit;
-        // The f32 ray only prunes boxes; generous parameter slack keeps that conservative.
+        let ray_origin =
+            (origin + direction * start - self.center) / self.unit - unit_direction * RAY_LEAD;
+        // obvhs picks a slab's near side by `direction < 0` but inverts a zero by its sign bit,
+        // so a component of -0.0 (or one that rounds to it) would turn the slab inside out and
+        // the ray would miss every box: zeros are made positive.
         let ray = Ray::new(
-            to_vec3a((origin - self.center) / self.unit),
-            to_vec3a(direction / length),
-            -1e-5,
-            if t_max.is_finite() {
-                (t_max * scale * (1.0 + 1e-5)) as f32 + 1e-5
-            } else {
-                f32::INFINITY
-            },
+            to_vec3a(ray_origin),
+            to_vec3a(unit_direction) + Vec3A::ZERO,
+            0.0,
+            round_up(RAY_LEAD + (end - start) * scale),
         );
-        (ray, scale)
+        Some(IndexRay {
+            ray,
+            t_start: start,
+            scale,
+        })
     }
 
     /// Whether something other than the `ignore`d surfaces blocks the open segment `from -> to`.
@@ -214,32 +297,65 @@ impl Visibility {
         let Some(bvh) = &self.rays else {
             return false;
         };
+        let Some(segment) = self.segment(from, to, ignore) else {
+            return false;
+        };
+        let Some(ray) = self.f32_ray(from, segment.d, segment.t_min, segment.t_max) else {
+            return false;
+        };
+        !bvh.ray_traverse_miss(ray.ray, |_, id| {
+            if self.blocks(bvh.primitive_indices[id] as usize, &segment) {
+                0.0
+            } else {
+                f32::INFINITY
+            }
+        })
+    }
+
+    /// [`Self::occluded`] decided without the index, by testing every triangle: the reference
+    /// the index is checked against (slow: for tests and measurements).
+    pub fn occluded_exhaustive(&self, from: DVec3, to: DVec3, ignore: [SurfaceId; 2]) -> bool {
+        let Some(segment) = self.segment(from, to, ignore) else {
+            return false;
+        };
+        (0..self.triangles.len()).any(|index| self.blocks(index, &segment))
+    }
+
+    /// The segment `from -> to` as [`Self::occluded`] tests it; `None` when nothing can block it.
+    fn segment(&self, from: DVec3, to: DVec3, ignore: [SurfaceId; 2]) -> Option<Segment> {
         let d = to - from;
         let length = d.length();
         if !(length > 2.0 * self.contact) || !d.is_finite() || !from.is_finite() {
-            return false;
+            return None;
         }
         let margin = self.contact / length;
-        let (t_min, t_max) = (margin, 1.0 - margin);
-        let (ray, _) = self.f32_ray(from, d, 1.0);
-        !bvh.ray_traverse_miss(ray, |_, id| {
-            let index = bvh.primitive_indices[id] as usize;
-            let tri = &self.triangles[index];
-            if tri.surface == ignore[0] || tri.surface == ignore[1] {
-                return f32::INFINITY;
-            }
-            let n = self.normals[index];
-            let anchor = tri.vertices[0];
-            if n.dot(from - anchor).abs() <= self.contact
-                && n.dot(to - anchor).abs() <= self.contact
-            {
-                return f32::INFINITY;
-            }
-            match intersect_watertight(from, d, &tri.vertices) {
-                Some(t) if t > t_min && t < t_max => 0.0,
-                _ => f32::INFINITY,
-            }
+        Some(Segment {
+            from,
+            to,
+            d,
+            t_min: margin,
+            t_max: 1.0 - margin,
+            ignore,
         })
+    }
+
+    /// Whether triangle `index` blocks `segment`: the exact f64 decision of [`Self::occluded`].
+    fn blocks(&self, index: usize, segment: &Segment) -> bool {
+        let tri = &self.triangles[index];
+        if segment.ignore.contains(&tri.surface) {
+            return false;
+        }
+        let n = self.normals[index];
+        let anchor = tri.vertices[0];
+        if n.dot(segment.from - anchor).abs() <= self.contact
+            && n.dot(segment.to - anchor).abs() <= self.contact
+        {
+            return false;
+        }
+        matches!(
+            intersect_watertight(segment.from, segment.d, &tri.vertices),
+            Some(t) if t > segment.t_min && t < segment.t_max
+        )
     }
 
     /// The closest hit along `origin + t * direction` for `t` in `(t_min, t_max)`, skipping `ignore`.
@@ -255,32 +371,73 @@ impl Visibility {
         if !origin.is_finite() || !direction.is_finite() || direction == DVec3::ZERO {
             return None;
         }
-        let (ray, scale) = self.f32_ray(origin, direction, t_max);
+        let ray = self.f32_ray(origin, direction, t_min, t_max)?;
         let mut best: Option<(f64, usize)> = None;
         let mut hit = RayHit::none();
-        bvh.ray_traverse(ray, &mut hit, |_, id| {
+        bvh.ray_traverse(ray.ray, &mut hit, |_, id| {
             let index = bvh.primitive_indices[id] as usize;
-            let tri = &self.triangles[index];
-            if Some(tri.surface) == ignore {
-                return f32::INFINITY;
-            }
-            match intersect_watertight(origin, direction, &tri.vertices) {
-                Some(t) if t > t_min && t < t_max => {
+            match self.hit_parameter(index, origin, direction, t_min, t_max, ignore) {
+                Some(t) => {
                     if best.is_none_or(|(bt, _)| t < bt) {
                         best = Some((t, index));
                     }
-                    // Round up so that the f32 traversal never prunes a closer f64 hit.
-                    ((t * scale * (1.0 + 1e-6)) as f32).max(f32::MIN_POSITIVE) + 1e-6
+                    // Boxes that hold a closer hit are entered before this parameter.
+                    ray.parameter_rounded_up(t)
                 }
-                _ => f32::INFINITY,
+                None => f32::INFINITY,
             }
         });
-        best.map(|(t, triangle)| Hit {
+        best.map(|(t, triangle)| self.hit(origin, direction, t, triangle))
+    }
+
+    /// [`Self::closest_hit`] found without the index, by testing every triangle (the first of
+    /// equally close ones): the reference the index is checked against.
+    pub fn closest_hit_exhaustive(
+        &self,
+        origin: DVec3,
+        direction: DVec3,
+        t_min: f64,
+        t_max: f64,
+        ignore: Option<SurfaceId>,
+    ) -> Option<Hit> {
+        if !origin.is_finite() || !direction.is_finite() || direction == DVec3::ZERO {
+            return None;
+        }
+        let mut best: Option<(f64, usize)> = None;
+        for index in 0..self.triangles.len() {
+            if let Some(t) = self.hit_parameter(index, origin, direction, t_min, t_max, ignore)
+                && best.is_none_or(|(bt, _)| t < bt)
+            {
+                best = Some((t, index));
+            }
+        }
+        best.map(|(t, triangle)| self.hit(origin, direction, t, triangle))
+    }
+
+    /// Where the ray meets triangle `index` within `(t_min, t_max)`, unless its surface is ignored.
+    fn hit_parameter(
+        &self,
+        index: usize,
+        origin: DVec3,
+        direction: DVec3,
+        t_min: f64,
+        t_max: f64,
+        ignore: Option<SurfaceId>,
+    ) -> Option<f64> {
+        let tri = &self.triangles[index];
+        if Some(tri.surface) == ignore {
+            return None;
+        }
+        intersect_watertight(origin, direction, &tri.vertices).filter(|&t| t > t_min && t < t_max)
+    }
+
+    fn hit(&self, origin: DVec3, direction: DVec3, t: f64, triangle: usize) -> Hit {
+        Hit {
             surface: self.triangles[triangle].surface,
             triangle,
             t,
             point: origin + direction * t,
-        })
+        }
     }
 
     /// Calls `visit` with the index of every triangle whose box overlaps `bounds` (and maybe a few
@@ -413,14 +570,24 @@ fn to_vec3a(v: DVec3) -> Vec3A {
 }
 
 fn to_f32_box(b: Bounds, center: DVec3, unit: f64, padding: f64) -> Aabb {
-    // Padding covers the f32 rounding of both the box and the rays tested against it.
-    let lo = (b.min - center) / unit;
-    let hi = (b.max - center) / unit;
-    let slack = padding + 2f64.powi(-22) * lo.abs().max(hi.abs()).max_element();
+    let lo = (b.min - center) / unit - DVec3::splat(padding);
+    let hi = (b.max - center) / unit + DVec3::splat(padding);
     Aabb::new(
-        to_vec3a(lo - DVec3::splat(slack)),
-        to_vec3a(hi + DVec3::splat(slack)),
+        Vec3A::new(round_down(lo.x), round_down(lo.y), round_down(lo.z)),
+        Vec3A::new(round_up(hi.x), round_up(hi.y), round_up(hi.z)),
     )
+}
+
+/// The least f32 not below `x`.
+fn round_up(x: f64) -> f32 {
+    let f = x as f32;
+    if f64::from(f) < x { f.next_up() } else { f }
+}
+
+/// The greatest f32 not above `x`.
+fn round_down(x: f64) -> f32 {
+    let f = x as f32;
+    if f64::from(f) > x { f.next_down() } else { f }
 }
 
 /// Watertight ray–triangle intersection (Woop, Benthin & Wald 2013) in f64; no back-face culling.
@@ -471,6 +638,7 @@ mod tests {
     use super::*;
     use crate::builtin;
     use crate::rng::SplitMix64;
+    use glam::DAffine3;
 
     #[test]
     fn closed_box_does_not_leak_through_shared_edges_and_corners() {
@@ -581,6 +749,163 @@ mod tests {
                 None => assert!(brute.is_infinite()),
             }
         }
+    }
+
+    /// Sibenik's leak: a segment that starts 1.3e-3 above a corner of a small triangle's box
+    /// and crosses the triangle 3.3e-3 further on, less than 1e-4 scene diagonals from its start,
+    /// where obvhs's traversal used to begin (it skips boxes that a ray leaves before that).
+    /// Re-run moved far from the origin and scaled.
+    #[test]
+    fn segment_crossing_a_triangle_next_to_its_start_is_blocked() {
+        for (offset, scale) in [
+            (DVec3::ZERO, 1.0),
+            (DVec3::new(3e6, -1e6, 2e5), 1.0),
+            (DVec3::new(-7e3, 2e4, 5e3), 1e-3),
+            (DVec3::new(1e9, 1e9, -1e9), 1e3),
+        ] {
+            let at = |x: f64, y: f64, z: f64| offset + DVec3::new(x, y, z) * scale;
+            let blocker = [
+                at(11.5884, -12.385, 0.929501),
+                at(11.6694, -12.385, 0.929501),
+                at(11.6716, -12.3975, 0.927251),
+            ];
+            let mut triangles = vec![SceneTriangle {
+                vertices: blocker,
+                surface: 1,
+            }];
+            // Copies of the blocker behind the segment's start, so that the blocker's node of
+            // the index is small, and so are the steps its children's boxes are quantized in.
+            for i in 1..4 {
+                for j in 1..4 {
+                    let shift = at(0.1 * i as f64, -0.1 * j as f64, 0.05) - at(0.0, 0.0, 0.0);
+                    triangles.push(SceneTriangle {
+                        vertices: blocker.map(|v| v + shift),
+                        surface: 2,
+                    });
+                }
+            }
+            // A floor 80 units across cut in 8 x 8 squares.
+            let corner =
+                |i: usize, j: usize| at(i as f64 * 10.0 - 40.0, j as f64 * 10.0 - 40.0, -2.0);
+            for i in 0..8 {
+                for j in 0..8 {
+                    let [a, b, c, d] = [
+                        corner(i, j),
+                        corner(i + 1, j),
+                        corner(i + 1, j + 1),
+                        corner(i, j + 1),
+                    ];
+                    for vertices in [[a, b, c], [a, c, d]] {
+                        triangles.push(SceneTriangle {
+                            vertices,
+                            surface: 0,
+                        });
+                    }
+                }
+            }
+            let bounds = Bounds::from_points(triangles.iter().flat_map(|t| &t.vertices));
+            let vis = Visibility::from_triangles(triangles, bounds);
+            let from = at(11.6716, -12.3975, 0.928586921875);
+            let to = at(4.6347, -5.0, -2.0);
+            let t = intersect_watertight(from, to - from, &blocker).expect("the segment crosses");
+            assert!(t > 3e-4 && t < 3.2e-4, "{t}");
+            assert!(vis.occluded_exhaustive(from, to, [0, usize::MAX]));
+            assert!(
+                vis.occluded(from, to, [0, usize::MAX]),
+                "{offset} x {scale}"
+            );
+            let hit = vis.closest_hit(from, to - from, 0.0, f64::INFINITY, None);
+            assert_eq!(hit.map(|h| h.surface), Some(1), "{offset} x {scale}");
+            assert_eq!(hit.map(|h| h.t), Some(t));
+        }
+    }
+
+    #[test]
+    fn rays_with_negative_zero_direction_components_are_traced() {
+        // -0.0 and components too small for f32 that round to it, in rays straight down.
+        let scene = builtin::cornell();
+        let vis = Visibility::build(&scene);
+        for tiny in [-0.0, -1e-50, 0.0, 1e-50] {
+            let origin = DVec3::new(300.0, 300.0, 270.0);
+            let direction = DVec3::new(tiny, -1.0, tiny);
+            let hit = vis.closest_hit(origin, direction, 0.0, f64::INFINITY, None);
+            let exhaustive =
+                vis.closest_hit_exhaustive(origin, direction, 0.0, f64::INFINITY, None);
+            assert!(exhaustive.is_some());
+            assert_eq!(hit.map(|h| h.t), exhaustive.map(|h| h.t), "{tiny:e}");
+            let below = origin + direction * 1e4;
+            assert!(vis.occluded(origin, below, [usize::MAX; 2]), "{tiny:e}");
+        }
+    }
+
+    /// Every kind of sampled segment, on `scene`: the index agrees with exhaustive search.
+    /// Returns how many sampled segments were blocked.
+    fn assert_index_matches_exhaustive_search(scene: &Scene, seed: u64, count: usize) -> usize {
+        use crate::visibility_check::{
+            ProbeKind, closest_hit_mismatch, occlusion_mismatch, sample_segment,
+        };
+        let vis = Visibility::build(scene);
+        let diagonal = scene.bounds().diagonal();
+        let mut rng = SplitMix64::new(seed);
+        let mut total_blocked = 0;
+        for kind in ProbeKind::ALL {
+            let (mut leaks, mut hits, mut blocked) = (Vec::new(), 0, 0);
+            for _ in 0..count {
+                let segment = sample_segment(&vis, kind, diagonal, &mut rng).expect("triangles");
+                blocked +=
+                    usize::from(vis.occluded_exhaustive(segment.from, segment.to, segment.ignore));
+                if occlusion_mismatch(&vis, &segment).is_some() {
+                    leaks.push(segment);
+                }
+                hits += usize::from(closest_hit_mismatch(&vis, &segment));
+            }
+            assert!(
+                leaks.is_empty(),
+                "{}: {} of {count} {kind:?} segments disagree, first {:?}",
+                scene.name,
+                leaks.len(),
+                leaks[0]
+            );
+            assert_eq!(hits, 0, "{}: {kind:?} closest hits disagree", scene.name);
+            total_blocked += blocked;
+        }
+        total_blocked
+    }
+
+    #[test]
+    fn index_matches_exhaustive_search_on_built_in_scenes() {
+        for (seed, name) in [
+            "cornell",
+            "furnace",
+            "bars",
+            "textbook",
+            "boxworld",
+            "tessellated",
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let scene = builtin::builtin(name).expect("a built-in scene");
+            let blocked = assert_index_matches_exhaustive_search(&scene, seed as u64, 1500);
+            // Not vacuous (even in the furnace, segments from beside its corners can be blocked).
+            assert!(blocked > 0, "{name}: nothing blocked");
+        }
+    }
+
+    #[test]
+    fn index_matches_exhaustive_search_far_from_the_origin() {
+        // A hundred boxes a few units across, 1e7 units from the origin, and the same scene
+        // shrunk to a millimetre across and moved 1e4 away.
+        let scene = builtin::boxworld(100, 5);
+        let far = DAffine3::from_translation(DVec3::new(1e7, -3e7, 2e6));
+        assert!(assert_index_matches_exhaustive_search(&scene.transformed(&far), 21, 1500) > 0);
+        let size = scene.bounds().diagonal();
+        let tiny = DAffine3::from_scale_rotation_translation(
+            DVec3::splat(1e-3 / size),
+            glam::DQuat::from_rotation_y(0.7),
+            DVec3::new(-1e4, 5e3, 1e4),
+        );
+        assert!(assert_index_matches_exhaustive_search(&scene.transformed(&tiny), 22, 1500) > 0);
     }
 
     #[test]
