@@ -24,6 +24,11 @@ use i_overlay::i_float::float::rect::FloatRect;
 
 use crate::clip::{area_2d, clip_to_convex};
 
+/// Shadows go into one overlay until they have this many edges; the next batch is subtracted
+/// from what the last left visible, so no overlay holds the many overlapping shadows of a large
+/// light seen through a building at once, and a piece covered early is done.
+const BATCH_EDGES: usize = 2048;
+
 /// A corner of an occluder face, welded: faces that share a point share its key.
 pub(crate) type CornerKey = u32;
 
@@ -96,42 +101,63 @@ impl ShadowUnion {
             return None;
         }
         // Only what lies on the piece matters to the difference.
-        let contours: Vec<Vec<DVec2>> = contours
+        let mut contours: Vec<Vec<DVec2>> = contours
             .iter()
             .filter_map(|c| clip_to_convex(c, piece))
             .collect();
-        if contours.is_empty() {
-            return Some(vec![vec![piece.to_vec()]]);
+        // The largest shadows first: where they cover the piece, the rest is never looked at.
+        contours.sort_by(|a, b| area_2d(b).abs().total_cmp(&area_2d(a).abs()));
+        let mut visible = vec![vec![piece.to_vec()]];
+        let mut batch_start = 0;
+        let mut edges = 0;
+        for (i, c) in contours.iter().enumerate() {
+            edges += c.len();
+            if edges >= BATCH_EDGES || i + 1 == contours.len() {
+                visible = difference(&visible, &contours[batch_start..=i])?;
+                if visible.is_empty() {
+                    break;
+                }
+                (batch_start, edges) = (i + 1, 0);
+            }
         }
-        let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
-        for p in piece.iter().chain(contours.iter().flatten()) {
-            lo = lo.min(*p);
-            hi = hi.max(*p);
-        }
-        if !(lo.is_finite() && hi.is_finite()) {
-            return None;
-        }
-        let rect = FloatRect::new(lo.x, hi.x, lo.y, hi.y).ok()?;
-        let adapter = FloatPointAdapter::<[f64; 2], i64>::new_conservative(rect);
-        let edges = piece.len() + contours.iter().map(Vec::len).sum::<usize>();
-        let mut overlay = FloatOverlay::<[f64; 2], i64>::with_adapter(adapter, edges);
-        overlay = overlay.unsafe_add_contour(&to_arrays(piece), ShapeType::Subject);
-        for c in &contours {
-            overlay = overlay.unsafe_add_contour(&to_arrays(c), ShapeType::Clip);
-        }
-        let shapes = overlay.overlay(OverlayRule::Difference, FillRule::NonZero);
-        Some(
-            shapes
-                .into_iter()
-                .map(|shape| {
-                    shape
-                        .into_iter()
-                        .map(|c| c.into_iter().map(|[x, y]| DVec2::new(x, y)).collect())
-                        .collect()
-                })
-                .collect(),
-        )
+        Some(visible)
     }
+}
+
+/// What of the shapes `visible` (outlines counter-clockwise, holes clockwise) no contour covers
+/// (non-zero winding), on the overlay's grid over their common bounding box.
+fn difference(visible: &[VisibleShape], contours: &[Vec<DVec2>]) -> Option<Vec<VisibleShape>> {
+    let subject = visible.iter().flatten();
+    let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
+    for p in subject.clone().chain(contours.iter()).flatten() {
+        lo = lo.min(*p);
+        hi = hi.max(*p);
+    }
+    if !(lo.is_finite() && hi.is_finite()) {
+        return None;
+    }
+    let rect = FloatRect::new(lo.x, hi.x, lo.y, hi.y).ok()?;
+    let adapter = FloatPointAdapter::<[f64; 2], i64>::new_conservative(rect);
+    let edges = subject.clone().chain(contours.iter()).map(Vec::len).sum();
+    let mut overlay = FloatOverlay::<[f64; 2], i64>::with_adapter(adapter, edges);
+    for c in subject {
+        overlay = overlay.unsafe_add_contour(&to_arrays(c), ShapeType::Subject);
+    }
+    for c in contours {
+        overlay = overlay.unsafe_add_contour(&to_arrays(c), ShapeType::Clip);
+    }
+    let shapes = overlay.overlay(OverlayRule::Difference, FillRule::NonZero);
+    Some(
+        shapes
+            .into_iter()
+            .map(|shape| {
+                shape
+                    .into_iter()
+                    .map(|c| c.into_iter().map(|[x, y]| DVec2::new(x, y)).collect())
+                    .collect()
+            })
+            .collect(),
+    )
 }
 
 fn to_arrays(contour: &[DVec2]) -> Vec<[f64; 2]> {
@@ -265,6 +291,36 @@ mod tests {
         assert_eq!(visible.len(), 1);
         assert_eq!(visible[0].len(), 2, "one outline with one hole");
         assert!(area_2d(&visible[0][1]) < 0.0);
+    }
+
+    /// 600 squares overlapping in a row, more edges than one batch: the union is counted once,
+    /// and a shadow covering the whole piece ends the work with nothing visible.
+    #[test]
+    fn shadows_in_batches_are_counted_once() {
+        let row = |union: &mut ShadowUnion| {
+            for i in 0..600 {
+                union.add_contour(crate::clip::sq(i as f64 * 1e-3, 0.0, 1.0));
+            }
+        };
+        assert!(600 * 4 > BATCH_EDGES);
+        let mut union = ShadowUnion::default();
+        row(&mut union);
+        let piece = [
+            DVec2::new(-1.0, -1.0),
+            DVec2::new(3.0, -1.0),
+            DVec2::new(3.0, 2.0),
+            DVec2::new(-1.0, 2.0),
+        ];
+        let visible = union.subtract_from(&piece).expect("finite");
+        assert!(
+            (area(&visible) - (12.0 - 1.599)).abs() < 1e-12,
+            "{}",
+            area(&visible)
+        );
+        let mut union = ShadowUnion::default();
+        row(&mut union);
+        union.add_contour(crate::clip::sq(-2.0, -2.0, 6.0));
+        assert!(union.subtract_from(&piece).expect("finite").is_empty());
     }
 
     #[test]
