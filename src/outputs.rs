@@ -197,13 +197,27 @@ struct RenderSummary {
     ambient: Rgb,
 }
 
-/// What to say when the deadline came before the exact direct light was done.
+/// What to say when the direct light at some vertices is an estimate by rays, not exact.
 pub fn estimated_direct_warning(stats: &SolveStats) -> Option<String> {
-    (stats.direct_estimated > 0).then(|| {
+    let late = stats.direct_estimated - stats.direct_beyond_cap;
+    let mut causes = Vec::new();
+    if late > 0 {
+        causes.push(format!("{late} left when the time budget ran out"));
+    }
+    if stats.direct_beyond_cap > 0 {
+        causes.push(format!(
+            "{} whose view of a light needs a polygon difference too large to hold \
+             (solver.direct_beyond_cap)",
+            stats.direct_beyond_cap
+        ));
+    }
+    (!causes.is_empty()).then(|| {
         format!(
-            "the time budget ran out during the exact direct light: {} of {} vertices were \
-             estimated with rays instead (solver.direct_estimated)",
-            stats.direct_estimated, stats.receivers
+            "the direct light at {} of {} vertices is estimated with rays, not exact \
+             (solver.direct_estimated): {}",
+            stats.direct_estimated,
+            stats.receivers,
+            causes.join("; ")
         )
     })
 }

@@ -22,7 +22,7 @@ use crate::clip::{
 };
 use crate::lambert::{ReceivingPoint, contour_sum};
 use crate::occluder_tree::{OccluderTree, Reached, ShaftTest, TreeFace};
-use crate::shadow_union::{CornerKey, ShadowUnion, VisibleShape};
+use crate::shadow_union::{CornerKey, Refusal, ShadowUnion, VisibleShape};
 use crate::solids::closed_solid_orientation;
 
 /// Visible pieces narrower than this many units in the last place of the coordinates involved
@@ -153,7 +153,13 @@ pub struct DirectLight<'a> {
     tol: f64,
     /// Occluders per shaft up to which shadows are subtracted one by one.
     sequential_shadows: usize,
+    /// Edges one polygon difference may hold ([`Self::with_overlay_cap`]).
+    overlay_cap: usize,
 }
+
+/// The visible part of a light needs a larger polygon difference than the evaluator allows.
+#[derive(Clone, Copy, Debug)]
+struct TooComplex;
 
 impl std::fmt::Debug for DirectLight<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -234,6 +240,17 @@ impl<'a> DirectLight<'a> {
             tree,
             tol: visibility.contact_distance(),
             sequential_shadows: SEQUENTIAL_SHADOWS,
+            overlay_cap: usize::MAX,
+        }
+    }
+
+    /// The same evaluator, giving up (NaN) where the visible part of a light would need a
+    /// polygon difference of more than `edges` edges at once: a large light seen through a
+    /// lattice of thin occluders can need millions, and as much memory.
+    pub fn with_overlay_cap(self, edges: usize) -> Self {
+        DirectLight {
+            overlay_cap: edges,
+            ..self
         }
     }
 
@@ -276,13 +293,14 @@ impl<'a> DirectLight<'a> {
             let shared = if group.len() > 1 {
                 self.shared_view(first.point, e)
             } else {
-                None
+                Ok(None)
             };
             for ((x, r), h) in group.iter().zip(&mut out) {
                 let sees =
                     *r != e.surface && x.in_front_of(e.frame.origin, e.frame.normal, self.tol);
                 let f = match &shared {
-                    Some(view) if sees => self.form_factor_of_view(view, x, *r, e),
+                    Ok(Some(view)) if sees => self.form_factor_of_view(view, x, *r, e),
+                    Err(TooComplex) if sees => f64::NAN,
                     _ => self.form_factor_visible(x, *r, k),
                 };
                 *h += e.emission * f;
@@ -294,10 +312,10 @@ impl<'a> DirectLight<'a> {
     /// What the occluders not through `point` leave visible of each piece of emitter `e`, when
     /// enough of them are in the way to be subtracted at once (else `None`: each receiver is
     /// evaluated on its own, one shadow at a time).
-    fn shared_view(&self, point: DVec3, e: &Emitter) -> Option<Vec<PieceView>> {
+    fn shared_view(&self, point: DVec3, e: &Emitter) -> Result<Option<Vec<PieceView>>, TooComplex> {
         let h_x = e.frame.height(point);
         if h_x <= self.tol {
-            return None;
+            return Ok(None);
         }
         let min_width = e.sliver_width(point);
         let mut views = Vec::with_capacity(e.pieces.len());
@@ -314,7 +332,7 @@ impl<'a> DirectLight<'a> {
                             .iter()
                             .any(|b| matches!(b, Blocking::Outline { .. }))
                     {
-                        return None;
+                        return Ok(None);
                     }
                     let touching = blockings
                         .iter()
@@ -323,10 +341,18 @@ impl<'a> DirectLight<'a> {
                             _ => None,
                         })
                         .collect();
-                    (
-                        subtract_at_once(&piece, &blockings, e, min_width)?,
-                        touching,
-                    )
+                    let visible = match subtract_at_once(
+                        &piece,
+                        &blockings,
+                        e,
+                        min_width,
+                        self.overlay_cap,
+                    ) {
+                        Ok(visible) => visible,
+                        Err(Refusal::NotFinite) => return Ok(None),
+                        Err(Refusal::TooComplex) => return Err(TooComplex),
+                    };
+                    (visible, touching)
                 }
             };
             views.push(PieceView {
@@ -335,7 +361,7 @@ impl<'a> DirectLight<'a> {
                 touching,
             });
         }
-        Some(views)
+        Ok(Some(views))
     }
 
     /// The form factor from receiver x (at the shared view's point) to what it sees of `e`.
@@ -457,10 +483,14 @@ impl<'a> DirectLight<'a> {
         self.emitters[k].surface
     }
 
-    /// The form factor from x to the part of emitter `k` that x sees.
+    /// The form factor from x to the part of emitter `k` that x sees (NaN where that part is
+    /// beyond the evaluator's overlay cap, [`Self::with_overlay_cap`]).
     pub fn form_factor_visible(&self, x: &ReceivingPoint, receiver: SurfaceId, k: usize) -> f64 {
         let tol = self.tol;
-        self.visible_parts(x, receiver, k)
+        let Ok(parts) = self.visible_parts_within_cap(x, receiver, k) else {
+            return f64::NAN;
+        };
+        parts
             .iter()
             .map(|shape| {
                 let mut contours = shape.iter().map(|c| contour_sum(x, c, tol).abs());
@@ -473,17 +503,27 @@ impl<'a> DirectLight<'a> {
 
     /// The part of emitter `k` visible from x, in 3D on the emitter's plane: shapes, each an
     /// outline followed by its holes (convex outlines without holes where few occluders are in
-    /// the way).
+    /// the way); empty where that part is beyond the evaluator's overlay cap.
     pub fn visible_parts(
         &self,
         x: &ReceivingPoint,
         receiver: SurfaceId,
         k: usize,
     ) -> Vec<Vec<Vec<DVec3>>> {
+        self.visible_parts_within_cap(x, receiver, k)
+            .unwrap_or_default()
+    }
+
+    fn visible_parts_within_cap(
+        &self,
+        x: &ReceivingPoint,
+        receiver: SurfaceId,
+        k: usize,
+    ) -> Result<Vec<Vec<Vec<DVec3>>>, TooComplex> {
         let e = &self.emitters[k];
         let tol = self.tol;
         if e.surface == receiver || !x.in_front_of(e.frame.origin, e.frame.normal, tol) {
-            return Vec::new();
+            return Ok(Vec::new());
         }
         let h_x = e.frame.height(x.point);
         let mut out = Vec::new();
@@ -499,7 +539,7 @@ impl<'a> DirectLight<'a> {
                 out.push(vec![front]);
                 continue;
             }
-            let visible = self.unblocked(x, receiver, e, &front, h_x);
+            let visible = self.unblocked(x, receiver, e, &front, h_x)?;
             out.extend(visible.into_iter().map(|shape| {
                 shape
                     .into_iter()
@@ -507,7 +547,7 @@ impl<'a> DirectLight<'a> {
                     .collect::<Vec<_>>()
             }));
         }
-        out
+        Ok(out)
     }
 
     /// `front` (a convex piece of the emitter, in front of x) minus the projections of the
@@ -519,7 +559,7 @@ impl<'a> DirectLight<'a> {
         e: &Emitter,
         front: &[DVec3],
         h_x: f64,
-    ) -> Vec<VisibleShape> {
+    ) -> Result<Vec<VisibleShape>, TooComplex> {
         // The rounding scale of this evaluation: coordinates as large as these carry this error.
         let min_width = e.sliver_width(x.point);
         let mut piece = front.iter().map(|&p| e.frame.to_2d(p)).collect::<Vec<_>>();
@@ -528,7 +568,7 @@ impl<'a> DirectLight<'a> {
         }
         let Some(mut blockings) = self.blockings(x.point, Some(receiver), e, front, h_x, &piece)
         else {
-            return Vec::new();
+            return Ok(Vec::new());
         };
         for b in &mut blockings {
             if let Blocking::Touching(index) = *b {
@@ -539,14 +579,18 @@ impl<'a> DirectLight<'a> {
             || blockings
                 .iter()
                 .any(|b| matches!(b, Blocking::Outline { .. }));
-        if at_once && let Some(visible) = subtract_at_once(&piece, &blockings, e, min_width) {
-            return visible;
+        if at_once {
+            match subtract_at_once(&piece, &blockings, e, min_width, self.overlay_cap) {
+                Ok(visible) => return Ok(visible),
+                Err(Refusal::TooComplex) => return Err(TooComplex),
+                Err(Refusal::NotFinite) => {}
+            }
         }
         let blockings = self.faces_of_outlines(blockings, x.point, e, h_x);
-        subtract_one_by_one(piece, blockings, e, min_width)
+        Ok(subtract_one_by_one(piece, blockings, e, min_width)
             .into_iter()
             .map(|p| vec![p])
-            .collect()
+            .collect())
     }
 
     /// What each occluder in the shaft from x to `front` hides of it, or `None` when one of them
@@ -810,14 +854,15 @@ fn subtract_one_by_one(
     visible
 }
 
-/// `piece` minus every blocking at once ([`ShadowUnion`]); `None` if the overlay refuses the
-/// coordinates.
+/// `piece` minus every blocking at once ([`ShadowUnion`]), unless the overlay refuses the
+/// coordinates or would hold more than `cap` edges.
 fn subtract_at_once(
     piece: &[DVec2],
     blockings: &[Blocking],
     e: &Emitter,
     min_width: f64,
-) -> Option<Vec<VisibleShape>> {
+    cap: usize,
+) -> Result<Vec<VisibleShape>, Refusal> {
     let mut union = ShadowUnion::default();
     for blocking in blockings {
         match blocking {
@@ -845,7 +890,7 @@ fn subtract_at_once(
             Blocking::Outline { edges, .. } => union.add_edges(edges),
         }
     }
-    union.subtract_from(piece)
+    union.subtract_from(piece, cap)
 }
 
 /// What an occluder whose plane holds x hides of the emitter's plane, in the one-sided limit from
@@ -1063,6 +1108,33 @@ mod tests {
         }
         // Against the light at the edge of the penumbra, 0.028.
         assert!(worst > 0.0 && worst < 1e-3, "{worst}");
+    }
+
+    /// Past the overlay cap a point's light is unknown (NaN), never a wrong number; points that
+    /// need no overlay keep their exact value.
+    #[test]
+    fn the_overlay_cap_gives_up_rather_than_guess() {
+        let scene = penumbra_scenes::tessellated::tessellated(7);
+        let vis = Visibility::build(&scene);
+        let exact = DirectLight::new(&scene, &vis);
+        let capped = DirectLight::new(&scene, &vis).with_overlay_cap(8);
+        let floor = scene.surface_id("floor").expect("floor");
+        let (mut unknown, mut same) = (0, 0);
+        for i in 0..40 {
+            let p = floor_point(-2.0 + 0.1 * i as f64, 0.3);
+            let (e, c) = (
+                exact.irradiance(&p, floor).r,
+                capped.irradiance(&p, floor).r,
+            );
+            assert!(e.is_finite());
+            if c.is_nan() {
+                unknown += 1;
+            } else {
+                assert_eq!(e, c);
+                same += 1;
+            }
+        }
+        assert!(unknown > 0 && same > 0, "{unknown} {same}");
     }
 
     #[test]

@@ -350,6 +350,7 @@ pub fn solve_gathering(
         direct_seconds: system.direct_seconds,
         // The gathering solvers compute the direct light exactly whatever the clock says.
         direct_estimated: 0,
+        direct_beyond_cap: 0,
         // Everything after the direct light: the form factors, K and the sweeps.
         shooting_seconds: started.elapsed().as_secs_f64() - system.direct_seconds,
         remeshes: 0,

@@ -151,9 +151,11 @@ pub struct SolveStats {
     /// after a remesh a patch may owe negative power).
     pub unshot_fraction: f64,
     pub direct_seconds: f64,
-    /// Vertices whose direct light was estimated by rays, not computed exactly, because the
-    /// deadline came first.
+    /// Vertices whose direct light was estimated by rays, not computed exactly: the deadline
+    /// came first, or (`direct_beyond_cap` of them) their view of a light needed a polygon
+    /// difference beyond the evaluator's cap.
     pub direct_estimated: usize,
+    pub direct_beyond_cap: usize,
     pub shooting_seconds: f64,
     /// Iterations of the solver (shots for progressive refinement, sweeps for gathering) and
     /// its final residual relative to the light put in: the unshot fraction for progressive
@@ -213,7 +215,7 @@ pub fn direct_irradiance_on(
     on: Option<&[bool]>,
     progress: &dyn Progress,
 ) -> Result<Vec<Rgb>, SolveError> {
-    let direct = DirectLight::new(scene, visibility);
+    let direct = DirectLight::new(scene, visibility).with_overlay_cap(OVERLAY_CAP);
     let limits = Limits {
         interrupt: options.interrupt.as_ref(),
         deadline: None,
@@ -223,14 +225,14 @@ pub fn direct_irradiance_on(
 }
 
 /// The direct irradiance at the vertices of the surfaces `on` marks (all when `None`; the others
-/// get zero), and how many vertices were estimated by rays because the deadline came first.
+/// get zero), and how many vertices were estimated by rays instead.
 fn direct_on(
     direct: &DirectLight,
     disc: &Discretization,
     on: Option<&[bool]>,
     limits: &Limits,
     progress: &dyn Progress,
-) -> Result<(Vec<Rgb>, usize), SolveError> {
+) -> Result<(Vec<Rgb>, Estimated), SolveError> {
     let all: Vec<usize> = (0..disc.receiver_count()).collect();
     let wanted =
         |v: usize| on.is_none_or(|on| on.get(disc.receiver_surface[v]).copied().unwrap_or(false));
@@ -256,6 +258,10 @@ struct Limits<'o> {
 /// there a few ulps apart, and the light seen from points that close differs by as little.
 const SHARED_POINT: f64 = 1e-12;
 
+/// Edges one polygon difference of the direct light may hold (about 100 MB of overlay); points
+/// that would need more get the estimate by rays, and the report counts them.
+const OVERLAY_CAP: usize = 1 << 18;
+
 /// The exact direct irradiance at `receivers`, computed once per point for receivers that
 /// share one (faces of a mesh meeting at a vertex; see [`DirectLight::irradiance_group`]).
 /// Only the groups holding a receiver that `wanted` accepts are evaluated (the others are
@@ -268,7 +274,7 @@ fn direct_at(
     wanted: &(dyn Fn(usize) -> bool + Sync),
     limits: &Limits,
     progress: &dyn Progress,
-) -> Result<(Vec<Rgb>, usize), SolveError> {
+) -> Result<(Vec<Rgb>, Estimated), SolveError> {
     // Groups in order of first appearance, so the work and its result do not depend on hashing.
     let mut groups: Vec<Vec<usize>> = Vec::new();
     let mut at_point: HashMap<[i64; 3], usize> = HashMap::new();
@@ -305,8 +311,24 @@ fn direct_at(
     let exact = par_map_with_progress(&groups, "direct light", limits.interrupt, progress, |g| {
         (!late()).then(|| direct.irradiance_group(&members(g)))
     })?;
-    // Past the deadline, what is left is estimated (quickly, and whatever the clock says, so
-    // every vertex has a value).
+    // A point whose view of a light is beyond the overlay cap gets NaN: estimated, like the
+    // points left at the deadline.
+    let too_complex = |values: &Option<Vec<Rgb>>| {
+        values.as_ref().is_some_and(|v| {
+            v.iter()
+                .any(|h| !(h.r.is_finite() && h.g.is_finite() && h.b.is_finite()))
+        })
+    };
+    let beyond_cap = (0..groups.len())
+        .filter(|&g| too_complex(&exact[g]))
+        .map(|g| groups[g].len())
+        .sum();
+    let exact: Vec<Option<Vec<Rgb>>> = exact
+        .into_iter()
+        .map(|values| if too_complex(&values) { None } else { values })
+        .collect();
+    // What is left is estimated (quickly, and whatever the clock says, so every vertex has a
+    // value).
     let left: Vec<usize> = (0..groups.len()).filter(|&g| exact[g].is_none()).collect();
     let estimates =
         par_map_with_progress(&left, "direct light, estimated", None, progress, |&g| {
@@ -315,7 +337,7 @@ fn direct_at(
                 .map(|(x, r)| direct.irradiance_sampled(x, *r, limits.rays))
                 .collect::<Vec<Rgb>>()
         })?;
-    let estimated = left.iter().map(|&g| groups[g].len()).sum();
+    let estimated: usize = left.iter().map(|&g| groups[g].len()).sum();
     let mut estimates = estimates.into_iter();
     let mut out = vec![Rgb::ZERO; receivers.len()];
     for (g, exact) in groups.iter().zip(exact) {
@@ -324,7 +346,21 @@ fn direct_at(
             out[i] = h;
         }
     }
-    Ok((out, estimated))
+    Ok((
+        out,
+        Estimated {
+            late: estimated - beyond_cap,
+            beyond_cap,
+        },
+    ))
+}
+
+/// Vertices whose direct light was estimated by rays: left at the deadline, or whose view of a
+/// light was beyond the overlay cap.
+#[derive(Clone, Copy, Debug, Default)]
+struct Estimated {
+    late: usize,
+    beyond_cap: usize,
 }
 
 /// `f` at each of `receivers`, in parallel, with a progress bar; stops early, with
@@ -423,8 +459,8 @@ pub struct ProgressiveSolver<'a> {
     scene: &'a Scene,
     visibility: &'a Visibility,
     direct: DirectLight<'a>,
-    /// Vertices whose direct light was estimated at the deadline ([`SolveStats::direct_estimated`]).
-    direct_estimated: usize,
+    /// Vertices whose direct light was estimated ([`SolveStats::direct_estimated`]).
+    direct_estimated: Estimated,
     options: SolverOptions,
     /// The surface meshes the state below belongs to.
     meshes: Vec<SurfaceMesh>,
@@ -478,7 +514,7 @@ impl<'a> ProgressiveSolver<'a> {
         check_mesh(scene, mesh)?;
         let disc = Discretization::new(scene, mesh, options.elements_per_patch);
         let started = Instant::now();
-        let direct = DirectLight::new(scene, visibility);
+        let direct = DirectLight::new(scene, visibility).with_overlay_cap(OVERLAY_CAP);
         let limits = Limits {
             interrupt: options.interrupt.as_ref(),
             deadline: options.deadline,
@@ -515,7 +551,7 @@ impl<'a> ProgressiveSolver<'a> {
             columns,
             shot_power: Rgb::ZERO,
             escaped: scene.emitted_power() - received,
-            stop: if direct_estimated > 0 {
+            stop: if direct_estimated.late > 0 {
                 StopReason::TimeBudget
             } else if options.direct_only {
                 StopReason::DirectOnly
@@ -910,7 +946,8 @@ impl<'a> ProgressiveSolver<'a> {
             iterations: self.shots,
             residual,
             direct_seconds: self.direct_seconds,
-            direct_estimated: self.direct_estimated,
+            direct_estimated: self.direct_estimated.late + self.direct_estimated.beyond_cap,
+            direct_beyond_cap: self.direct_estimated.beyond_cap,
             shooting_seconds: self.shooting_seconds,
             remeshes: self.remeshes,
             gathered: self.gathered,

@@ -88,17 +88,17 @@ impl ShadowUnion {
         self.contours.push(contour);
     }
 
-    /// `piece` (convex, counter-clockwise) minus every shadow, or `None` if the overlay cannot
-    /// represent the coordinates (not finite).
-    pub fn subtract_from(self, piece: &[DVec2]) -> Option<Vec<VisibleShape>> {
+    /// `piece` (convex, counter-clockwise) minus every shadow, unless the overlay cannot
+    /// represent the coordinates (not finite) or would need more than `cap` edges at once.
+    pub fn subtract_from(self, piece: &[DVec2], cap: usize) -> Result<Vec<VisibleShape>, Refusal> {
         let mut contours = self.contours;
-        contours.extend(outlines(self.sheet)?);
+        contours.extend(outlines(self.sheet).ok_or(Refusal::NotFinite)?);
         if !piece
             .iter()
             .chain(contours.iter().flatten())
             .all(|p| p.is_finite())
         {
-            return None;
+            return Err(Refusal::NotFinite);
         }
         // Only what lies on the piece matters to the difference.
         let mut contours: Vec<Vec<DVec2>> = contours
@@ -113,32 +113,48 @@ impl ShadowUnion {
         for (i, c) in contours.iter().enumerate() {
             edges += c.len();
             if edges >= BATCH_EDGES || i + 1 == contours.len() {
-                visible = difference(&visible, &contours[batch_start..=i])?;
+                visible = difference(&visible, &contours[batch_start..=i], cap)?;
                 if visible.is_empty() {
                     break;
                 }
                 (batch_start, edges) = (i + 1, 0);
             }
         }
-        Some(visible)
+        Ok(visible)
     }
+}
+
+/// Why a difference was not computed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Refusal {
+    /// A coordinate is not finite.
+    NotFinite,
+    /// The overlay would hold more edges than allowed (the light seen through a lattice).
+    TooComplex,
 }
 
 /// What of the shapes `visible` (outlines counter-clockwise, holes clockwise) no contour covers
 /// (non-zero winding), on the overlay's grid over their common bounding box.
-fn difference(visible: &[VisibleShape], contours: &[Vec<DVec2>]) -> Option<Vec<VisibleShape>> {
+fn difference(
+    visible: &[VisibleShape],
+    contours: &[Vec<DVec2>],
+    cap: usize,
+) -> Result<Vec<VisibleShape>, Refusal> {
     let subject = visible.iter().flatten();
+    let edges: usize = subject.clone().chain(contours.iter()).map(Vec::len).sum();
+    if edges > cap {
+        return Err(Refusal::TooComplex);
+    }
     let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
     for p in subject.clone().chain(contours.iter()).flatten() {
         lo = lo.min(*p);
         hi = hi.max(*p);
     }
     if !(lo.is_finite() && hi.is_finite()) {
-        return None;
+        return Err(Refusal::NotFinite);
     }
-    let rect = FloatRect::new(lo.x, hi.x, lo.y, hi.y).ok()?;
+    let rect = FloatRect::new(lo.x, hi.x, lo.y, hi.y).map_err(|_| Refusal::NotFinite)?;
     let adapter = FloatPointAdapter::<[f64; 2], i64>::new_conservative(rect);
-    let edges = subject.clone().chain(contours.iter()).map(Vec::len).sum();
     let mut overlay = FloatOverlay::<[f64; 2], i64>::with_adapter(adapter, edges);
     for c in subject {
         overlay = overlay.unsafe_add_contour(&to_arrays(c), ShapeType::Subject);
@@ -147,17 +163,15 @@ fn difference(visible: &[VisibleShape], contours: &[Vec<DVec2>]) -> Option<Vec<V
         overlay = overlay.unsafe_add_contour(&to_arrays(c), ShapeType::Clip);
     }
     let shapes = overlay.overlay(OverlayRule::Difference, FillRule::NonZero);
-    Some(
-        shapes
-            .into_iter()
-            .map(|shape| {
-                shape
-                    .into_iter()
-                    .map(|c| c.into_iter().map(|[x, y]| DVec2::new(x, y)).collect())
-                    .collect()
-            })
-            .collect(),
-    )
+    Ok(shapes
+        .into_iter()
+        .map(|shape| {
+            shape
+                .into_iter()
+                .map(|c| c.into_iter().map(|[x, y]| DVec2::new(x, y)).collect())
+                .collect()
+        })
+        .collect())
 }
 
 fn to_arrays(contour: &[DVec2]) -> Vec<[f64; 2]> {
@@ -271,7 +285,7 @@ mod tests {
         assert_eq!(loops.len(), 1);
         assert_eq!(loops[0].len(), 12, "the outline's corners");
         let visible = union
-            .subtract_from(&crate::clip::sq(-0.5, -0.5, 2.0))
+            .subtract_from(&crate::clip::sq(-0.5, -0.5, 2.0), usize::MAX)
             .expect("finite");
         assert!((area(&visible) - (4.0 - 0.5625)).abs() < 1e-15);
     }
@@ -285,7 +299,7 @@ mod tests {
         union.add_contour(crate::clip::sq(0.5, 0.5, 1.0));
         union.add_contour(crate::clip::sq(3.5, 3.5, 1.0));
         let visible = union
-            .subtract_from(&crate::clip::sq(-1.0, -1.0, 5.0))
+            .subtract_from(&crate::clip::sq(-1.0, -1.0, 5.0), usize::MAX)
             .expect("finite");
         assert!((area(&visible) - (25.0 - 1.75 - 0.25)).abs() < 1e-13);
         assert_eq!(visible.len(), 1);
@@ -311,7 +325,7 @@ mod tests {
             DVec2::new(3.0, 2.0),
             DVec2::new(-1.0, 2.0),
         ];
-        let visible = union.subtract_from(&piece).expect("finite");
+        let visible = union.subtract_from(&piece, usize::MAX).expect("finite");
         assert!(
             (area(&visible) - (12.0 - 1.599)).abs() < 1e-12,
             "{}",
@@ -320,7 +334,12 @@ mod tests {
         let mut union = ShadowUnion::default();
         row(&mut union);
         union.add_contour(crate::clip::sq(-2.0, -2.0, 6.0));
-        assert!(union.subtract_from(&piece).expect("finite").is_empty());
+        assert!(
+            union
+                .subtract_from(&piece, usize::MAX)
+                .expect("finite")
+                .is_empty()
+        );
     }
 
     #[test]
@@ -328,9 +347,8 @@ mod tests {
         let mut union = ShadowUnion::default();
         union.add_contour(vec![DVec2::ZERO, DVec2::X, DVec2::new(f64::NAN, 1.0)]);
         assert!(
-            union
-                .subtract_from(&crate::clip::sq(0.0, 0.0, 1.0))
-                .is_none()
+            union.subtract_from(&crate::clip::sq(0.0, 0.0, 1.0), usize::MAX)
+                == Err(Refusal::NotFinite)
         );
     }
 }
