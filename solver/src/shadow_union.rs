@@ -316,7 +316,7 @@ mod tests {
                 union.add_contour(crate::clip::sq(i as f64 * 1e-3, 0.0, 1.0));
             }
         };
-        assert!(600 * 4 > BATCH_EDGES);
+        const { assert!(600 * 4 > BATCH_EDGES) };
         let mut union = ShadowUnion::default();
         row(&mut union);
         let piece = [
