@@ -22,7 +22,7 @@ use crate::clip::{
 };
 use crate::lambert::{ReceivingPoint, contour_sum};
 use crate::occluder_tree::{OccluderTree, Reached, ShaftTest, TreeFace};
-use crate::shadow_union::{CornerKey, Refusal, ShadowUnion, VisibleShape};
+use crate::shadow_union::{CornerKey, OverlayLimit, Refusal, ShadowUnion, VisibleShape};
 use crate::solids::closed_solid_orientation;
 
 /// Visible pieces narrower than this many units in the last place of the coordinates involved
@@ -153,8 +153,9 @@ pub struct DirectLight<'a> {
     tol: f64,
     /// Occluders per shaft up to which shadows are subtracted one by one.
     sequential_shadows: usize,
-    /// Edges one polygon difference may hold ([`Self::with_overlay_cap`]).
-    overlay_cap: usize,
+    /// How far one polygon difference may go ([`Self::with_overlay_cap`],
+    /// [`Self::with_deadline`]).
+    overlay_limit: OverlayLimit,
 }
 
 /// The visible part of a light needs a larger polygon difference than the evaluator allows.
@@ -240,7 +241,7 @@ impl<'a> DirectLight<'a> {
             tree,
             tol: visibility.contact_distance(),
             sequential_shadows: SEQUENTIAL_SHADOWS,
-            overlay_cap: usize::MAX,
+            overlay_limit: OverlayLimit::NONE,
         }
     }
 
@@ -249,7 +250,22 @@ impl<'a> DirectLight<'a> {
     /// lattice of thin occluders can need millions, and as much memory.
     pub fn with_overlay_cap(self, edges: usize) -> Self {
         DirectLight {
-            overlay_cap: edges,
+            overlay_limit: OverlayLimit {
+                edges,
+                ..self.overlay_limit
+            },
+            ..self
+        }
+    }
+
+    /// The same evaluator, giving up (NaN) on a point whose polygon difference is still going
+    /// at `deadline` (it works in batches, and checks between them).
+    pub fn with_deadline(self, deadline: Option<std::time::Instant>) -> Self {
+        DirectLight {
+            overlay_limit: OverlayLimit {
+                deadline,
+                ..self.overlay_limit
+            },
             ..self
         }
     }
@@ -346,7 +362,7 @@ impl<'a> DirectLight<'a> {
                         &blockings,
                         e,
                         min_width,
-                        self.overlay_cap,
+                        &self.overlay_limit,
                     ) {
                         Ok(visible) => visible,
                         Err(Refusal::NotFinite) => return Ok(None),
@@ -580,7 +596,7 @@ impl<'a> DirectLight<'a> {
                 .iter()
                 .any(|b| matches!(b, Blocking::Outline { .. }));
         if at_once {
-            match subtract_at_once(&piece, &blockings, e, min_width, self.overlay_cap) {
+            match subtract_at_once(&piece, &blockings, e, min_width, &self.overlay_limit) {
                 Ok(visible) => return Ok(visible),
                 Err(Refusal::TooComplex) => return Err(TooComplex),
                 Err(Refusal::NotFinite) => {}
@@ -861,7 +877,7 @@ fn subtract_at_once(
     blockings: &[Blocking],
     e: &Emitter,
     min_width: f64,
-    cap: usize,
+    limit: &OverlayLimit,
 ) -> Result<Vec<VisibleShape>, Refusal> {
     let mut union = ShadowUnion::default();
     for blocking in blockings {
@@ -890,7 +906,7 @@ fn subtract_at_once(
             Blocking::Outline { edges, .. } => union.add_edges(edges),
         }
     }
-    union.subtract_from(piece, cap)
+    union.subtract_from(piece, limit)
 }
 
 /// What an occluder whose plane holds x hides of the emitter's plane, in the one-sided limit from

@@ -258,9 +258,12 @@ struct Limits<'o> {
 /// there a few ulps apart, and the light seen from points that close differs by as little.
 const SHARED_POINT: f64 = 1e-12;
 
-/// Edges one polygon difference of the direct light may hold (about 100 MB of overlay); points
-/// that would need more get the estimate by rays, and the report counts them.
-const OVERLAY_CAP: usize = 1 << 18;
+/// Edges one polygon difference of the direct light may hold; points that would need more get
+/// the estimate by rays, and the report counts them. The overlay's cost grows with the
+/// crossings of its edges, which the edges bound only by their square: a light seen through a
+/// lattice of beams and rods crosses each new batch of shadows with the many holes left so far
+/// (with 2^15 edges, one Sponza vertex took minutes and gigabytes in a single overlay).
+const OVERLAY_CAP: usize = 1 << 13;
 
 /// The exact direct irradiance at `receivers`, computed once per point for receivers that
 /// share one (faces of a mesh meeting at a vertex; see [`DirectLight::irradiance_group`]).
@@ -319,10 +322,15 @@ fn direct_at(
                 .any(|h| !(h.r.is_finite() && h.g.is_finite() && h.b.is_finite()))
         })
     };
-    let beyond_cap = (0..groups.len())
-        .filter(|&g| too_complex(&exact[g]))
-        .map(|g| groups[g].len())
-        .sum();
+    // Past the deadline, the evaluator also gives up on the points still in progress.
+    let beyond_cap = if late() {
+        0
+    } else {
+        (0..groups.len())
+            .filter(|&g| too_complex(&exact[g]))
+            .map(|g| groups[g].len())
+            .sum()
+    };
     let exact: Vec<Option<Vec<Rgb>>> = exact
         .into_iter()
         .map(|values| if too_complex(&values) { None } else { values })
@@ -514,7 +522,9 @@ impl<'a> ProgressiveSolver<'a> {
         check_mesh(scene, mesh)?;
         let disc = Discretization::new(scene, mesh, options.elements_per_patch);
         let started = Instant::now();
-        let direct = DirectLight::new(scene, visibility).with_overlay_cap(OVERLAY_CAP);
+        let direct = DirectLight::new(scene, visibility)
+            .with_overlay_cap(OVERLAY_CAP)
+            .with_deadline(options.deadline);
         let limits = Limits {
             interrupt: options.interrupt.as_ref(),
             deadline: options.deadline,

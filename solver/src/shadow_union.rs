@@ -13,6 +13,7 @@
 //! silhouette from the receiving point — however finely the mesh is tessellated.
 
 use std::collections::HashMap;
+use std::time::Instant;
 
 use glam::DVec2;
 use i_overlay::core::fill_rule::FillRule;
@@ -27,7 +28,7 @@ use crate::clip::{area_2d, clip_to_convex};
 /// Shadows go into one overlay until they have this many edges; the next batch is subtracted
 /// from what the last left visible, so no overlay holds the many overlapping shadows of a large
 /// light seen through a building at once, and a piece covered early is done.
-const BATCH_EDGES: usize = 2048;
+const BATCH_EDGES: usize = 1024;
 
 /// A corner of an occluder face, welded: faces that share a point share its key.
 pub(crate) type CornerKey = u32;
@@ -89,8 +90,12 @@ impl ShadowUnion {
     }
 
     /// `piece` (convex, counter-clockwise) minus every shadow, unless the overlay cannot
-    /// represent the coordinates (not finite) or would need more than `cap` edges at once.
-    pub fn subtract_from(self, piece: &[DVec2], cap: usize) -> Result<Vec<VisibleShape>, Refusal> {
+    /// represent the coordinates (not finite) or the work goes past `limit`.
+    pub fn subtract_from(
+        self,
+        piece: &[DVec2],
+        limit: &OverlayLimit,
+    ) -> Result<Vec<VisibleShape>, Refusal> {
         let mut contours = self.contours;
         contours.extend(outlines(self.sheet).ok_or(Refusal::NotFinite)?);
         if !piece
@@ -113,7 +118,10 @@ impl ShadowUnion {
         for (i, c) in contours.iter().enumerate() {
             edges += c.len();
             if edges >= BATCH_EDGES || i + 1 == contours.len() {
-                visible = difference(&visible, &contours[batch_start..=i], cap)?;
+                if limit.deadline.is_some_and(|d| Instant::now() >= d) {
+                    return Err(Refusal::TooComplex);
+                }
+                visible = difference(&visible, &contours[batch_start..=i], limit.edges)?;
                 if visible.is_empty() {
                     break;
                 }
@@ -124,12 +132,28 @@ impl ShadowUnion {
     }
 }
 
+/// How far one subtraction may go: edges in one overlay, and a moment after which no new batch
+/// starts.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct OverlayLimit {
+    pub edges: usize,
+    pub deadline: Option<Instant>,
+}
+
+impl OverlayLimit {
+    pub const NONE: OverlayLimit = OverlayLimit {
+        edges: usize::MAX,
+        deadline: None,
+    };
+}
+
 /// Why a difference was not computed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Refusal {
     /// A coordinate is not finite.
     NotFinite,
-    /// The overlay would hold more edges than allowed (the light seen through a lattice).
+    /// The overlay would hold more edges than allowed (the light seen through a lattice), or
+    /// the deadline passed.
     TooComplex,
 }
 
@@ -285,7 +309,7 @@ mod tests {
         assert_eq!(loops.len(), 1);
         assert_eq!(loops[0].len(), 12, "the outline's corners");
         let visible = union
-            .subtract_from(&crate::clip::sq(-0.5, -0.5, 2.0), usize::MAX)
+            .subtract_from(&crate::clip::sq(-0.5, -0.5, 2.0), &OverlayLimit::NONE)
             .expect("finite");
         assert!((area(&visible) - (4.0 - 0.5625)).abs() < 1e-15);
     }
@@ -299,7 +323,7 @@ mod tests {
         union.add_contour(crate::clip::sq(0.5, 0.5, 1.0));
         union.add_contour(crate::clip::sq(3.5, 3.5, 1.0));
         let visible = union
-            .subtract_from(&crate::clip::sq(-1.0, -1.0, 5.0), usize::MAX)
+            .subtract_from(&crate::clip::sq(-1.0, -1.0, 5.0), &OverlayLimit::NONE)
             .expect("finite");
         assert!((area(&visible) - (25.0 - 1.75 - 0.25)).abs() < 1e-13);
         assert_eq!(visible.len(), 1);
@@ -325,7 +349,9 @@ mod tests {
             DVec2::new(3.0, 2.0),
             DVec2::new(-1.0, 2.0),
         ];
-        let visible = union.subtract_from(&piece, usize::MAX).expect("finite");
+        let visible = union
+            .subtract_from(&piece, &OverlayLimit::NONE)
+            .expect("finite");
         assert!(
             (area(&visible) - (12.0 - 1.599)).abs() < 1e-12,
             "{}",
@@ -336,7 +362,7 @@ mod tests {
         union.add_contour(crate::clip::sq(-2.0, -2.0, 6.0));
         assert!(
             union
-                .subtract_from(&piece, usize::MAX)
+                .subtract_from(&piece, &OverlayLimit::NONE)
                 .expect("finite")
                 .is_empty()
         );
@@ -347,7 +373,7 @@ mod tests {
         let mut union = ShadowUnion::default();
         union.add_contour(vec![DVec2::ZERO, DVec2::X, DVec2::new(f64::NAN, 1.0)]);
         assert!(
-            union.subtract_from(&crate::clip::sq(0.0, 0.0, 1.0), usize::MAX)
+            union.subtract_from(&crate::clip::sq(0.0, 0.0, 1.0), &OverlayLimit::NONE)
                 == Err(Refusal::NotFinite)
         );
     }
