@@ -898,7 +898,7 @@ fn the_default_budget_fits_the_scene() {
         triangles > 10_000 && triangles <= budget,
         "{triangles} of {budget}"
     );
-    let least = budget - 4 * surfaces;
+    let least = budget - penumbra_meshing::FIT_TRIANGLES_PER_SURFACE * surfaces;
     assert!(least > polygons_need + 4 * surfaces, "{least}");
 
     let refused = dir.path().join("refused");
@@ -948,8 +948,10 @@ fn the_default_budget_fits_the_scene() {
         first < least + surfaces && last > first && last <= budget,
         "{first} -> {last} of {budget}"
     );
-    // An explicit budget that fits the scene but not the default start (a tenth of it) names
-    // the start's option.
+    // An explicit budget that fits the scene but not the default start (a tenth of it, enough
+    // for the polygons alone) names the start's option.
+    let explicit = (10 * (polygons_need + 1)).max(budget);
+    assert!(explicit / 10 < least);
     let o = penumbra(&[
         "run",
         path,
@@ -957,7 +959,7 @@ fn the_default_budget_fits_the_scene() {
         "--refine-tol",
         "0.01",
         "--max-elements",
-        &budget.to_string(),
+        &explicit.to_string(),
         "--out",
         refused.to_str().expect("utf-8"),
         "--quiet",
