@@ -633,10 +633,7 @@ impl<'a> DirectLight<'a> {
 
         // Faces wholly between the two planes and not too close to x are projected whole.
         let reach = h_x * (1.0 - 1.0 / PROJECTION_REACH);
-        let project = |p: DVec3| {
-            let s = h_x / (h_x - e.frame.height(p));
-            e.frame.to_2d(point + (p - point) * s)
-        };
+        let project = |p: DVec3| project_onto(e, point, h_x, p);
         let mut candidates = Vec::new();
         let mut outlines = Vec::new();
         self.tree.walk(
@@ -753,10 +750,7 @@ impl DirectLight<'_> {
                 let corners = self.occluders[index]
                     .polygon
                     .iter()
-                    .map(|&p| {
-                        let s = h_x / (h_x - e.frame.height(p));
-                        e.frame.to_2d(point + (p - point) * s)
-                    })
+                    .map(|&p| project_onto(e, point, h_x, p))
                     .collect();
                 out.push(Blocking::Shadow {
                     corners,
@@ -774,6 +768,13 @@ struct PieceView {
     piece: Vec<DVec2>,
     visible: Vec<VisibleShape>,
     touching: Vec<usize>,
+}
+
+/// `p` projected from `point` (at height `h_x` above the emitter's plane) onto that plane, in
+/// the emitter's 2D frame.
+fn project_onto(e: &Emitter, point: DVec3, h_x: f64, p: DVec3) -> DVec2 {
+    let s = h_x / (h_x - e.frame.height(p));
+    e.frame.to_2d(point + (p - point) * s)
 }
 
 /// Points spread evenly over convex polygons (fanned into triangles, each cut into about
