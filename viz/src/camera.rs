@@ -13,8 +13,9 @@ pub const DEFAULT_VIEW_DIRECTION: DVec3 = DVec3::new(0.3, -1.0, 0.6);
 
 /// A camera that frames the scene's bounding box: it looks at the box's centre from
 /// [`DEFAULT_VIEW_DIRECTION`], far enough that the box's bounding sphere fits the vertical field
-/// of view ([`DEFAULT_FOV_DEG`]), with +z up (never parallel to that direction). An empty scene
-/// gets a view of the unit sphere about the origin.
+/// of view ([`DEFAULT_FOV_DEG`]), with +z up (never parallel to that direction). A scene whose
+/// lights face -y (the +y-up convention of OBJ files) is seen the same way with +y up and +z to
+/// the front. An empty scene gets a view of the unit sphere about the origin.
 pub fn default_camera(scene: &Scene) -> Camera {
     let bounds = scene.bounds();
     let diagonal = bounds.diagonal();
@@ -26,15 +27,32 @@ pub fn default_camera(scene: &Scene) -> Camera {
     } else {
         (DVec3::ZERO, 1.0)
     };
-    let direction = DEFAULT_VIEW_DIRECTION.normalize();
+    let (direction, up) = if lights_face_minus_y(scene) {
+        // z up, -y front turned into y up, +z front.
+        let d = DEFAULT_VIEW_DIRECTION;
+        (DVec3::new(d.x, d.z, -d.y), DVec3::Y)
+    } else {
+        (DEFAULT_VIEW_DIRECTION, DVec3::Z)
+    };
+    let direction = direction.normalize();
     let half_fov = (0.5 * DEFAULT_FOV_DEG).to_radians();
     let distance = radius / half_fov.sin();
     Camera {
         eye: center + direction * distance,
         target: center,
-        up: DVec3::Z,
+        up,
         fov_deg: DEFAULT_FOV_DEG,
     }
+}
+
+/// Whether the scene's lights, weighted by their power, face -y more than any other axis
+/// direction.
+fn lights_face_minus_y(scene: &Scene) -> bool {
+    let facing: DVec3 = scene
+        .emitters()
+        .map(|(_, s)| s.normal() * s.area() * s.emission.mean())
+        .sum();
+    facing.y < 0.0 && -facing.y > facing.x.abs().max(facing.z.abs())
 }
 
 /// A camera set up for one image: an orthonormal basis and the projection to pixel coordinates.
@@ -108,6 +126,23 @@ impl View {
 mod tests {
     use super::*;
     use penumbra_scenes::builtin;
+
+    /// A y-up scene (the textbook's light turned to face -y) is seen with +y up, from the
+    /// front (+z) and above.
+    #[test]
+    fn a_scene_lit_from_plus_y_is_seen_with_y_up() {
+        let mut scene = builtin::textbook();
+        for s in &mut scene.surfaces {
+            for p in &mut s.polygon {
+                *p = DVec3::new(p.x, p.z, -p.y);
+            }
+        }
+        let camera = default_camera(&scene);
+        assert_eq!(camera.up, DVec3::Y);
+        let to_eye = camera.eye - camera.target;
+        assert!(to_eye.y > 0.0 && to_eye.z > 0.0, "{to_eye}");
+        assert_eq!(default_camera(&builtin::textbook()).up, DVec3::Z);
+    }
 
     #[test]
     fn default_camera_sees_the_whole_box() {
