@@ -393,6 +393,25 @@ mod tests {
         (faces, outlines)
     }
 
+    /// The faces of a grid, all facing one way.
+    fn tree_faces<'a>(
+        polygons: &'a [Vec<DVec3>],
+        keys: &'a [Vec<CornerKey>],
+        facing: DVec3,
+        closed: bool,
+    ) -> Vec<TreeFace<'a>> {
+        polygons
+            .iter()
+            .zip(keys)
+            .map(|(polygon, keys)| TreeFace {
+                polygon,
+                keys,
+                facing,
+                closed,
+            })
+            .collect()
+    }
+
     /// Under an emitter at z = 10, a point below a 16 x 16 sheet at z = 5 meets the sheet as one
     /// outline: its rim of 64 edges, the inner edges cancelled.
     #[test]
@@ -401,16 +420,7 @@ mod tests {
         for (facing, closed, expect_reversed) in
             [(-DVec3::Z, false, false), (DVec3::Z, false, true)]
         {
-            let faces: Vec<TreeFace> = polygons
-                .iter()
-                .zip(&keys)
-                .map(|(p, k)| TreeFace {
-                    polygon: p,
-                    keys: k,
-                    facing,
-                    closed,
-                })
-                .collect();
+            let faces = tree_faces(&polygons, &keys, facing, closed);
             let tree = OccluderTree::build(&faces);
             // A shaft with no side planes holds everything between the planes.
             let (loose, outlines) = walk(&tree, DVec3::ZERO, &[]);
@@ -438,16 +448,7 @@ mod tests {
     #[test]
     fn the_walk_skips_what_cannot_cast_and_opens_what_it_cannot_decide() {
         let (polygons, keys) = grid(16, 5.0);
-        let faces: Vec<TreeFace> = polygons
-            .iter()
-            .zip(&keys)
-            .map(|(p, k)| TreeFace {
-                polygon: p,
-                keys: k,
-                facing: DVec3::Z,
-                closed: true,
-            })
-            .collect();
+        let faces = tree_faces(&polygons, &keys, DVec3::Z, true);
         let tree = OccluderTree::build(&faces);
         // Below the sheet, a closed solid's faces turned away cast nothing.
         let (loose, outlines) = walk(&tree, DVec3::ZERO, &[]);
