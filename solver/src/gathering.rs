@@ -25,7 +25,7 @@ use crate::elements::Discretization;
 use crate::error::SolveError;
 use crate::progress::Progress;
 use crate::progressive::{
-    ConvergencePoint, Solution, SolveStats, SolverOptions, StopReason, direct_irradiance,
+    ConvergencePoint, Solution, SolveStats, SolverOptions, StopReason, direct_irradiance_counted,
 };
 
 /// How the discrete system is solved.
@@ -78,6 +78,9 @@ pub struct PatchSystem {
     pub rays_cast: u64,
     /// Seconds spent on the direct light, and on the form factors and K.
     pub direct_seconds: f64,
+    /// Vertices whose direct light is an estimate by rays (their view of a light was beyond the
+    /// exact evaluator's overlay cap).
+    pub direct_beyond_cap: usize,
     pub assembly_seconds: f64,
 }
 
@@ -91,7 +94,8 @@ impl PatchSystem {
     ) -> Result<PatchSystem, SolveError> {
         let disc = Discretization::new(scene, mesh, options.elements_per_patch);
         let started = Instant::now();
-        let direct = direct_irradiance(scene, &disc, visibility, options, progress)?;
+        let (direct, direct_beyond_cap) =
+            direct_irradiance_counted(scene, &disc, visibility, options, None, progress)?;
         let direct_seconds = started.elapsed().as_secs_f64();
         let started = Instant::now();
         let n = disc.receiver_count();
@@ -139,6 +143,7 @@ impl PatchSystem {
             k,
             rays_cast,
             direct_seconds,
+            direct_beyond_cap,
             assembly_seconds: started.elapsed().as_secs_f64(),
         })
     }
@@ -348,9 +353,10 @@ pub fn solve_gathering(
         escaped: emitted + sent - received,
         unshot_fraction: unshot.mean().abs() / emitted.mean().max(f64::MIN_POSITIVE),
         direct_seconds: system.direct_seconds,
-        // The gathering solvers compute the direct light exactly whatever the clock says.
-        direct_estimated: 0,
-        direct_beyond_cap: 0,
+        // The gathering solvers compute the direct light whatever the clock says, exactly but
+        // where a point's view is beyond the overlay cap.
+        direct_estimated: system.direct_beyond_cap,
+        direct_beyond_cap: system.direct_beyond_cap,
         // Everything after the direct light: the form factors, K and the sweeps.
         shooting_seconds: started.elapsed().as_secs_f64() - system.direct_seconds,
         remeshes: 0,

@@ -215,13 +215,27 @@ pub fn direct_irradiance_on(
     on: Option<&[bool]>,
     progress: &dyn Progress,
 ) -> Result<Vec<Rgb>, SolveError> {
+    Ok(direct_irradiance_counted(scene, disc, visibility, options, on, progress)?.0)
+}
+
+/// [`direct_irradiance_on`], and how many vertices were estimated by rays because their view of
+/// a light needed a polygon difference beyond the evaluator's cap.
+pub fn direct_irradiance_counted(
+    scene: &Scene,
+    disc: &Discretization,
+    visibility: &Visibility,
+    options: &SolverOptions,
+    on: Option<&[bool]>,
+    progress: &dyn Progress,
+) -> Result<(Vec<Rgb>, usize), SolveError> {
     let direct = DirectLight::new(scene, visibility).with_overlay_cap(OVERLAY_CAP);
     let limits = Limits {
         interrupt: options.interrupt.as_ref(),
         deadline: None,
         rays: options.visibility_rays,
     };
-    Ok(direct_on(&direct, disc, on, &limits, progress)?.0)
+    let (values, estimated) = direct_on(&direct, disc, on, &limits, progress)?;
+    Ok((values, estimated.beyond_cap))
 }
 
 /// The direct irradiance at the vertices of the surfaces `on` marks (all when `None`; the others
