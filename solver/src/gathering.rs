@@ -25,7 +25,7 @@ use crate::elements::Discretization;
 use crate::error::SolveError;
 use crate::progress::Progress;
 use crate::progressive::{
-    ConvergencePoint, Solution, SolveStats, SolverOptions, StopReason, direct_irradiance_counted,
+    ConvergencePoint, Solution, SolveStats, SolverOptions, StopReason, direct_irradiance,
 };
 
 /// How the discrete system is solved.
@@ -95,7 +95,7 @@ impl PatchSystem {
         let disc = Discretization::new(scene, mesh, options.elements_per_patch);
         let started = Instant::now();
         let (direct, direct_beyond_cap) =
-            direct_irradiance_counted(scene, &disc, visibility, options, None, progress)?;
+            direct_irradiance(scene, &disc, visibility, options, progress)?;
         let direct_seconds = started.elapsed().as_secs_f64();
         let started = Instant::now();
         let n = disc.receiver_count();

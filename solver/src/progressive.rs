@@ -191,41 +191,15 @@ pub struct Solution {
     pub convergence: Vec<ConvergencePoint>,
 }
 
-/// Direct irradiance at every vertex from the exact evaluator; stops early, with
-/// [`SolveError::Interrupted`], once `options.interrupt` is set.
+/// Direct irradiance at every vertex from the exact evaluator, and how many vertices were
+/// estimated by rays because their view of a light needed a polygon difference beyond the
+/// evaluator's cap; stops early, with [`SolveError::Interrupted`], once `options.interrupt` is
+/// set.
 pub fn direct_irradiance(
     scene: &Scene,
     disc: &Discretization,
     visibility: &Visibility,
     options: &SolverOptions,
-    progress: &dyn Progress,
-) -> Result<Vec<Rgb>, SolveError> {
-    direct_irradiance_on(scene, disc, visibility, options, None, progress)
-}
-
-/// [`direct_irradiance`] at the vertices of the surfaces `on` marks only (all when `None`); the
-/// other vertices get zero. Each value is the one [`direct_irradiance`] gives, to the bit: where
-/// vertices of several surfaces share a point and one evaluation, that evaluation is made for
-/// them all, as it is when every vertex is lit (see [`direct_at`]).
-pub fn direct_irradiance_on(
-    scene: &Scene,
-    disc: &Discretization,
-    visibility: &Visibility,
-    options: &SolverOptions,
-    on: Option<&[bool]>,
-    progress: &dyn Progress,
-) -> Result<Vec<Rgb>, SolveError> {
-    Ok(direct_irradiance_counted(scene, disc, visibility, options, on, progress)?.0)
-}
-
-/// [`direct_irradiance_on`], and how many vertices were estimated by rays because their view of
-/// a light needed a polygon difference beyond the evaluator's cap.
-pub fn direct_irradiance_counted(
-    scene: &Scene,
-    disc: &Discretization,
-    visibility: &Visibility,
-    options: &SolverOptions,
-    on: Option<&[bool]>,
     progress: &dyn Progress,
 ) -> Result<(Vec<Rgb>, usize), SolveError> {
     let direct = DirectLight::new(scene, visibility).with_overlay_cap(OVERLAY_CAP);
@@ -234,12 +208,14 @@ pub fn direct_irradiance_counted(
         deadline: None,
         rays: options.visibility_rays,
     };
-    let (values, estimated) = direct_on(&direct, disc, on, &limits, progress)?;
+    let (values, estimated) = direct_on(&direct, disc, None, &limits, progress)?;
     Ok((values, estimated.beyond_cap))
 }
 
 /// The direct irradiance at the vertices of the surfaces `on` marks (all when `None`; the others
-/// get zero), and how many vertices were estimated by rays instead.
+/// get zero), and how many vertices were estimated by rays instead. Each value is the one
+/// computed when every vertex is lit, to the bit: where vertices of several surfaces share a
+/// point and one evaluation, that evaluation is made for them all (see [`direct_at`]).
 fn direct_on(
     direct: &DirectLight,
     disc: &Discretization,
@@ -523,7 +499,7 @@ impl<'a> ProgressiveSolver<'a> {
     }
 
     /// [`Self::new`], with the direct light at the vertices of the surfaces `on` marks only
-    /// (see [`direct_irradiance_on`]).
+    /// (see [`direct_on`]).
     fn new_on(
         scene: &'a Scene,
         mesh: &SceneMesh,
