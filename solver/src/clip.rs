@@ -122,6 +122,32 @@ pub fn subtract_convex(piece: &[DVec2], hole: &[DVec2], min_width: f64, out: &mu
     }
 }
 
+/// The convex hull of `points`, counter-clockwise, without collinear corners (Andrew's monotone
+/// chain, turns decided exactly).
+pub fn convex_hull_2d(mut points: Vec<DVec2>) -> Vec<DVec2> {
+    points.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+    points.dedup();
+    if points.len() < 3 {
+        return points;
+    }
+    let backwards: Vec<DVec2> = points.iter().rev().copied().collect();
+    let mut hull: Vec<DVec2> = Vec::with_capacity(points.len() + 1);
+    for chain in [&points, &backwards] {
+        let base = hull.len();
+        for &p in chain {
+            while hull.len() >= base + 2
+                && orient(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0.0
+            {
+                hull.pop();
+            }
+            hull.push(p);
+        }
+        // The chain's last point starts the other chain.
+        hull.pop();
+    }
+    hull
+}
+
 /// Whether `p` lies inside or on a convex counter-clockwise polygon.
 pub fn inside_convex(p: DVec2, polygon: &[DVec2]) -> bool {
     let n = polygon.len();

@@ -86,7 +86,7 @@ impl CornerIds {
 }
 
 /// What one occluder hides of an emitter piece, seen from a point.
-enum Blocking {
+enum Blocking<'a> {
     /// The occluder's plane holds the point (occluder index): what it hides depends on the side
     /// the receiving surface lies on ([`contact_shadow`]).
     Touching(usize),
@@ -96,7 +96,7 @@ enum Blocking {
     /// corners' keys when the whole occluder lies inside the shaft.
     Shadow {
         corners: Vec<DVec2>,
-        keys: Option<Vec<CornerKey>>,
+        keys: Option<&'a [CornerKey]>,
     },
     /// The faces of a node of the occluder tree, projected whole: their outline's edges
     /// (corner keys and the projection of the first), all turned one way.
@@ -619,7 +619,7 @@ impl<'a> DirectLight<'a> {
         front: &[DVec3],
         h_x: f64,
         piece: &[DVec2],
-    ) -> Option<Vec<Blocking>> {
+    ) -> Option<Vec<Blocking<'_>>> {
         let tol = self.tol;
         let min_width = e.sliver_width(point);
         // The shaft's side planes through x and each edge, oriented to contain the piece.
@@ -700,7 +700,7 @@ impl<'a> DirectLight<'a> {
             // planes and not too close to x is projected whole, keeping its own corners.
             let whole = inside || (at_once && heights.iter().all(|&h| h >= 0.0 && h <= reach));
             let poly = if whole {
-                occ.polygon.clone()
+                std::borrow::Cow::Borrowed(&occ.polygon)
             } else {
                 let mut poly = clip_polygon_3d(&occ.polygon, |p| e.frame.height(p));
                 for &m in &sides {
@@ -709,7 +709,7 @@ impl<'a> DirectLight<'a> {
                     }
                     poly = clip_polygon_3d(&poly, |p| m.dot(p - point));
                 }
-                poly
+                std::borrow::Cow::Owned(poly)
             };
             if poly.len() < 3 {
                 continue;
@@ -723,7 +723,7 @@ impl<'a> DirectLight<'a> {
             }
             blockings.push(Blocking::Shadow {
                 corners,
-                keys: whole.then(|| occ.keys.clone()),
+                keys: whole.then_some(&occ.keys[..]),
             });
         }
         Some(blockings)
@@ -733,13 +733,13 @@ impl<'a> DirectLight<'a> {
 impl DirectLight<'_> {
     /// The blockings with each outline replaced by its node's faces, projected whole, for the
     /// one-by-one subtraction.
-    fn faces_of_outlines(
+    fn faces_of_outlines<'b>(
         &self,
-        blockings: Vec<Blocking>,
+        blockings: Vec<Blocking<'b>>,
         point: DVec3,
         e: &Emitter,
         h_x: f64,
-    ) -> Vec<Blocking> {
+    ) -> Vec<Blocking<'b>> {
         let mut out = Vec::with_capacity(blockings.len());
         for b in blockings {
             let Blocking::Outline { node, .. } = b else {
@@ -835,7 +835,7 @@ fn tidy_shadow(corners: &[DVec2], e: &Emitter, min_width: f64) -> Option<Vec<DVe
 /// `piece` minus each blocking in turn, as convex pieces.
 fn subtract_one_by_one(
     piece: Vec<DVec2>,
-    blockings: Vec<Blocking>,
+    blockings: Vec<Blocking<'_>>,
     e: &Emitter,
     min_width: f64,
 ) -> Vec<Vec<DVec2>> {
@@ -875,7 +875,7 @@ fn subtract_one_by_one(
 /// coordinates or would hold more than `cap` edges.
 fn subtract_at_once(
     piece: &[DVec2],
-    blockings: &[Blocking],
+    blockings: &[Blocking<'_>],
     e: &Emitter,
     min_width: f64,
     limit: &OverlayLimit,

@@ -23,12 +23,18 @@ use i_overlay::float::overlay::FloatOverlay;
 use i_overlay::i_float::adapter::FloatPointAdapter;
 use i_overlay::i_float::float::rect::FloatRect;
 
-use crate::clip::{area_2d, clip_to_convex};
+use crate::clip::{area_2d, clip_to_convex, convex_hull_2d};
 
 /// Shadows go into one overlay until they have this many edges; the next batch is subtracted
 /// from what the last left visible, so no overlay holds the many overlapping shadows of a large
 /// light seen through a building at once, and a piece covered early is done.
 const BATCH_EDGES: usize = 1024;
+
+/// The first batch holds the largest shadows up to this many edges, and each batch may hold
+/// twice as many as the last: the largest shadows often hide most of the piece, and the hull of
+/// what they leave bounds what every later shadow can still hide, so later shadows shrink or
+/// drop out before they reach an overlay.
+const FIRST_BATCH_EDGES: usize = 16;
 
 /// A corner of an occluder face, welded: faces that share a point share its key.
 pub(crate) type CornerKey = u32;
@@ -113,20 +119,29 @@ impl ShadowUnion {
         // The largest shadows first: where they cover the piece, the rest is never looked at.
         contours.sort_by(|a, b| area_2d(b).abs().total_cmp(&area_2d(a).abs()));
         let mut visible = vec![vec![piece.to_vec()]];
-        let mut batch_start = 0;
-        let mut edges = 0;
-        for (i, c) in contours.iter().enumerate() {
-            edges += c.len();
-            if edges >= BATCH_EDGES || i + 1 == contours.len() {
-                if limit.deadline.is_some_and(|d| Instant::now() >= d) {
-                    return Err(Refusal::TooComplex);
-                }
-                visible = difference(&visible, &contours[batch_start..=i], limit.edges)?;
-                if visible.is_empty() {
-                    break;
-                }
-                (batch_start, edges) = (i + 1, 0);
+        let mut batch_edges = FIRST_BATCH_EDGES;
+        while !contours.is_empty() {
+            if limit.deadline.is_some_and(|d| Instant::now() >= d) {
+                return Err(Refusal::TooComplex);
             }
+            let mut taken = 1;
+            let mut edges = contours[0].len();
+            while taken < contours.len() && edges + contours[taken].len() <= batch_edges {
+                edges += contours[taken].len();
+                taken += 1;
+            }
+            let later = contours.split_off(taken);
+            visible = difference(&visible, &contours, limit.edges)?;
+            if visible.is_empty() {
+                break;
+            }
+            // What is left visible lies in its hull: only the later shadows' parts in it matter.
+            let hull = convex_hull_2d(visible.iter().flatten().flatten().copied().collect());
+            contours = later
+                .iter()
+                .filter_map(|c| clip_to_convex(c, &hull))
+                .collect();
+            batch_edges = (batch_edges * 2).min(BATCH_EDGES);
         }
         Ok(visible)
     }
@@ -216,8 +231,12 @@ pub(crate) fn cancel_opposite<E: Copy>(
         let (from, to) = ends(e);
         from < to
     };
-    // Each corner pair's edges together, forward ones (from the smaller key) first.
-    edges.sort_by_key(|e| (pair(e), !forward(e)));
+    // Each corner pair's edges together, forward ones (from the smaller key) first. Edges with
+    // equal keys are the same edge, so an unstable sort keeps the result fixed.
+    edges.sort_unstable_by_key(|e| {
+        let (lo, hi) = pair(e);
+        (u64::from(lo) << 33) | (u64::from(hi) << 1) | u64::from(!forward(e))
+    });
     let mut kept = Vec::with_capacity(edges.len() / 4);
     let mut i = 0;
     while i < edges.len() {
