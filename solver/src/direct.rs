@@ -13,7 +13,7 @@
 use std::f64::consts::PI;
 
 use glam::{DVec2, DVec3};
-use penumbra_scenes::polygon::{is_convex_ccw, triangulate_ccw};
+use penumbra_scenes::polygon::{self, is_convex_ccw, triangulate_ccw};
 use penumbra_scenes::{PlaneFrame, Rgb, Scene, SurfaceId, Visibility};
 
 use crate::clip::{
@@ -186,7 +186,7 @@ impl<'a> DirectLight<'a> {
                         .iter()
                         .map(|p| p.abs().max_element())
                         .fold(0.0, f64::max),
-                    merge_distance: MERGE_FRACTION * penumbra_scenes::polygon::diameter(&s.polygon),
+                    merge_distance: MERGE_FRACTION * polygon::diameter(&s.polygon),
                 })
             })
             .collect();
@@ -506,20 +506,25 @@ impl<'a> DirectLight<'a> {
         let Ok(parts) = self.visible_parts_within_cap(x, receiver, k) else {
             return f64::NAN;
         };
-        parts
+        // Each contour counts with the sign of its turn about the emitter's normal: the overlay
+        // may give a degenerate part as an outline and a reversed copy of it, which cancel.
+        let normal = self.emitters[k].frame.normal;
+        let signed: f64 = parts
             .iter()
-            .map(|shape| {
-                let mut contours = shape.iter().map(|c| contour_sum(x, c, tol).abs());
-                let outline = contours.next().unwrap_or(0.0);
-                (outline - contours.sum::<f64>()).max(0.0)
+            .flatten()
+            .map(|c| {
+                let turn = polygon::newell_normal(c).dot(normal);
+                turn.signum() * contour_sum(x, c, tol).abs()
             })
-            .sum::<f64>()
-            / (2.0 * PI)
+            .sum();
+        signed.max(0.0) / (2.0 * PI)
     }
 
     /// The part of emitter `k` visible from x, in 3D on the emitter's plane: shapes, each an
     /// outline followed by its holes (convex outlines without holes where few occluders are in
-    /// the way); empty where that part is beyond the evaluator's overlay cap.
+    /// the way); empty where that part is beyond the evaluator's overlay cap. A contour turning
+    /// clockwise about the emitter's normal removes its inside: where the overlay leaves a
+    /// degenerate part, it may come as an outline and a reversed copy of it, on its own.
     pub fn visible_parts(
         &self,
         x: &ReceivingPoint,
