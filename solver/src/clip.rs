@@ -205,28 +205,35 @@ const DEGENERATE_EDGE: f64 = 1e-9;
 /// The part of a closed contour inside a convex counter-clockwise polygon (Sutherland–Hodgman,
 /// which keeps the contour's winding inside), or `None` when none is.
 pub fn clip_to_convex(contour: &[DVec2], convex: &[DVec2]) -> Option<Vec<DVec2>> {
+    let ((lo, hi), (convex_lo, convex_hi)) = (bounds_2d(contour), bounds_2d(convex));
+    if lo.cmpgt(convex_hi).any() || convex_lo.cmpgt(hi).any() {
+        return None;
+    }
     let n = convex.len();
     let edge = |i: usize| convex[(i + 1) % n] - convex[i];
     let longest = (0..n).map(|i| edge(i).length()).fold(0.0, f64::max);
-    let mut out = contour.to_vec();
+    // Most contours lie inside most of the sides: those leave it as it is, uncopied.
+    let mut out = std::borrow::Cow::Borrowed(contour);
     for i in 0..n {
         let (a, d) = (convex[i], edge(i));
         if d.length() <= DEGENERATE_EDGE * longest {
             continue;
         }
         let normal = DVec2::new(-d.y, d.x);
-        out = clip_half_plane(
-            &out,
-            &HalfPlane {
-                normal,
-                offset: -normal.dot(a),
-            },
-        );
-        if out.len() < 3 {
+        let side = HalfPlane {
+            normal,
+            offset: -normal.dot(a),
+        };
+        if out.iter().all(|&p| side.value(p) >= 0.0) {
+            continue;
+        }
+        let clipped = clip_half_plane(&out, &side);
+        if clipped.len() < 3 {
             return None;
         }
+        out = std::borrow::Cow::Owned(clipped);
     }
-    Some(out)
+    Some(out.into_owned())
 }
 
 /// `piece` minus the convex region where every half-plane holds, as convex pieces no narrower

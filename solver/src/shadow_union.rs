@@ -17,6 +17,8 @@
 //! silhouette from the receiving point — however finely the mesh is tessellated.
 
 use std::collections::HashMap;
+
+use foldhash::fast::FixedState;
 use std::time::Instant;
 
 use clipper2_rust::{ClipType, Clipper64, FillRule, Path64, Paths64, Point64, PolyTree64};
@@ -101,49 +103,73 @@ impl ShadowUnion {
         piece: &[DVec2],
         limit: &OverlayLimit,
     ) -> Result<Vec<VisibleShape>, Refusal> {
-        let mut contours = self.contours;
-        contours.extend(outlines(self.sheet).ok_or(Refusal::NotFinite)?);
+        let mut shadows: Vec<Shadow> = self.contours.into_iter().map(|c| vec![c]).collect();
+        shadows.extend(outlines(self.sheet).ok_or(Refusal::NotFinite)?);
         if !piece
             .iter()
-            .chain(contours.iter().flatten())
+            .chain(shadows.iter().flatten().flatten())
             .all(|p| p.is_finite())
         {
             return Err(Refusal::NotFinite);
         }
         // Only what lies on the piece matters to the difference.
-        let mut contours: Vec<Vec<DVec2>> = contours
-            .iter()
-            .filter_map(|c| clip_to_convex(c, piece))
-            .collect();
+        let mut shadows = clip_shadows(&shadows, piece);
         // The largest shadows first: where they cover the piece, the rest is never looked at.
-        contours.sort_by(|a, b| area_2d(b).abs().total_cmp(&area_2d(a).abs()));
+        let areas: Vec<f64> = shadows
+            .iter()
+            .map(|s| s.iter().map(|c| area_2d(c)).sum())
+            .collect();
+        let mut order: Vec<usize> = (0..shadows.len()).collect();
+        order.sort_by(|&a, &b| areas[b].total_cmp(&areas[a]));
+        let mut shadows: Vec<Shadow> = order
+            .into_iter()
+            .map(|i| std::mem::take(&mut shadows[i]))
+            .collect();
         let mut visible = vec![vec![piece.to_vec()]];
         let mut batch_edges = FIRST_BATCH_EDGES;
-        while !contours.is_empty() {
+        while !shadows.is_empty() {
             if limit.deadline.is_some_and(|d| Instant::now() >= d) {
                 return Err(Refusal::TooComplex);
             }
+            let edges_of = |s: &Shadow| s.iter().map(Vec::len).sum::<usize>();
             let mut taken = 1;
-            let mut edges = contours[0].len();
-            while taken < contours.len() && edges + contours[taken].len() <= batch_edges {
-                edges += contours[taken].len();
+            let mut edges = edges_of(&shadows[0]);
+            while taken < shadows.len() && edges + edges_of(&shadows[taken]) <= batch_edges {
+                edges += edges_of(&shadows[taken]);
                 taken += 1;
             }
-            let later = contours.split_off(taken);
-            visible = difference(&visible, &contours, limit.edges)?;
+            let later = shadows.split_off(taken);
+            let batch: Vec<Vec<DVec2>> = shadows.into_iter().flatten().collect();
+            visible = difference(&visible, &batch, limit.edges)?;
             if visible.is_empty() {
                 break;
             }
             // What is left visible lies in its hull: only the later shadows' parts in it matter.
             let hull = convex_hull_2d(visible.iter().flatten().flatten().copied().collect());
-            contours = later
-                .iter()
-                .filter_map(|c| clip_to_convex(c, &hull))
-                .collect();
+            shadows = clip_shadows(&later, &hull);
             batch_edges = (batch_edges * 2).min(BATCH_EDGES);
         }
         Ok(visible)
     }
+}
+
+/// One shadow as closed loops whose winding numbers add up to its coverage, never below zero:
+/// a convex shadow, or a connected sheet's outline with its holes (only together are they a
+/// shadow; the outline alone would cover the holes).
+type Shadow = Vec<Vec<DVec2>>;
+
+/// Each shadow's loops clipped to a convex region (the winding inside it stays); shadows left
+/// without a loop are dropped.
+fn clip_shadows(shadows: &[Shadow], convex: &[DVec2]) -> Vec<Shadow> {
+    shadows
+        .iter()
+        .map(|s| {
+            s.iter()
+                .filter_map(|c| clip_to_convex(c, convex))
+                .collect::<Shadow>()
+        })
+        .filter(|s| !s.is_empty())
+        .collect()
 }
 
 /// How far one subtraction may go: edges in one overlay, and a moment after which no new batch
@@ -300,17 +326,22 @@ pub(crate) fn cancel_opposite<E: Copy>(
 }
 
 /// The closed outlines of the sheet's edges once each edge met in both directions cancels
-/// (the winding number of what remains is that of the faces). `None` if the edges do not close,
-/// which faces of distinct corners always do.
-fn outlines(edges: Vec<SheetEdge>) -> Option<Vec<Vec<DVec2>>> {
+/// (the winding number of what remains is that of the faces), one shadow per connected set of
+/// faces. `None` if the edges do not close, which faces of distinct corners always do.
+fn outlines(edges: Vec<SheetEdge>) -> Option<Vec<Shadow>> {
+    let mut sheets = Components::default();
+    for e in &edges {
+        sheets.join(e.from, e.to);
+    }
     let kept = cancel_opposite(edges, |e| (e.from, e.to));
     // Walk the surviving edges into closed loops: every corner has as many edges in as out.
-    let mut leaving: HashMap<CornerKey, Vec<usize>> = HashMap::new();
+    let mut leaving: HashMap<CornerKey, Vec<usize>, FixedState> = HashMap::default();
     for (k, e) in kept.iter().enumerate().rev() {
         leaving.entry(e.from).or_default().push(k);
     }
     let mut used = vec![false; kept.len()];
-    let mut loops = Vec::new();
+    let mut shadows: Vec<Shadow> = Vec::new();
+    let mut shadow_of_sheet: HashMap<u32, usize, FixedState> = HashMap::default();
     for start in 0..kept.len() {
         if used[start] {
             continue;
@@ -331,9 +362,63 @@ fn outlines(edges: Vec<SheetEdge>) -> Option<Vec<Vec<DVec2>>> {
             contour.push(kept[next].at);
             at = kept[next].to;
         }
-        loops.push(contour);
+        let sheet = sheets.find(kept[start].from);
+        let index = *shadow_of_sheet.entry(sheet).or_insert_with(|| {
+            shadows.push(Vec::new());
+            shadows.len() - 1
+        });
+        shadows[index].push(contour);
     }
-    Some(loops)
+    Some(shadows)
+}
+
+/// Corners joined by edges, as disjoint sets (union by size, path halving).
+#[derive(Default)]
+struct Components {
+    index: HashMap<CornerKey, u32, FixedState>,
+    parent: Vec<u32>,
+    size: Vec<u32>,
+}
+
+impl Components {
+    fn slot(&mut self, key: CornerKey) -> u32 {
+        let next = self.parent.len() as u32;
+        let slot = *self.index.entry(key).or_insert(next);
+        if slot == next {
+            self.parent.push(next);
+            self.size.push(1);
+        }
+        slot
+    }
+
+    fn root(&mut self, mut i: u32) -> u32 {
+        while self.parent[i as usize] != i {
+            let grand = self.parent[self.parent[i as usize] as usize];
+            self.parent[i as usize] = grand;
+            i = grand;
+        }
+        i
+    }
+
+    fn join(&mut self, a: CornerKey, b: CornerKey) {
+        let (a, b) = (self.slot(a), self.slot(b));
+        let (a, b) = (self.root(a), self.root(b));
+        if a != b {
+            let (small, large) = if self.size[a as usize] < self.size[b as usize] {
+                (a, b)
+            } else {
+                (b, a)
+            };
+            self.parent[small as usize] = large;
+            self.size[large as usize] += self.size[small as usize];
+        }
+    }
+
+    /// The set of a corner met by [`Self::join`].
+    fn find(&mut self, key: CornerKey) -> u32 {
+        let slot = self.slot(key);
+        self.root(slot)
+    }
 }
 
 #[cfg(test)]
@@ -369,11 +454,50 @@ mod tests {
         }
         let loops = outlines(union.sheet.clone()).expect("closes");
         assert_eq!(loops.len(), 1);
-        assert_eq!(loops[0].len(), 12, "the outline's corners");
+        assert_eq!(loops[0].len(), 1, "one loop");
+        assert_eq!(loops[0][0].len(), 12, "the outline's corners");
         let visible = union
             .subtract_from(&crate::clip::sq(-0.5, -0.5, 2.0), &OverlayLimit::NONE)
             .expect("finite");
         assert!((area(&visible) - (4.0 - 0.5625)).abs() < 1e-15);
+    }
+
+    /// A ring of faces (4 x 4 cells without the middle 2 x 2) is one shadow of two loops: its
+    /// outline (16 edges, a batch of its own) and its hole. The hole stays visible, around the
+    /// ring too.
+    #[test]
+    fn a_sheet_with_a_hole_keeps_its_hole() {
+        let corner = |i: u32, j: u32| (key(5 * i + j), DVec2::new(i as f64, j as f64));
+        let mut union = ShadowUnion::default();
+        for i in 0..4 {
+            for j in 0..4 {
+                if (1..3).contains(&i) && (1..3).contains(&j) {
+                    continue;
+                }
+                let (a, b, c, d) = (
+                    corner(i, j),
+                    corner(i + 1, j),
+                    corner(i + 1, j + 1),
+                    corner(i, j + 1),
+                );
+                union.add_face(&[a.0, b.0, c.0], &[a.1, b.1, c.1]);
+                union.add_face(&[a.0, c.0, d.0], &[a.1, c.1, d.1]);
+            }
+        }
+        let shadows = outlines(union.sheet.clone()).expect("closes");
+        assert_eq!(shadows.len(), 1);
+        let mut loops: Vec<usize> = shadows[0].iter().map(Vec::len).collect();
+        loops.sort_unstable();
+        assert_eq!(loops, [8, 16]);
+        const { assert!(16 <= FIRST_BATCH_EDGES && 16 + 8 > FIRST_BATCH_EDGES) };
+        let visible = union
+            .subtract_from(&crate::clip::sq(-0.5, -0.5, 5.0), &OverlayLimit::NONE)
+            .expect("finite");
+        assert!(
+            (area(&visible) - (25.0 - 16.0 + 4.0)).abs() < 1e-12,
+            "{}",
+            area(&visible)
+        );
     }
 
     /// Overlapping shadows count once; a shadow reaching past the piece removes only what it
