@@ -378,16 +378,24 @@ struct Components {
     index: HashMap<CornerKey, u32, FixedState>,
     parent: Vec<u32>,
     size: Vec<u32>,
+    last: Option<(CornerKey, u32)>,
 }
 
 impl Components {
     fn slot(&mut self, key: CornerKey) -> u32 {
+        // Edges come in chains (each one's end is the next one's start): look that up once.
+        if let Some((last, slot)) = self.last
+            && last == key
+        {
+            return slot;
+        }
         let next = self.parent.len() as u32;
         let slot = *self.index.entry(key).or_insert(next);
         if slot == next {
             self.parent.push(next);
             self.size.push(1);
         }
+        self.last = Some((key, slot));
         slot
     }
 
@@ -401,7 +409,8 @@ impl Components {
     }
 
     fn join(&mut self, a: CornerKey, b: CornerKey) {
-        let (a, b) = (self.slot(a), self.slot(b));
+        let a = self.slot(a);
+        let b = self.slot(b);
         let (a, b) = (self.root(a), self.root(b));
         if a != b {
             let (small, large) = if self.size[a as usize] < self.size[b as usize] {
