@@ -688,22 +688,28 @@ impl<'a> DirectLight<'a> {
                 continue;
             }
             // Wholly outside one side of the shaft, or beyond the emitter's plane: no shadow.
-            let heights: Vec<f64> = occ.polygon.iter().map(|&p| e.frame.height(p)).collect();
-            if heights.iter().all(|&h| h < 0.0)
+            let (lowest, highest) = occ
+                .polygon
+                .iter()
+                .map(|&p| e.frame.height(p))
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), h| {
+                    (lo.min(h), hi.max(h))
+                });
+            if highest < 0.0
                 || sides
                     .iter()
                     .any(|m| occ.polygon.iter().all(|&p| m.dot(p - point) < 0.0))
             {
                 continue;
             }
-            let inside = heights.iter().all(|&h| h >= 0.0)
+            let inside = lowest >= 0.0
                 && occ
                     .polygon
                     .iter()
                     .all(|&p| sides.iter().all(|m| m.dot(p - point) >= 0.0));
             // Shadows subtracted at once may reach past the piece: a face between the two
             // planes and not too close to x is projected whole, keeping its own corners.
-            let whole = inside || (at_once && heights.iter().all(|&h| h >= 0.0 && h <= reach));
+            let whole = inside || (at_once && lowest >= 0.0 && highest <= reach);
             let poly = if whole {
                 std::borrow::Cow::Borrowed(&occ.polygon)
             } else {
