@@ -396,13 +396,11 @@ impl<'a> DirectLight<'a> {
             offset: n.dot(e.frame.origin - x.point),
         };
         let signed_sum = |contours: &[Vec<DVec2>]| -> f64 {
-            contours
+            let contours: Vec<Vec<DVec3>> = contours
                 .iter()
-                .map(|c| {
-                    let c3: Vec<DVec3> = c.iter().map(|&q| e.frame.to_3d(q)).collect();
-                    area_2d(c).signum() * contour_sum(x, &c3, tol).abs()
-                })
-                .sum()
+                .map(|c| c.iter().map(|&q| e.frame.to_3d(q)).collect())
+                .collect();
+            signed_sum(x, &contours, e.frame.normal, tol)
         };
         let mut total = 0.0;
         for view in views {
@@ -506,18 +504,8 @@ impl<'a> DirectLight<'a> {
         let Ok(parts) = self.visible_parts_within_cap(x, receiver, k) else {
             return f64::NAN;
         };
-        // Each contour counts with the sign of its turn about the emitter's normal: the overlay
-        // may give a degenerate part as an outline and a reversed copy of it, which cancel.
         let normal = self.emitters[k].frame.normal;
-        let signed: f64 = parts
-            .iter()
-            .flatten()
-            .map(|c| {
-                let turn = polygon::newell_normal(c).dot(normal);
-                turn.signum() * contour_sum(x, c, tol).abs()
-            })
-            .sum();
-        signed.max(0.0) / (2.0 * PI)
+        signed_sum(x, parts.iter().flatten(), normal, tol).max(0.0) / (2.0 * PI)
     }
 
     /// The part of emitter `k` visible from x, in 3D on the emitter's plane: shapes, each an
@@ -779,6 +767,22 @@ struct PieceView {
     piece: Vec<DVec2>,
     visible: Vec<VisibleShape>,
     touching: Vec<usize>,
+}
+
+/// Lambert's contour sum over contours on an emitter's plane, each counted with the sign of its
+/// turn about the emitter's normal (counter-clockwise adds, clockwise removes). The overlay may
+/// give a part of no area as an outline and a reversed copy of it, not as a hole inside it:
+/// those cancel.
+fn signed_sum<'c>(
+    x: &ReceivingPoint,
+    contours: impl IntoIterator<Item = &'c Vec<DVec3>>,
+    normal: DVec3,
+    tol: f64,
+) -> f64 {
+    contours
+        .into_iter()
+        .map(|c| polygon::newell_normal(c).dot(normal).signum() * contour_sum(x, c, tol).abs())
+        .sum()
 }
 
 /// `p` projected from `point` (at height `h_x` above the emitter's plane) onto that plane, in
@@ -1163,6 +1167,27 @@ mod tests {
             }
         }
         assert!(unknown > 0 && same > 0, "{unknown} {same}");
+    }
+
+    /// A part of no area given as a triangle and, beside it, a reversed copy with a corner
+    /// repeated (as the overlay may give it) adds nothing; the triangle alone adds its sum.
+    #[test]
+    fn a_reversed_copy_cancels_its_outline() {
+        let x = floor_point(0.1, -0.2);
+        let at = |u: f64, v: f64| DVec3::new(u, v, 1.0);
+        let triangle = vec![at(-0.3, 0.2), at(0.1, -0.5), at(0.4, 0.25)];
+        let copy = vec![
+            at(0.4, 0.25),
+            at(0.1, -0.5),
+            at(0.1, -0.5 + 1e-15),
+            at(-0.3, 0.2),
+        ];
+        let tol = 1e-12;
+        let alone = signed_sum(&x, [&triangle], DVec3::Z, tol);
+        assert!(alone > 0.1, "{alone}");
+        assert_eq!(alone, contour_sum(&x, &triangle, tol).abs());
+        let both = signed_sum(&x, [&triangle, &copy], DVec3::Z, tol);
+        assert!(both.abs() < 1e-12 * alone, "{both}");
     }
 
     #[test]
