@@ -15,6 +15,7 @@ use std::f64::consts::PI;
 use glam::{DVec2, DVec3};
 use penumbra_scenes::polygon::{self, is_convex_ccw, triangulate_ccw};
 use penumbra_scenes::{PlaneFrame, Rgb, Scene, SurfaceId, Visibility};
+use smallvec::SmallVec;
 
 use crate::clip::{
     HalfPlane, area_2d, clip_half_plane, clip_polygon_3d, clip_to_convex, inside_convex,
@@ -93,9 +94,10 @@ enum Blocking<'a> {
     /// A touching occluder's hidden regions, for one receiver: intersections of half-planes.
     Contact(Vec<Vec<HalfPlane>>),
     /// The occluder clipped to the shaft and projected onto the emitter's plane; with the
-    /// corners' keys when the whole occluder lies inside the shaft.
+    /// corners' keys when the whole occluder lies inside the shaft. Most are triangles, held
+    /// inline: a shaft through a building holds tens of thousands.
     Shadow {
-        corners: Vec<DVec2>,
+        corners: FaceCorners,
         keys: Option<&'a [CornerKey]>,
     },
     /// The faces of a node of the occluder tree, projected whole: their outline's edges
@@ -105,6 +107,9 @@ enum Blocking<'a> {
         edges: Vec<(CornerKey, CornerKey, DVec2)>,
     },
 }
+
+/// A projected face's corners.
+type FaceCorners = SmallVec<[DVec2; 4]>;
 
 #[derive(Clone, Debug)]
 struct Emitter {
@@ -713,7 +718,7 @@ impl<'a> DirectLight<'a> {
             if poly.len() < 3 {
                 continue;
             }
-            let corners: Vec<DVec2> = poly.iter().map(|&p| project(p)).collect();
+            let corners: FaceCorners = poly.iter().map(|&p| project(p)).collect();
             // Only a shadow whose box holds the piece's can cover it; most are far smaller.
             if box_holds(&corners, piece)
                 && tidy_shadow(&corners, e, min_width).is_some_and(|shadow| covers(&shadow, piece))
@@ -895,7 +900,16 @@ fn subtract_at_once(
     min_width: f64,
     limit: &OverlayLimit,
 ) -> Result<Vec<VisibleShape>, Refusal> {
-    let mut union = ShadowUnion::default();
+    let mut union = ShadowUnion::with_capacity(
+        blockings
+            .iter()
+            .map(|b| match b {
+                Blocking::Shadow { corners, .. } => corners.len(),
+                Blocking::Outline { edges, .. } => edges.len(),
+                _ => 0,
+            })
+            .sum(),
+    );
     for blocking in blockings {
         match blocking {
             Blocking::Touching(_) => {}

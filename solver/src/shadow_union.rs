@@ -61,6 +61,14 @@ pub(crate) struct ShadowUnion {
 pub(crate) type VisibleShape = Vec<Vec<DVec2>>;
 
 impl ShadowUnion {
+    /// Room for this many sheet edges.
+    pub fn with_capacity(edges: usize) -> Self {
+        ShadowUnion {
+            sheet: Vec::with_capacity(edges),
+            contours: Vec::new(),
+        }
+    }
+
     /// Adds the shadow of a face wholly inside the shaft: its corners' keys and projections.
     pub fn add_face(&mut self, keys: &[CornerKey], corners: &[DVec2]) {
         let n = corners.len();
