@@ -111,18 +111,30 @@ impl ShadowUnion {
         piece: &[DVec2],
         limit: &OverlayLimit,
     ) -> Result<Vec<VisibleShape>, Refusal> {
+        self.subtract_within(vec![vec![piece.to_vec()]], piece, limit)
+    }
+
+    /// `start` (shapes lying in the convex `bound`) minus every shadow, as
+    /// [`Self::subtract_from`].
+    pub fn subtract_within(
+        self,
+        start: Vec<VisibleShape>,
+        bound: &[DVec2],
+        limit: &OverlayLimit,
+    ) -> Result<Vec<VisibleShape>, Refusal> {
         let mut shadows: Vec<Shadow> = self.contours.into_iter().map(|c| vec![c]).collect();
         shadows.extend(outlines(self.sheet).ok_or(Refusal::NotFinite)?);
-        if !piece
+        if !bound
             .iter()
+            .chain(visible_points(&start))
             .chain(shadows.iter().flatten().flatten())
             .all(|p| p.is_finite())
         {
             return Err(Refusal::NotFinite);
         }
-        // Only what lies on the piece matters to the difference.
-        let mut shadows = clip_shadows(&shadows, piece);
-        // The largest shadows first: where they cover the piece, the rest is never looked at.
+        // Only what lies in the bound matters to the difference.
+        let mut shadows = clip_shadows(&shadows, bound);
+        // The largest shadows first: where they cover what is visible, the rest is never looked at.
         let areas: Vec<f64> = shadows
             .iter()
             .map(|s| s.iter().map(|c| area_2d(c)).sum())
@@ -133,7 +145,7 @@ impl ShadowUnion {
             .into_iter()
             .map(|i| std::mem::take(&mut shadows[i]))
             .collect();
-        let mut visible = vec![vec![piece.to_vec()]];
+        let mut visible = start;
         let mut batch_edges = FIRST_BATCH_EDGES;
         while !shadows.is_empty() {
             if limit.deadline.is_some_and(|d| Instant::now() >= d) {
@@ -159,6 +171,10 @@ impl ShadowUnion {
         }
         Ok(visible)
     }
+}
+
+fn visible_points(shapes: &[VisibleShape]) -> impl Iterator<Item = &DVec2> {
+    shapes.iter().flatten().flatten()
 }
 
 /// One shadow as closed loops whose winding numbers add up to its coverage, never below zero:
