@@ -252,17 +252,25 @@ fn difference(
     let paths = |contours: &mut dyn Iterator<Item = &Vec<DVec2>>| -> Paths64 {
         contours.map(|c| grid.path(c)).collect()
     };
-    let mut clipper = Clipper64::new();
-    clipper.add_subject(&paths(&mut subject.clone()));
-    clipper.add_clip(&paths(&mut contours.iter()));
+    let (subject, clip) = (paths(&mut subject.clone()), paths(&mut contours.iter()));
     let mut tree = PolyTree64::new();
-    clipper.execute_tree(
-        ClipType::Difference,
-        FillRule::NonZero,
-        &mut tree,
-        &mut Paths64::new(),
-    );
+    // One engine per thread, cleared between uses: it keeps its arenas' memory.
+    CLIPPER.with_borrow_mut(|clipper| {
+        clipper.clear();
+        clipper.add_subject(&subject);
+        clipper.add_clip(&clip);
+        clipper.execute_tree(
+            ClipType::Difference,
+            FillRule::NonZero,
+            &mut tree,
+            &mut Paths64::new(),
+        );
+    });
     Ok(grid.shapes(&tree))
+}
+
+thread_local! {
+    static CLIPPER: std::cell::RefCell<Clipper64> = std::cell::RefCell::new(Clipper64::new());
 }
 
 /// The overlay's coordinates span this many integer steps: fine enough that snapping moves a
@@ -353,15 +361,19 @@ pub(crate) fn cancel_opposite<E: Copy>(
 /// (the winding number of what remains is that of the faces), one shadow per connected set of
 /// faces. `None` if the edges do not close, which faces of distinct corners always do.
 fn outlines(edges: Vec<SheetEdge>) -> Option<Vec<Shadow>> {
-    let mut sheets = Components::default();
+    let mut sheets = Components::with_capacity(edges.len());
     for e in &edges {
         sheets.join(e.from, e.to);
     }
     let kept = cancel_opposite(edges, |e| (e.from, e.to));
     // Walk the surviving edges into closed loops: every corner has as many edges in as out.
-    let mut leaving: HashMap<CornerKey, Vec<usize>, FixedState> = HashMap::default();
-    for (k, e) in kept.iter().enumerate().rev() {
-        leaving.entry(e.from).or_default().push(k);
+    // The edges leaving each corner, in the order of `kept`, and where the next unused one is.
+    let mut by_start: Vec<usize> = (0..kept.len()).collect();
+    by_start.sort_unstable_by_key(|&k| (kept[k].from, k));
+    let mut leaving: HashMap<CornerKey, usize, FixedState> =
+        HashMap::with_capacity_and_hasher(kept.len(), FixedState::default());
+    for (position, &k) in by_start.iter().enumerate().rev() {
+        leaving.insert(kept[k].from, position);
     }
     let mut used = vec![false; kept.len()];
     let mut shadows: Vec<Shadow> = Vec::new();
@@ -374,8 +386,9 @@ fn outlines(edges: Vec<SheetEdge>) -> Option<Vec<Shadow>> {
         let mut contour = vec![kept[start].at];
         let mut at = kept[start].to;
         while at != kept[start].from {
-            let next = leaving.get_mut(&at).and_then(|list| {
-                while let Some(k) = list.pop() {
+            let next = leaving.get_mut(&at).and_then(|position| {
+                while let Some(&k) = by_start.get(*position).filter(|&&k| kept[k].from == at) {
+                    *position += 1;
                     if !used[k] {
                         return Some(k);
                     }
@@ -397,7 +410,6 @@ fn outlines(edges: Vec<SheetEdge>) -> Option<Vec<Shadow>> {
 }
 
 /// Corners joined by edges, as disjoint sets (union by size, path halving).
-#[derive(Default)]
 struct Components {
     index: HashMap<CornerKey, u32, FixedState>,
     parent: Vec<u32>,
@@ -406,6 +418,16 @@ struct Components {
 }
 
 impl Components {
+    /// Room for this many edges' corners.
+    fn with_capacity(edges: usize) -> Self {
+        Components {
+            index: HashMap::with_capacity_and_hasher(edges, FixedState::default()),
+            parent: Vec::with_capacity(edges),
+            size: Vec::with_capacity(edges),
+            last: None,
+        }
+    }
+
     fn slot(&mut self, key: CornerKey) -> u32 {
         // Edges come in chains (each one's end is the next one's start): look that up once.
         if let Some((last, slot)) = self.last
