@@ -23,7 +23,9 @@ use crate::clip::{
 };
 use crate::lambert::{ReceivingPoint, contour_sum};
 use crate::occluder_tree::{OccluderTree, Reached, ShaftTest, TreeFace};
-use crate::shadow_union::{CornerKey, OverlayLimit, Refusal, ShadowUnion, VisibleShape};
+use crate::shadow_union::{
+    CornerKey, OverlayLimit, Refusal, ShadowUnion, VisibleShape, visible_points,
+};
 use crate::solids::closed_solid_orientation;
 
 /// Visible pieces narrower than this many units in the last place of the coordinates involved
@@ -864,7 +866,7 @@ impl<'a> DirectLight<'a> {
         if visible.is_empty() {
             return Window::Covered;
         }
-        let hull = convex_hull_2d(visible.iter().flatten().flatten().copied().collect());
+        let hull = convex_hull_2d(visible_points(&visible).copied().collect());
         if hull.len() < 3 || area_2d(&hull) > WINDOW_SHRINK * area_2d(piece) {
             return Window::Wide;
         }

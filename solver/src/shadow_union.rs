@@ -132,19 +132,9 @@ impl ShadowUnion {
         {
             return Err(Refusal::NotFinite);
         }
-        // Only what lies in the bound matters to the difference.
-        let mut shadows = clip_shadows(&shadows, bound);
-        // The largest shadows first: where they cover what is visible, the rest is never looked at.
-        let areas: Vec<f64> = shadows
-            .iter()
-            .map(|s| s.iter().map(|c| area_2d(c)).sum())
-            .collect();
-        let mut order: Vec<usize> = (0..shadows.len()).collect();
-        order.sort_by(|&a, &b| areas[b].total_cmp(&areas[a]));
-        let mut shadows: Vec<Shadow> = order
-            .into_iter()
-            .map(|i| std::mem::take(&mut shadows[i]))
-            .collect();
+        // Only what lies in the bound matters to the difference; the largest shadows go first:
+        // where they cover what is visible, the rest is never looked at.
+        let mut shadows = largest_first(clip_shadows(&shadows, bound));
         let mut visible = start;
         let mut batch_edges = FIRST_BATCH_EDGES;
         while !shadows.is_empty() {
@@ -165,7 +155,7 @@ impl ShadowUnion {
                 break;
             }
             // What is left visible lies in its hull: only the later shadows' parts in it matter.
-            let hull = convex_hull_2d(visible.iter().flatten().flatten().copied().collect());
+            let hull = convex_hull_2d(visible_points(&visible).copied().collect());
             shadows = clip_shadows(&later, &hull);
             batch_edges = (batch_edges * 2).min(BATCH_EDGES);
         }
@@ -173,7 +163,8 @@ impl ShadowUnion {
     }
 }
 
-fn visible_points(shapes: &[VisibleShape]) -> impl Iterator<Item = &DVec2> {
+/// Every corner of the shapes.
+pub(crate) fn visible_points(shapes: &[VisibleShape]) -> impl Iterator<Item = &DVec2> {
     shapes.iter().flatten().flatten()
 }
 
@@ -181,6 +172,14 @@ fn visible_points(shapes: &[VisibleShape]) -> impl Iterator<Item = &DVec2> {
 /// a convex shadow, or a connected sheet's outline with its holes (only together are they a
 /// shadow; the outline alone would cover the holes).
 type Shadow = Vec<Vec<DVec2>>;
+
+/// The shadows by area, largest first (ties in their given order).
+fn largest_first(mut shadows: Vec<Shadow>) -> Vec<Shadow> {
+    let area = |s: &Shadow| s.iter().map(|c| area_2d(c)).sum::<f64>();
+    let mut ranked: Vec<(f64, Shadow)> = shadows.drain(..).map(|s| (area(&s), s)).collect();
+    ranked.sort_by(|a, b| b.0.total_cmp(&a.0));
+    ranked.into_iter().map(|(_, s)| s).collect()
+}
 
 /// Each shadow's loops clipped to a convex region (the winding inside it stays); shadows left
 /// without a loop are dropped.
