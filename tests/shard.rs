@@ -232,33 +232,21 @@ fn run_refuses_shards_it_cannot_split() {
         );
         assert!(message.contains(if bad == "2/2" { "0 to 1" } else { "I/N" }) || bad == "0/0");
     }
-    refused(
-        &[
-            "run",
-            "textbook",
-            "--direct-only",
-            "--shard",
-            "0/2",
-            "--refine-tol",
-            "0.01",
-            "--out",
-            out_s,
-        ],
-        &["--shard with --refine-tol"],
-    );
-    refused(
-        &[
-            "run",
-            "textbook",
-            "--direct-only",
-            "--shard",
-            "0/2",
-            "--time-budget",
-            "5",
-            "--out",
-            out_s,
-        ],
-        &["--shard with --time-budget"],
-    );
+    for (flag, value) in [("--refine-tol", "0.01"), ("--time-budget", "5")] {
+        refused(
+            &[
+                "run",
+                "textbook",
+                "--direct-only",
+                "--shard",
+                "0/2",
+                flag,
+                value,
+                "--out",
+                out_s,
+            ],
+            &[&format!("--shard with {flag}")],
+        );
+    }
     assert!(!out.exists(), "nothing written");
 }

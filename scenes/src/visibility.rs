@@ -368,7 +368,7 @@ impl Visibility {
         ignore: Option<SurfaceId>,
     ) -> Option<Hit> {
         let bvh = self.rays.as_ref()?;
-        if !origin.is_finite() || !direction.is_finite() || direction == DVec3::ZERO {
+        if !ray_is_usable(origin, direction) {
             return None;
         }
         let ray = self.f32_ray(origin, direction, t_min, t_max)?;
@@ -400,7 +400,7 @@ impl Visibility {
         t_max: f64,
         ignore: Option<SurfaceId>,
     ) -> Option<Hit> {
-        if !origin.is_finite() || !direction.is_finite() || direction == DVec3::ZERO {
+        if !ray_is_usable(origin, direction) {
             return None;
         }
         let mut best: Option<(f64, usize)> = None;
@@ -631,6 +631,11 @@ pub fn intersect_watertight(origin: DVec3, direction: DVec3, v: &[DVec3; 3]) -> 
     }
     let t_scaled = u * sz * a[kz] + w_v * sz * b[kz] + w * sz * c[kz];
     Some(t_scaled / det)
+}
+
+/// Whether a ray has a finite start and a finite, non-zero direction.
+fn ray_is_usable(origin: DVec3, direction: DVec3) -> bool {
+    origin.is_finite() && direction.is_finite() && direction != DVec3::ZERO
 }
 
 #[cfg(test)]

@@ -71,6 +71,11 @@ struct ConvexPiece {
 }
 
 impl ConvexPiece {
+    /// Whether the piece's plane passes within `tol` of `point`.
+    fn holds(&self, point: DVec3, tol: f64) -> bool {
+        self.normal.dot(point - self.polygon[0]).abs() <= tol
+    }
+
     fn new(
         surface: SurfaceId,
         polygon: Vec<DVec3>,
@@ -143,6 +148,16 @@ struct Emitter {
 }
 
 impl Emitter {
+    /// The lowest and highest of the points' heights above the emitter's plane.
+    fn height_range(&self, points: &[DVec3]) -> (f64, f64) {
+        points
+            .iter()
+            .map(|&p| self.frame.height(p))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), h| {
+                (lo.min(h), hi.max(h))
+            })
+    }
+
     /// Visible pieces and shadows no wider than this, seen from `point`, are slivers of rounding:
     /// coordinates as large as the emitter's and the point's carry this error.
     fn sliver_width(&self, point: DVec3) -> f64 {
@@ -577,7 +592,7 @@ impl<'a> DirectLight<'a> {
                 out.push(vec![front]);
                 continue;
             }
-            let visible = self.unblocked(x, receiver, e, &front, h_x)?;
+            let visible = self.unblocked(x, receiver, e, &front, h_x, true)?;
             out.extend(visible.into_iter().map(|shape| {
                 shape
                     .into_iter()
@@ -589,20 +604,9 @@ impl<'a> DirectLight<'a> {
     }
 
     /// `front` (a convex piece of the emitter, in front of x) minus the projections of the
-    /// occluders in the shaft, in the emitter's 2D frame.
+    /// occluders in the shaft, in the emitter's 2D frame; narrowing the shaft where it is full
+    /// (`narrow`, [`Self::blockings`]).
     fn unblocked(
-        &self,
-        x: &ReceivingPoint,
-        receiver: SurfaceId,
-        e: &Emitter,
-        front: &[DVec3],
-        h_x: f64,
-    ) -> Result<Vec<VisibleShape>, TooComplex> {
-        self.unblocked_narrowing(x, receiver, e, front, h_x, true)
-    }
-
-    /// [`Self::unblocked`], narrowing the shaft where it is full (`narrow`).
-    fn unblocked_narrowing(
         &self,
         x: &ReceivingPoint,
         receiver: SurfaceId,
@@ -641,7 +645,7 @@ impl<'a> DirectLight<'a> {
                 Err(Refusal::TooComplex) => return Err(TooComplex),
                 // The narrowed shaft's blockings alone do not cover the rest of the piece.
                 Err(Refusal::NotFinite) if narrowed => {
-                    return self.unblocked_narrowing(x, receiver, e, front, h_x, false);
+                    return self.unblocked(x, receiver, e, front, h_x, false);
                 }
                 Err(Refusal::NotFinite) => {}
             }
@@ -701,18 +705,12 @@ impl<'a> DirectLight<'a> {
             // A plane through x is seen edge-on: it hides nothing, unless x lies on the occluder
             // itself (a blocker standing on the receiver); then the limit from inside the
             // receiving surface sees it hide everything across its plane, within its corner.
-            if occ.normal.dot(point - occ.polygon[0]).abs() <= tol {
+            if occ.holds(point, tol) {
                 blockings.push(Blocking::Touching(index));
                 continue;
             }
             // Wholly outside one side of the shaft, or beyond the emitter's plane: no shadow.
-            let (lowest, highest) = occ
-                .polygon
-                .iter()
-                .map(|&p| e.frame.height(p))
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), h| {
-                    (lo.min(h), hi.max(h))
-                });
+            let (lowest, highest) = e.height_range(&occ.polygon);
             if highest < 0.0
                 || sides
                     .iter()
@@ -850,11 +848,8 @@ impl<'a> DirectLight<'a> {
             let occ = &self.occluders[index];
             // Faces through x, or not wholly between the planes within reach, wait for the
             // full pass.
-            let between = occ.polygon.iter().all(|&p| {
-                let h = e.frame.height(p);
-                (0.0..=reach).contains(&h)
-            });
-            if !between || occ.normal.dot(point - occ.polygon[0]).abs() <= self.tol {
+            let (lowest, highest) = e.height_range(&occ.polygon);
+            if lowest < 0.0 || highest > reach || occ.holds(point, self.tol) {
                 continue;
             }
             let corners: Vec<DVec2> = occ.polygon.iter().map(|&p| project(p)).collect();

@@ -487,14 +487,14 @@ mod tests {
         shapes.iter().flatten().map(|c| area_2d(c)).sum()
     }
 
-    /// A 4 x 4 grid of corners, split into 18 triangles (some listed clockwise): the sheet's
-    /// inner edges cancel and its outline is the grid's square.
-    #[test]
-    fn a_welded_sheet_fuses_into_its_outline() {
-        let corner = |i: u32, j: u32| (key(4 * i + j), DVec2::new(i as f64, j as f64) * 0.25);
+    /// The cells of an n x n grid of squares of side `step` that `keep` keeps, each as two
+    /// triangles with welded corners, the second listed clockwise on purpose (faces are oriented
+    /// by their projection).
+    fn welded_grid(n: u32, step: f64, keep: impl Fn(u32, u32) -> bool) -> ShadowUnion {
+        let corner = |i: u32, j: u32| (key((n + 1) * i + j), DVec2::new(i as f64, j as f64) * step);
         let mut union = ShadowUnion::default();
-        for i in 0..3 {
-            for j in 0..3 {
+        for i in 0..n {
+            for j in (0..n).filter(|&j| keep(i, j)) {
                 let (a, b, c, d) = (
                     corner(i, j),
                     corner(i + 1, j),
@@ -502,10 +502,17 @@ mod tests {
                     corner(i, j + 1),
                 );
                 union.add_face(&[a.0, b.0, c.0], &[a.1, b.1, c.1]);
-                // Clockwise on purpose: faces are oriented by their projection.
                 union.add_face(&[a.0, d.0, c.0], &[a.1, d.1, c.1]);
             }
         }
+        union
+    }
+
+    /// A 4 x 4 grid of corners, split into 18 triangles (some listed clockwise): the sheet's
+    /// inner edges cancel and its outline is the grid's square.
+    #[test]
+    fn a_welded_sheet_fuses_into_its_outline() {
+        let union = welded_grid(3, 0.25, |_, _| true);
         let loops = outlines(union.sheet.clone()).expect("closes");
         assert_eq!(loops.len(), 1);
         assert_eq!(loops[0].len(), 1, "one loop");
@@ -521,23 +528,8 @@ mod tests {
     /// ring too.
     #[test]
     fn a_sheet_with_a_hole_keeps_its_hole() {
-        let corner = |i: u32, j: u32| (key(5 * i + j), DVec2::new(i as f64, j as f64));
-        let mut union = ShadowUnion::default();
-        for i in 0..4 {
-            for j in 0..4 {
-                if (1..3).contains(&i) && (1..3).contains(&j) {
-                    continue;
-                }
-                let (a, b, c, d) = (
-                    corner(i, j),
-                    corner(i + 1, j),
-                    corner(i + 1, j + 1),
-                    corner(i, j + 1),
-                );
-                union.add_face(&[a.0, b.0, c.0], &[a.1, b.1, c.1]);
-                union.add_face(&[a.0, c.0, d.0], &[a.1, c.1, d.1]);
-            }
-        }
+        let middle = |i: u32| (1..3).contains(&i);
+        let union = welded_grid(4, 1.0, |i, j| !(middle(i) && middle(j)));
         let shadows = outlines(union.sheet.clone()).expect("closes");
         assert_eq!(shadows.len(), 1);
         let mut loops: Vec<usize> = shadows[0].iter().map(Vec::len).collect();
