@@ -9,7 +9,7 @@ use crate::shard::{Shard, ShardError};
 use penumbra_meshing::discontinuity::{DiscontinuityOptions, find_discontinuities_reporting};
 use penumbra_meshing::grading::DEFAULT_PENUMBRA_DENSITY;
 use penumbra_meshing::{
-    ElementBudget, MeshError, SceneMesh, mesh_scene_discontinuity, mesh_scene_uniform,
+    ElementBudget, MeshError, SceneMesh, mesh_scene_discontinuity_on, mesh_scene_uniform,
     polygon_minimum,
 };
 use penumbra_scenes::{LoadedScene, Rgb, Visibility};
@@ -296,6 +296,12 @@ pub fn run(
     times.visibility = t.elapsed().as_secs_f64();
     peaks.visibility = memory::peak_resident_bytes();
 
+    // A shard of a large scene finds the discontinuities of its own surfaces and meshes them
+    // alone: each one's share of a fitted budget then depends on nothing else.
+    let shard_surfaces = options
+        .shard
+        .filter(|_| crate::shard::meshed_alone(scene, options))
+        .map(|shard| shard.surfaces(surfaces));
     let t = Instant::now();
     let found = match options.mesh {
         MeshMethod::Uniform => None,
@@ -306,6 +312,7 @@ pub fn run(
                 element_area: Some(scene.total_area() / planned_budget(scene, options) as f64),
                 deadline: solver.deadline,
                 interrupt: options.solver.interrupt.clone(),
+                receivers: shard_surfaces.as_deref().map(Into::into),
                 ..options.discontinuity.clone()
             },
             progress,
@@ -323,12 +330,13 @@ pub fn run(
                 || found.stats.segments > 0
                 || found.stats.pairs_skipped > 0 =>
         {
-            mesh_scene_discontinuity(
+            mesh_scene_discontinuity_on(
                 scene,
                 &visibility,
                 found,
                 initial_budget,
                 options.penumbra_density,
+                shard_surfaces.as_deref(),
             )
         }
         _ => mesh_scene_uniform(scene, initial_budget),

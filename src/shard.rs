@@ -2,21 +2,24 @@
 //! scheduler (a Slurm job array, GNU parallel), then joined.
 //!
 //! Shard `I` of `N` (`0 <= I < N`) lights the surfaces whose index in the scene is `I` modulo
-//! `N`. Everything else is computed for the whole scene, exactly as in a run that is not split,
-//! so that each surface's mesh and values are the same to the bit:
+//! `N`, so that each surface's mesh and values are those of the run not split, to the bit:
 //!
-//! - the discontinuity search and every surface's constrained triangulation: the element budget
-//!   fitted to the scene, and each surface's share of it, depend on every surface's least mesh,
-//!   which depends on its discontinuities;
-//! - the refined meshes: the exact direct light at a point shared by several surfaces (the faces
-//!   of a tessellated mesh meeting at a vertex) is evaluated once for all of them, so a vertex's
-//!   value depends on which vertices of other surfaces share its point.
+//! - a large scene (its polygons alone need more triangles than the fitted budget's floor;
+//!   [`meshed_alone`]): the shard finds the discontinuities of its own surfaces and meshes them
+//!   alone, since each surface's share of the budget depends on nothing but the surface and the
+//!   scene's polygons; the other surfaces get empty meshes;
+//! - otherwise (a budget chosen with `--max-elements`, or a scene within the floor) the budget
+//!   is spread over all surfaces, and each one's share depends on every surface's least mesh, so
+//!   every shard finds the discontinuities of the whole scene and meshes every surface;
+//! - the direct light at a vertex is the same whichever other surfaces have a vertex at its
+//!   point: the faces meeting there share one view of the light, taken from the point they round
+//!   to ([`penumbra_solver::DirectLight::irradiance_group`]).
 //!
-//! What is split is the direct light at the vertices, which is most of a large run (the scanned
-//! statue: 195 of 212 s). Each shard writes [`SHARD_FILE`] (its surfaces' part of
-//! `solution.json`, its report and a fingerprint of the scene and the options) and the SVGs of
-//! its surfaces; [`merge`] checks that the shards belong to one run, that none is missing or
-//! twice, and joins them into the `solution.json` the run would have written, byte for byte.
+//! Each shard writes [`SHARD_FILE`] (its surfaces' part of `solution.json`, its report and a
+//! fingerprint of the scene and the options) and the SVGs of its surfaces; [`merge`] checks
+//! that the shards belong to one run, that none is missing or twice, and joins them into the
+//! `solution.json` the run would have written, byte for byte, with the report's figures of the
+//! discontinuities and the mesh summed over the shards that meshed alone.
 //!
 //! A full solution cannot be split this way: light bounces between all surfaces, so every
 //! surface's radiosity depends on every other's. Adaptive refinement spends one budget over the
@@ -25,14 +28,14 @@
 
 use std::path::{Path, PathBuf};
 
-use penumbra_meshing::{SceneMesh, SurfaceMesh};
-use penumbra_scenes::{LoadedScene, PlaneFrame, Rgb, SceneError, SurfaceId};
+use penumbra_meshing::{SceneMesh, SurfaceMesh, polygon_minimum, quality_of};
+use penumbra_scenes::{LoadedScene, PlaneFrame, Rgb, Scene, SceneError, SurfaceId};
 use serde::{Deserialize, Serialize};
 
 use crate::energy::EnergyBalance;
 use crate::outputs::{
-    SVG_DIR, Staging, SurfaceSolution, SvgSelection, report_json, solution_json_of,
-    surface_solution, svg_name,
+    DEFAULT_SVG_SURFACES, SVG_DIR, Staging, SurfaceSolution, SvgSelection, report_json,
+    solution_json_of, surface_solution, svg_name, worth_looking_at,
 };
 use crate::pipeline::{RunOptions, RunResult};
 
@@ -121,6 +124,18 @@ impl Shard {
     }
 }
 
+/// Whether a shard of a run with these options finds the discontinuities of its own surfaces and
+/// meshes them alone: a fitted budget of a scene whose polygons need more than the budget's
+/// floor ([`penumbra_meshing::ElementBudget::planned_alone`]) gives each surface a share that depends on nothing
+/// else. Otherwise each shard meshes the whole scene, as the run not split does.
+pub fn meshed_alone(scene: &Scene, options: &RunOptions) -> bool {
+    options.refine.is_none()
+        && options
+            .max_elements
+            .planned_alone(polygon_minimum(scene), scene.surfaces.len())
+            .is_some()
+}
+
 impl std::fmt::Display for Shard {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(f, "{}/{}", self.index, self.count)
@@ -154,8 +169,12 @@ pub struct ShardFile {
     pub render_height: u32,
     /// The loader's warnings.
     pub warnings: Vec<String>,
-    /// The shard's `report.json`: the whole scene's discontinuities, mesh and counts (every shard
-    /// builds them), and the power this shard's surfaces absorbed and received.
+    /// Whether the shard found the discontinuities of its own surfaces and meshed them alone
+    /// ([`meshed_alone`]); else it meshed the whole scene.
+    #[serde(default)]
+    pub meshed_alone: bool,
+    /// The shard's `report.json`: the discontinuities, mesh and counts of the surfaces it meshed
+    /// (its own, or the whole scene's), and the power its surfaces absorbed and received.
     pub report: serde_json::Value,
     /// The SVGs written beside this file, relative to its directory.
     pub svgs: Vec<String>,
@@ -182,11 +201,15 @@ pub fn scene_fingerprint(loaded: &LoadedScene) -> String {
 }
 
 /// The fingerprint of a run: its scene, and the options `report.json` records (the thread
-/// count aside, which changes no output), the render's size and the SVG selection.
+/// count aside, which changes no output, and what shards that mesh alone find for their own
+/// surfaces: the budget resolved and the mesh `auto` chose), the render's size and the SVG
+/// selection.
 fn run_fingerprint(report: &serde_json::Value, scene: &str, svgs: &SvgSelection) -> String {
     let mut method = report.get("method").cloned().unwrap_or_default();
     if let Some(m) = method.as_object_mut() {
-        m.remove("threads");
+        for found in ["threads", "max_elements", "mesh"] {
+            m.remove(found);
+        }
     }
     let render = report
         .get("render")
@@ -248,6 +271,7 @@ pub fn write_shard(
         render_width: result.render.image.width(),
         render_height: result.render.image.height(),
         warnings: result.loaded.warnings.clone(),
+        meshed_alone: meshed_alone(scene, &result.options),
         report,
         svgs: written,
         surfaces: (0..scene.surfaces.len())
@@ -282,6 +306,18 @@ pub enum MergeError {
         first: PathBuf,
         dir: PathBuf,
         what: &'static str,
+    },
+    #[error(
+        "{} meshed its surfaces by {mesh} but {} by {first_mesh}: with --mesh auto, a shard whose \
+         surfaces cast and receive no shadows meshes them uniformly, unlike the run not split; \
+         run every shard with --mesh discontinuity",
+        .dir.display(), .first.display()
+    )]
+    MeshChoice {
+        first: PathBuf,
+        dir: PathBuf,
+        first_mesh: String,
+        mesh: String,
     },
     #[error("shard {shard} is given twice: {} and {}", .first.display(), .second.display())]
     Duplicate {
@@ -378,6 +414,21 @@ pub fn check_shards(
         if file.shard.count != first.shard.count {
             return Err(mixed("their shard counts"));
         }
+        let mesh = |f: &ShardFile| {
+            f.report
+                .pointer("/method/mesh")
+                .and_then(serde_json::Value::as_str)
+                .unwrap_or_default()
+                .to_owned()
+        };
+        if mesh(file) != mesh(first) {
+            return Err(MergeError::MeshChoice {
+                first: first_dir.clone(),
+                dir: dir.clone(),
+                first_mesh: mesh(first),
+                mesh: mesh(file),
+            });
+        }
     }
     let count = first.shard.count;
     shards.sort_by_key(|(_, f)| f.shard.index);
@@ -450,7 +501,12 @@ pub fn merge(
         });
     }
     let mut report = first.report.clone();
+    if first.meshed_alone {
+        let reports: Vec<&serde_json::Value> = shards.iter().map(|(_, f)| &f.report).collect();
+        sum_mesh_figures(&mut report, &reports);
+    }
     let (width, height) = (first.render_width, first.render_height);
+    let first_meshed_alone = first.meshed_alone;
     let warnings = first.warnings.clone();
     let count = first.shard.count;
     let scene = &loaded.scene;
@@ -460,7 +516,7 @@ pub fn merge(
     let mut svgs = Vec::new();
     let mut parts = Vec::new();
     // Patches lie within one surface, so what is left unshot, its magnitude and the ambient
-    // term made from it (linear in it: every shard has the whole mesh's area and mean
+    // term made from it (linear in it, when every shard has the whole mesh's area and mean
     // reflectance) add up over the shards, to rounding.
     let mut absorbed = Rgb::ZERO;
     let mut received = Rgb::ZERO;
@@ -507,6 +563,10 @@ pub fn merge(
             }
         }
     }
+    if first_meshed_alone {
+        // Shards that meshed alone each knew only their own surfaces' area and reflectance.
+        ambient = ambient_of(scene, unshot);
+    }
     let surfaces: Vec<SurfaceSolution> = surfaces
         .into_iter()
         .enumerate()
@@ -518,6 +578,21 @@ pub fn merge(
         })
         .collect::<Result<_, _>>()?;
     svgs.sort_by(|a, b| a.1.cmp(&b.1));
+    let auto = report
+        .pointer("/svgs/selection")
+        .and_then(serde_json::Value::as_str)
+        == Some("auto");
+    if first_meshed_alone && auto {
+        // Each shard chose among its own surfaces (it knows no other's discontinuities); the
+        // run's choice is among the shards' choices.
+        let segments: Vec<usize> = surfaces.iter().map(|s| s.discontinuities.len()).collect();
+        let chosen: std::collections::HashSet<String> =
+            worth_looking_at(scene, &segments, DEFAULT_SVG_SURFACES)
+                .into_iter()
+                .map(|s| format!("{SVG_DIR}/{}", svg_name(s, &scene.surfaces[s].name)))
+                .collect();
+        svgs.retain(|(_, name)| chosen.contains(name));
+    }
 
     // The render, from the joined meshes (their 3D vertices and triangles).
     let render_started = std::time::Instant::now();
@@ -557,6 +632,13 @@ pub fn merge(
     let vertices = surfaces.iter().map(|s| s.vertices.len()).sum();
     if let Some(r) = report.as_object_mut() {
         r.insert("partial".to_owned(), false.into());
+        if first_meshed_alone {
+            let quality = quality_of(&mesh.surfaces);
+            r.insert(
+                "mesh_quality".to_owned(),
+                serde_json::to_value(quality).unwrap_or_default(),
+            );
+        }
         r.insert("warnings".to_owned(), all_warnings.into());
         r.insert(
             "energy".to_owned(),
@@ -610,6 +692,59 @@ pub fn merge(
         render_png,
         svgs,
     })
+}
+
+/// The figures of shards that each meshed their own surfaces, joined into `report`: the
+/// discontinuity search's, the mesh's counts and the budget resolved, summed (the largest of
+/// those named `..._max`).
+fn sum_mesh_figures(report: &mut serde_json::Value, shards: &[&serde_json::Value]) {
+    let sum = |path: &str| -> serde_json::Value {
+        let values: Vec<&serde_json::Value> =
+            shards.iter().filter_map(|r| r.pointer(path)).collect();
+        let floats = values.iter().filter_map(|v| v.as_f64());
+        if path.ends_with("_max") {
+            floats.fold(f64::NEG_INFINITY, f64::max).into()
+        } else if values.iter().all(|v| v.is_u64()) {
+            values.iter().filter_map(|v| v.as_u64()).sum::<u64>().into()
+        } else {
+            floats.sum::<f64>().into()
+        }
+    };
+    let mut paths = vec![
+        "/method/max_elements".to_owned(),
+        "/counts/triangles".to_owned(),
+        "/counts/vertices".to_owned(),
+        "/counts/patches".to_owned(),
+        "/counts/discontinuity_segments".to_owned(),
+    ];
+    if let Some(found) = report.get("discontinuities").and_then(|d| d.as_object()) {
+        paths.extend(
+            found
+                .iter()
+                .filter(|(_, v)| v.is_number())
+                .map(|(key, _)| format!("/discontinuities/{key}")),
+        );
+    }
+    for path in paths {
+        let total = sum(&path);
+        if let Some(slot) = report.pointer_mut(&path) {
+            *slot = total;
+        }
+    }
+}
+
+/// The ambient term of a solution that left `unshot` power unshot: spread over the scene's area
+/// and reflected on without end at its mean reflectance (as the solver makes it from its
+/// elements, which cover the polygons).
+fn ambient_of(scene: &Scene, unshot: Rgb) -> Rgb {
+    let area: f64 = scene.surfaces.iter().map(|s| s.area()).sum();
+    let mean_reflectance = scene
+        .surfaces
+        .iter()
+        .map(|s| s.reflectance * s.area())
+        .sum::<Rgb>()
+        / area;
+    (unshot / area).mul_rgb(mean_reflectance.map(|r| 1.0 / (1.0 - r)))
 }
 
 /// An RGB triple at `path` in a report, zero if absent.

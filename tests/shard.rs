@@ -36,14 +36,20 @@ fn path(p: &Path) -> &str {
     p.to_str().expect("utf-8")
 }
 
-/// A small direct-only run of `scene` into `out`, with `extra` options.
+/// A budget that keeps a run small, and spreads it over all surfaces (so that every shard meshes
+/// the whole scene).
+const CAP: &[&str] = &["--max-elements", "2500"];
+
+/// A direct-only run of `scene` into `out`, with `extra` options (by default [`CAP`]).
 fn run(scene: &str, out: &Path, extra: &[&str]) {
+    let budget = match extra.contains(&"--fit") {
+        true => &[][..],
+        false => CAP,
+    };
     let mut args = vec![
         "run",
         scene,
         "--direct-only",
-        "--max-elements",
-        "2500",
         "--width",
         "96",
         "--height",
@@ -52,7 +58,8 @@ fn run(scene: &str, out: &Path, extra: &[&str]) {
         "--out",
         path(out),
     ];
-    args.extend(extra);
+    args.extend(budget);
+    args.extend(extra.iter().filter(|&&a| a != "--fit"));
     succeeds(&args);
 }
 
@@ -95,16 +102,40 @@ fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
     all
 }
 
+/// `--fit`: the default budget, fitted to the scene: `boxworld-1000`'s polygons need more than
+/// its floor, so each shard finds the discontinuities of its own surfaces and meshes them alone.
 #[test]
 fn shards_merge_into_the_run_not_split_byte_for_byte() {
     let dir = tempfile::tempdir().expect("temp dir");
-    for scene in ["cornell", "boxworld-12", "tessellated-2"] {
+    let cases: [(&str, &[&str]); 4] = [
+        ("cornell", &[]),
+        ("boxworld-12", &[]),
+        ("tessellated-2", &[]),
+        ("boxworld-1000", &["--fit"]),
+    ];
+    for (scene, extra) in cases {
         let whole = dir.path().join(format!("{scene}-whole"));
-        run(scene, &whole, &[]);
+        run(scene, &whole, extra);
         let expected = files(&whole);
         for count in [1, 2, 3] {
             let root = dir.path().join(format!("{scene}-{count}"));
-            let dirs = shards(scene, &root, count, &[]);
+            let dirs = shards(scene, &root, count, extra);
+            let alone = extra.contains(&"--fit");
+            for d in &dirs {
+                let shard: serde_json::Value =
+                    serde_json::from_slice(&std::fs::read(d.join("shard.json")).expect("shard"))
+                        .expect("JSON");
+                assert_eq!(shard["meshed_alone"], alone, "{scene}: {}", d.display());
+                // A shard that meshes alone meshes only its own surfaces.
+                let triangles = |r: &serde_json::Value| r["counts"]["triangles"].as_u64();
+                let whole_report: serde_json::Value = serde_json::from_slice(
+                    &std::fs::read(whole.join("report.json")).expect("report"),
+                )
+                .expect("JSON");
+                if alone && count > 1 {
+                    assert!(triangles(&shard["report"]) < triangles(&whole_report));
+                }
+            }
             let out = root.join("merged");
             let o = merge(&dirs, &out);
             assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -130,6 +161,15 @@ fn shards_merge_into_the_run_not_split_byte_for_byte() {
                     .expect("JSON");
             assert_eq!(report["shards"]["count"], count);
             assert_eq!(report["counts"], whole_report["counts"]);
+            assert_eq!(
+                report["discontinuities"]["pairs"],
+                whole_report["discontinuities"]["pairs"]
+            );
+            assert_eq!(
+                report["discontinuities"]["segments"],
+                whole_report["discontinuities"]["segments"]
+            );
+            assert_eq!(report["svgs"]["written"], whole_report["svgs"]["written"]);
             assert_eq!(
                 report["method"]["max_elements"],
                 whole_report["method"]["max_elements"]

@@ -27,6 +27,9 @@ pub mod uniform;
 pub use budget::{ElementBudget, FIT_TRIANGLES_PER_SURFACE, polygon_minimum};
 pub use error::MeshError;
 pub use mesh::{MeshQuality, SurfaceMesh, quality_of};
-pub use scene_mesh::{SceneMesh, mesh_scene_discontinuity, mesh_scene_uniform, spread_by_area};
+pub use scene_mesh::{
+    SceneMesh, mesh_scene_discontinuity, mesh_scene_discontinuity_on, mesh_scene_uniform,
+    share_alone, spread_by_area,
+};
 pub use uniform::{MeshCoordinates, mesh_surface_uniform};
 pub mod discontinuity;

@@ -2,7 +2,7 @@
 
 use glam::{DVec2, DVec3};
 use penumbra_scenes::polygon::{orient, signed_area_2d};
-use penumbra_scenes::{PlaneFrame, SurfaceId};
+use penumbra_scenes::{PlaneFrame, Surface, SurfaceId};
 use serde::Serialize;
 
 use crate::error::MeshError;
@@ -48,6 +48,26 @@ pub struct MeshQuality {
 }
 
 impl SurfaceMesh {
+    /// A mesh of no triangles: a surface left to another shard of a run.
+    pub fn empty(id: SurfaceId, surface: &Surface) -> Result<SurfaceMesh, MeshError> {
+        let frame =
+            PlaneFrame::of_polygon(&surface.polygon).ok_or_else(|| MeshError::Degenerate {
+                surface: id,
+                name: surface.name.clone(),
+            })?;
+        Ok(SurfaceMesh {
+            surface: id,
+            frame,
+            scale: 1.0,
+            local: Vec::new(),
+            points3: Vec::new(),
+            triangles: Vec::new(),
+            boundary: Vec::new(),
+            constraints: Vec::new(),
+            polygon_area: surface.area(),
+        })
+    }
+
     pub fn vertex_count(&self) -> usize {
         self.local.len()
     }

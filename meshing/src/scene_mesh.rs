@@ -7,7 +7,7 @@ use rayon::prelude::*;
 use glam::DVec3;
 use penumbra_scenes::{PlaneFrame, Scene, SurfaceId, Visibility};
 
-use crate::budget::{ElementBudget, polygon_triangles};
+use crate::budget::{ElementBudget, polygon_minimum, polygon_triangles};
 use crate::constrained::{ConstrainedSurface, Constraint, RefinableSurface};
 use crate::discontinuity::{
     Discontinuities, DiscontinuitySegment, DiscontinuityStats, EmitterProbe, Event,
@@ -173,11 +173,35 @@ pub fn mesh_scene_discontinuity(
     budget: impl Into<ElementBudget>,
     penumbra_density: f64,
 ) -> Result<SceneMesh, MeshError> {
+    mesh_scene_discontinuity_on(scene, visibility, found, budget, penumbra_density, None)
+}
+
+/// [`mesh_scene_discontinuity`] of the surfaces `on` holds (all when `None`), when each
+/// surface's share of the budget depends on it alone ([`ElementBudget::planned_alone`]): the
+/// others get an empty mesh, and the budget, counts and least mesh are those of the surfaces
+/// meshed. A budget spread over all surfaces needs every surface's least mesh, so then every
+/// surface is meshed. A surface's mesh is the same whichever others are meshed.
+pub fn mesh_scene_discontinuity_on(
+    scene: &Scene,
+    visibility: &Visibility,
+    found: Discontinuities,
+    budget: impl Into<ElementBudget>,
+    penumbra_density: f64,
+    on: Option<&[bool]>,
+) -> Result<SceneMesh, MeshError> {
+    let budget = budget.into();
+    let alone = budget.planned_alone(polygon_minimum(scene), scene.surfaces.len());
+    let meshed: Vec<bool> = (0..scene.surfaces.len())
+        .map(|id| alone.is_none() || on.is_none_or(|on| on.get(id).copied().unwrap_or(false)))
+        .collect();
     let constrained = scene
         .surfaces
         .par_iter()
         .enumerate()
         .map(|(id, s)| {
+            if !meshed[id] {
+                return Ok(None);
+            }
             let segments = found.segments.get(id).map(Vec::as_slice).unwrap_or(&[]);
             let constraints: Vec<Constraint> = match PlaneFrame::of_polygon(&s.polygon) {
                 Some(frame) => segments
@@ -190,7 +214,7 @@ pub fn mesh_scene_discontinuity(
                     .collect(),
                 None => Vec::new(),
             };
-            ConstrainedSurface::new(id, s, &constraints)
+            ConstrainedSurface::new(id, s, &constraints).map(Some)
         })
         .collect::<Result<Vec<_>, _>>()?;
     let areas: Vec<f64> = scene
@@ -200,18 +224,22 @@ pub fn mesh_scene_discontinuity(
         .collect();
     let minimum: Vec<usize> = constrained
         .iter()
-        .map(ConstrainedSurface::minimum_triangles)
+        .map(|c| c.as_ref().map_or(0, ConstrainedSurface::minimum_triangles))
         .collect();
-    let (budget, targets) = spread_by_area(&areas, &minimum, budget, true)?;
+    let (budget, targets) = match alone {
+        Some(planned) => share_alone(&areas, &minimum, &meshed, planned),
+        None => spread_by_area(&areas, &minimum, budget, true)?,
+    };
     let minimum_triangles = minimum.iter().sum();
-    let refinable: Vec<RefinableSurface> = constrained
+    let refinable: Vec<Option<RefinableSurface>> = constrained
         .into_par_iter()
         .zip(targets)
         .enumerate()
         .map(|(id, (c, target))| {
+            let c = c?;
             let surface = &scene.surfaces[id];
             let Some(frame) = PlaneFrame::of_polygon(&surface.polygon) else {
-                return c.into_refinable(target, 1.0, &|_| false);
+                return Some(c.into_refinable(target, 1.0, &|_| false));
             };
             let emitters: BTreeSet<SurfaceId> = found
                 .segments
@@ -233,14 +261,27 @@ pub fn mesh_scene_discontinuity(
                     hi > 0.0 && lo < 1.0
                 })
             };
-            c.into_refinable(target, penumbra_density, &varies)
+            Some(c.into_refinable(target, penumbra_density, &varies))
         })
         .collect();
     let surfaces = refinable
         .par_iter()
         .zip(&scene.surfaces)
-        .map(|(r, s)| r.mesh(s))
-        .collect();
+        .enumerate()
+        .map(|(id, (r, s))| match r {
+            Some(r) => Ok(r.mesh(s)),
+            None => SurfaceMesh::empty(id, s),
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let refinable = refinable
+        .into_iter()
+        .zip(&scene.surfaces)
+        .enumerate()
+        .map(|(id, (r, s))| match r {
+            Some(r) => Ok(r),
+            None => RefinableSurface::uniform(id, s, 0),
+        })
+        .collect::<Result<Vec<_>, _>>()?;
     let mut discontinuities = found.segments;
     discontinuities.resize(scene.surfaces.len(), Vec::new());
     let mut hovering = found.hovering;
@@ -254,6 +295,28 @@ pub fn mesh_scene_discontinuity(
         budget,
         minimum_triangles,
     })
+}
+
+/// Each surface's share of `planned` triangles by area, or its least mesh (`minimum[s]`) when
+/// that is more: a target that depends on the surface alone. Surfaces not `meshed` get none.
+/// Returns the targets' sum and the targets.
+pub fn share_alone(
+    areas: &[f64],
+    minimum: &[usize],
+    meshed: &[bool],
+    planned: usize,
+) -> (usize, Vec<usize>) {
+    let total: f64 = areas.iter().sum();
+    let targets: Vec<usize> = areas
+        .iter()
+        .zip(minimum)
+        .zip(meshed)
+        .map(|((&a, &m), &meshed)| match meshed {
+            true => ((planned as f64 * a / total).floor() as usize).max(m),
+            false => 0,
+        })
+        .collect();
+    (targets.iter().sum(), targets)
 }
 
 #[cfg(test)]

@@ -336,22 +336,19 @@ impl<'a> DirectLight<'a> {
             .sum()
     }
 
-    /// The irradiance at receivers that share one point (the faces of a mesh meeting at a
-    /// vertex), each as [`Self::irradiance`] gives it to rounding. What the occluders other than
-    /// the faces through the point hide of each light is found once for all of them; each
-    /// receiver then keeps the part in front of it and loses what the faces through the point
-    /// hide on its side.
-    pub fn irradiance_group(&self, group: &[(ReceivingPoint, SurfaceId)]) -> Vec<Rgb> {
+    /// The irradiance at receivers that share the point `at` (the faces of a mesh meeting at a
+    /// vertex, each at its own rounding of `at`), each as [`Self::irradiance`] gives it to
+    /// rounding. What the occluders other than the faces through `at` hide of each light is
+    /// found once for all of them; each receiver then keeps the part in front of it and loses
+    /// what the faces through the point hide on its side. A receiver's value depends on `at` and
+    /// itself, not on the others.
+    pub fn irradiance_group(&self, at: DVec3, group: &[(ReceivingPoint, SurfaceId)]) -> Vec<Rgb> {
         let mut out = vec![Rgb::ZERO; group.len()];
-        let Some((first, _)) = group.first() else {
+        if group.is_empty() {
             return out;
-        };
+        }
         for (k, e) in self.emitters.iter().enumerate() {
-            let shared = if group.len() > 1 {
-                self.shared_view(first.point, e)
-            } else {
-                Ok(None)
-            };
+            let shared = self.shared_view(at, e);
             for ((x, r), h) in group.iter().zip(&mut out) {
                 let sees =
                     *r != e.surface && x.in_front_of(e.frame.origin, e.frame.normal, self.tol);

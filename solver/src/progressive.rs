@@ -21,6 +21,7 @@ use std::collections::HashMap;
 use std::sync::atomic::Ordering;
 use std::time::Instant;
 
+use glam::DVec3;
 use penumbra_meshing::locate::{TriangleLocator, transfer_density};
 use penumbra_meshing::{SceneMesh, SurfaceMesh};
 use penumbra_scenes::{Rgb, Scene, SurfaceId, Visibility};
@@ -255,11 +256,11 @@ const SHARED_POINT: f64 = 1e-12;
 /// (with 2^15 edges, one Sponza vertex took minutes and gigabytes in a single overlay).
 const OVERLAY_CAP: usize = 1 << 13;
 
-/// The exact direct irradiance at `receivers`, computed once per point for receivers that
-/// share one (faces of a mesh meeting at a vertex; see [`DirectLight::irradiance_group`]).
-/// Only the groups holding a receiver that `wanted` accepts are evaluated (the others are
-/// zero); a group is always evaluated whole, so a receiver's value does not depend on which
-/// others are wanted.
+/// The exact direct irradiance at the `receivers` that `wanted` accepts (the others get zero),
+/// computed once per point for receivers that share one (faces of a mesh meeting at a vertex;
+/// see [`DirectLight::irradiance_group`]). Points within [`SHARED_POINT`] of the scene are one:
+/// the view from the grid point they round to serves them all, so a receiver's value does not
+/// depend on which others share its point, or are wanted.
 fn direct_at(
     direct: &DirectLight,
     disc: &Discretization,
@@ -270,28 +271,31 @@ fn direct_at(
 ) -> Result<(Vec<Rgb>, Estimated), SolveError> {
     // Groups in order of first appearance, so the work and its result do not depend on hashing.
     let mut groups: Vec<Vec<usize>> = Vec::new();
+    let mut points: Vec<DVec3> = Vec::new();
     let mut at_point: HashMap<[i64; 3], usize> = HashMap::new();
     let quantum = SHARED_POINT * direct.scene_diagonal();
+    let gridded = quantum > 0.0 && quantum.is_finite();
     for (i, &v) in receivers.iter().enumerate() {
+        if !wanted(v) {
+            continue;
+        }
         let p = disc.receivers[v].point;
-        let key = if quantum > 0.0 && quantum.is_finite() {
+        let (key, at) = if gridded {
             let q = (p / quantum).round();
-            [q.x as i64, q.y as i64, q.z as i64]
+            ([q.x as i64, q.y as i64, q.z as i64], q * quantum)
         } else {
-            [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()].map(|b| b as i64)
+            (
+                [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()].map(|b| b as i64),
+                p,
+            )
         };
         let g = *at_point.entry(key).or_insert_with(|| {
             groups.push(Vec::new());
+            points.push(at);
             groups.len() - 1
         });
         groups[g].push(i);
     }
-    let evaluated: Vec<bool> = groups
-        .iter()
-        .map(|g| g.iter().any(|&i| wanted(receivers[i])))
-        .collect();
-    let mut kept = evaluated.iter();
-    groups.retain(|_| kept.next().copied().unwrap_or(false));
     let members = |g: &[usize]| -> Vec<(ReceivingPoint, SurfaceId)> {
         g.iter()
             .map(|&i| {
@@ -300,9 +304,10 @@ fn direct_at(
             })
             .collect()
     };
+    let order: Vec<usize> = (0..groups.len()).collect();
     let late = || limits.deadline.is_some_and(|d| Instant::now() >= d);
-    let exact = par_map_with_progress(&groups, "direct light", limits.interrupt, progress, |g| {
-        (!late()).then(|| direct.irradiance_group(&members(g)))
+    let exact = par_map_with_progress(&order, "direct light", limits.interrupt, progress, |&g| {
+        (!late()).then(|| direct.irradiance_group(points[g], &members(&groups[g])))
     })?;
     // A point whose view of a light is beyond the overlay cap gets NaN: estimated, like the
     // points left at the deadline.
@@ -886,7 +891,7 @@ impl<'a> ProgressiveSolver<'a> {
 
     /// Irradiance at an interior point of `surface` from the patches shot so far (without the
     /// direct light), for error estimates; `key` picks the random stream.
-    pub fn indirect_irradiance(&self, point: glam::DVec3, surface: SurfaceId, key: u64) -> Rgb {
+    pub fn indirect_irradiance(&self, point: DVec3, surface: SurfaceId, key: u64) -> Rgb {
         let normal = self.meshes[surface].frame.normal;
         self.gather(&ReceivingPoint::interior(point, normal), surface, key)
             .0

@@ -86,7 +86,9 @@ fn one_by_one_and_all_at_once_agree() {
 }
 
 /// Receivers that share a point (the faces of the prism meeting at a vertex) get from the
-/// shared evaluation what each gets on its own, with and without other faces touching them.
+/// shared evaluation what each gets on its own, with and without other faces touching them,
+/// and exactly what each gets in a group of its own at that point (a sharded run has only its
+/// own surfaces' vertices).
 #[test]
 fn receivers_at_one_point_share_work_without_changing_it() {
     use penumbra_solver::Discretization;
@@ -114,8 +116,12 @@ fn receivers_at_one_point_share_work_without_changing_it() {
                 .iter()
                 .map(|&v| (disc.receivers[v], disc.receiver_surface[v]))
                 .collect();
-            let together = shared_always.irradiance_group(&members);
-            for ((x, r), h) in members.iter().zip(&together) {
+            let at = members[0].0.point;
+            let together = shared_always.irradiance_group(at, &members);
+            for (member, h) in members.iter().zip(&together) {
+                let single = shared_always.irradiance_group(at, std::slice::from_ref(member));
+                assert_eq!(single[0], *h, "a receiver's value depends on its group");
+                let (x, r) = member;
                 let alone = direct.irradiance(x, *r);
                 worst = worst.max((alone.r - h.r).abs());
                 peak = peak.max(alone.r);

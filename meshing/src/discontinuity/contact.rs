@@ -22,9 +22,11 @@ pub fn contact_lines(
     scene: &Scene,
     frames: &[Option<PlaneFrame>],
     visibility: &Visibility,
+    searched: &(dyn Fn(SurfaceId) -> bool + Sync),
 ) -> Vec<(SurfaceId, Vec<ContactLine>)> {
     (0..scene.surfaces.len())
         .into_par_iter()
+        .filter(|&r| searched(r))
         .filter_map(|r| {
             let lines = receiver_contacts(scene, frames[r]?, r, visibility);
             (!lines.is_empty()).then_some((r, lines))

@@ -19,6 +19,7 @@ pub mod topology;
 pub mod trim;
 pub mod wedge;
 
+use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
@@ -88,12 +89,22 @@ pub struct DiscontinuityOptions {
     pub deadline: Option<Instant>,
     /// Stops the search early when set (Ctrl-C).
     pub interrupt: Option<Interrupt>,
+    /// The receivers to search, by surface (all when `None`): a sharded run's surfaces. A
+    /// receiver's segments do not depend on which others are searched.
+    pub receivers: Option<Arc<[bool]>>,
 }
 
 impl DiscontinuityOptions {
     fn should_stop(&self) -> bool {
         self.interrupt.as_ref().is_some_and(Interrupt::is_set)
             || self.deadline.is_some_and(|d| Instant::now() >= d)
+    }
+
+    /// Whether receiver `r` is searched.
+    fn searches(&self, r: SurfaceId) -> bool {
+        self.receivers
+            .as_ref()
+            .is_none_or(|on| on.get(r).copied().unwrap_or(false))
     }
 }
 
@@ -117,6 +128,7 @@ impl Default for DiscontinuityOptions {
             element_area: None,
             deadline: None,
             interrupt: None,
+            receivers: None,
         }
     }
 }
@@ -216,7 +228,8 @@ pub fn find_discontinuities_reporting(
 ) -> Discontinuities {
     let started = Instant::now();
     let context = SearchContext::new(scene, visibility, options);
-    let pairs = context.facing_pairs();
+    let mut pairs = context.facing_pairs();
+    pairs.retain(|&(_, r)| options.searches(r));
     progress.start("discontinuities", pairs.len() as u64);
     let done = AtomicU64::new(0);
     let found: Vec<Option<PairEvents>> = pairs
@@ -248,7 +261,8 @@ pub fn find_discontinuities_reporting(
     // Contact lines, for every receiver that something touches.
     let mut hovering = vec![Vec::new(); scene.surfaces.len()];
     let emitters: Vec<SurfaceId> = scene.emitters().map(|(e, _)| e).collect();
-    for (r, contacts) in contact::contact_lines(scene, &context.frames, visibility) {
+    let searched = |r: SurfaceId| options.searches(r);
+    for (r, contacts) in contact::contact_lines(scene, &context.frames, visibility, &searched) {
         stats.contact_segments += contacts.len();
         hovering[r].extend(contacts.iter().copied().filter(|c| c.2 > 0.0));
         for (from, to, _) in contacts {
