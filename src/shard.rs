@@ -126,13 +126,13 @@ impl Shard {
 
 /// Whether a shard of a run with these options finds the discontinuities of its own surfaces and
 /// meshes them alone: a fitted budget of a scene whose polygons need more than the budget's
-/// floor ([`penumbra_meshing::ElementBudget::planned_alone`]) gives each surface a share that depends on nothing
+/// floor ([`penumbra_meshing::ElementBudget::shared_extra`]) gives each surface a share that depends on nothing
 /// else. Otherwise each shard meshes the whole scene, as the run not split does.
 pub fn meshed_alone(scene: &Scene, options: &RunOptions) -> bool {
     options.refine.is_none()
         && options
             .max_elements
-            .planned_alone(polygon_minimum(scene), scene.surfaces.len())
+            .shared_extra(polygon_minimum(scene), scene.surfaces.len())
             .is_some()
 }
 

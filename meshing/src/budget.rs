@@ -89,20 +89,21 @@ impl ElementBudget {
     }
 
     /// For a fitted budget of a scene whose polygons alone need more than its floor (a large
-    /// scene: `polygon_minimum` triangles over `surfaces` surfaces), the triangles planned from
-    /// the polygons: each surface then gets its share of this plan by area, or its least mesh if
-    /// that is more ([`crate::share_alone`]), which depends on nothing but the surface
-    /// and the polygons, so each surface can be meshed without the others' discontinuities (a
-    /// sharded run). `None` for a cap, or a scene within the floor: one budget is spread over
-    /// all surfaces ([`crate::spread_by_area`]).
-    pub fn planned_alone(self, polygon_minimum: usize, surfaces: usize) -> Option<usize> {
+    /// scene: `polygon_minimum` triangles over `surfaces` surfaces), the triangles it adds to the
+    /// least mesh (`per_surface` for each surface). Each surface then gets its least mesh and
+    /// its share of these by area ([`crate::share_alone`]): the budget the fit resolves to, spread
+    /// so that each surface's part depends on nothing but the surface and the scene's polygons,
+    /// and each surface can be meshed without the others' discontinuities (a sharded run).
+    /// `None` for a cap, or a scene within the floor: one budget is spread over all surfaces
+    /// ([`crate::spread_by_area`]).
+    pub fn shared_extra(self, polygon_minimum: usize, surfaces: usize) -> Option<usize> {
         match self {
             ElementBudget::Fit {
                 at_least,
                 per_surface,
             } => {
-                let planned = polygon_minimum.saturating_add(per_surface.saturating_mul(surfaces));
-                (planned > at_least).then_some(planned)
+                let extra = per_surface.saturating_mul(surfaces);
+                (polygon_minimum.saturating_add(extra) > at_least).then_some(extra)
             }
             ElementBudget::AtMost(_) => None,
         }
@@ -164,12 +165,12 @@ mod tests {
         };
         assert_eq!(least.resolve(1500, 3).ok(), Some(1500));
         // Surfaces are meshed alone once the polygons need more than the floor.
-        assert_eq!(fit.planned_alone(990, 10), None);
+        assert_eq!(fit.shared_extra(990, 10), None);
         assert_eq!(
-            fit.planned_alone(999, 3),
-            Some(999 + 3 * FIT_TRIANGLES_PER_SURFACE)
+            fit.shared_extra(999, 3),
+            Some(3 * FIT_TRIANGLES_PER_SURFACE)
         );
-        assert_eq!(ElementBudget::AtMost(10).planned_alone(999, 3), None);
+        assert_eq!(ElementBudget::AtMost(10).shared_extra(999, 3), None);
         let square = penumbra_scenes::builtin::textbook();
         // Three quadrilaterals: two triangles each.
         assert_eq!(polygon_minimum(&square), 6);

@@ -177,7 +177,7 @@ pub fn mesh_scene_discontinuity(
 }
 
 /// [`mesh_scene_discontinuity`] of the surfaces `on` holds (all when `None`), when each
-/// surface's share of the budget depends on it alone ([`ElementBudget::planned_alone`]): the
+/// surface's share of the budget depends on it alone ([`ElementBudget::shared_extra`]): the
 /// others get an empty mesh, and the budget, counts and least mesh are those of the surfaces
 /// meshed. A budget spread over all surfaces needs every surface's least mesh, so then every
 /// surface is meshed. A surface's mesh is the same whichever others are meshed.
@@ -190,7 +190,7 @@ pub fn mesh_scene_discontinuity_on(
     on: Option<&[bool]>,
 ) -> Result<SceneMesh, MeshError> {
     let budget = budget.into();
-    let alone = budget.planned_alone(polygon_minimum(scene), scene.surfaces.len());
+    let alone = budget.shared_extra(polygon_minimum(scene), scene.surfaces.len());
     let meshed: Vec<bool> = (0..scene.surfaces.len())
         .map(|id| alone.is_none() || on.is_none_or(|on| on.get(id).copied().unwrap_or(false)))
         .collect();
@@ -227,7 +227,7 @@ pub fn mesh_scene_discontinuity_on(
         .map(|c| c.as_ref().map_or(0, ConstrainedSurface::minimum_triangles))
         .collect();
     let (budget, targets) = match alone {
-        Some(planned) => share_alone(&areas, &minimum, &meshed, planned),
+        Some(extra) => share_alone(&areas, &minimum, &meshed, extra),
         None => spread_by_area(&areas, &minimum, budget, true)?,
     };
     let minimum_triangles = minimum.iter().sum();
@@ -297,14 +297,14 @@ pub fn mesh_scene_discontinuity_on(
     })
 }
 
-/// Each surface's share of `planned` triangles by area, or its least mesh (`minimum[s]`) when
-/// that is more: a target that depends on the surface alone. Surfaces not `meshed` get none.
-/// Returns the targets' sum and the targets.
+/// Each surface's least mesh (`minimum[s]`) and its share of `extra` triangles by area: a
+/// target that depends on the surface alone, and targets that sum to the least mesh and at most
+/// `extra`. Surfaces not `meshed` get none. Returns the targets' sum and the targets.
 pub fn share_alone(
     areas: &[f64],
     minimum: &[usize],
     meshed: &[bool],
-    planned: usize,
+    extra: usize,
 ) -> (usize, Vec<usize>) {
     let total: f64 = areas.iter().sum();
     let targets: Vec<usize> = areas
@@ -312,7 +312,7 @@ pub fn share_alone(
         .zip(minimum)
         .zip(meshed)
         .map(|((&a, &m), &meshed)| match meshed {
-            true => ((planned as f64 * a / total).floor() as usize).max(m),
+            true => m + (extra as f64 * a / total).floor() as usize,
             false => 0,
         })
         .collect();
@@ -341,6 +341,19 @@ mod tests {
         let (budget, t) = spread_by_area(&[1.0, 3.0], &[5, 5], fit, false).expect("fits");
         assert_eq!(budget, 10 + 2 * crate::FIT_TRIANGLES_PER_SURFACE);
         assert!(t.iter().sum::<usize>() <= budget && t[1] > t[0], "{t:?}");
+    }
+
+    /// Shared alone: each surface's least mesh and its area's part of the extra triangles,
+    /// whatever the other surfaces' minima; surfaces not meshed get nothing.
+    #[test]
+    fn shares_alone_depend_on_each_surface_alone() {
+        let areas = [1.0, 3.0, 4.0];
+        let (sum, t) = share_alone(&areas, &[5, 2, 40], &[true; 3], 80);
+        assert_eq!(t, [5 + 10, 2 + 30, 40 + 40]);
+        assert_eq!(sum, 127);
+        let (sum, t) = share_alone(&areas, &[5, 900, 40], &[true, false, true], 80);
+        assert_eq!(t, [15, 0, 80]);
+        assert_eq!(sum, 95);
     }
 
     #[test]
