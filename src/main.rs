@@ -229,9 +229,10 @@ struct RunArgs {
     #[arg(long)]
     quiet: bool,
     /// With --direct-only: light only shard I of N (I from 0 to N - 1), the surfaces whose
-    /// index is I modulo N, and write OUT/shard.json and their SVGs for `penumbra merge`. The
-    /// discontinuities and meshes are still the whole scene's (each surface's share of the
-    /// element budget depends on all of them); the direct light is split.
+    /// index is I modulo N, and write OUT/shard.json and their SVGs for `penumbra merge`. In a
+    /// scene whose polygons need more than the budget's floor, with the fitted budget, the shard
+    /// also finds the discontinuities of its own surfaces and meshes them alone; otherwise it
+    /// meshes the whole scene (each surface's share of the budget depends on all of them).
     #[arg(long, value_name = "I/N")]
     shard: Option<String>,
 }

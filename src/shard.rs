@@ -309,8 +309,8 @@ pub enum MergeError {
     },
     #[error(
         "{} meshed its surfaces by {mesh} but {} by {first_mesh}: with --mesh auto, a shard whose \
-         surfaces cast and receive no shadows meshes them uniformly, unlike the run not split; \
-         run every shard with --mesh discontinuity",
+         surfaces have no discontinuities meshes them uniformly, unlike the run not split; run \
+         every shard with --mesh discontinuity",
         .dir.display(), .first.display()
     )]
     MeshChoice {

@@ -252,6 +252,23 @@ fn merge_refuses_missing_duplicate_and_mixed_shards() {
     run("textbook", &whole, &[]);
     refused(&["merge", "--out", out_s, path(&whole)], &["shard.json"]);
     refused(&["merge", "--out", out_s], &["DIRS"]);
+    // Shards that meshed alone, where `--mesh auto` chose differently: boxworld-1000's light
+    // (surface 0) receives no discontinuities, its floor (surface 1) does.
+    let alone: Vec<PathBuf> = (0..2)
+        .map(|i| {
+            let d = dir.path().join(format!("alone-{i}"));
+            run(
+                "boxworld-1000",
+                &d,
+                &["--fit", "--shard", &format!("{i}/5002")],
+            );
+            d
+        })
+        .collect();
+    refused(
+        &["merge", "--out", out_s, path(&alone[0]), path(&alone[1])],
+        &["by discontinuity but", "--mesh discontinuity"],
+    );
     assert!(!out.exists(), "nothing written");
 }
 
