@@ -25,6 +25,20 @@ use crate::shadow_union::{CornerKey, cancel_opposite};
 const LEAF_FACES: usize = 4;
 /// Nodes with fewer faces than this keep no outline: visiting their faces costs as little.
 const OUTLINE_MIN_FACES: usize = 8;
+/// A node whose faces do not all turn one way keeps the outlines of its faces' planes (faces
+/// whose facing normals and planes agree to [`GROUP_DEVIATION`]) when there are at most this
+/// many: a tessellated box or prism is then decided whole, plane by plane, rather than opened
+/// face by face along every fold.
+const MAX_GROUPS: usize = 8;
+/// Faces are in one plane group when their facing normals (unit) are at most this far apart and
+/// each one's centroid lies within this fraction of their distance from the origin of the
+/// other's plane: the rounding of a flat face's tessellation, far below any fold.
+const GROUP_DEVIATION: f64 = 1e-9;
+/// Consecutive outline edges whose directions differ by less than this sine are one straight
+/// edge: the corners between them lie within this fraction of the run's length of its chord,
+/// the rounding of corners computed along a straight edge (a tessellated face's rim), so the
+/// outline keeps the shape's few edges rather than every step of its tessellation.
+const COLLINEAR_SINE: f64 = 1e-12;
 
 /// One occluder face as the tree sees it.
 pub(crate) struct TreeFace<'a> {
@@ -55,8 +69,20 @@ struct Sheet {
     spread: f64,
     center: DVec3,
     radius: f64,
+    /// The least and greatest of `axis . v` over the corners.
+    heights: (f64, f64),
     closed: bool,
     outline: Vec<OutlineEdge>,
+    faces: Members,
+}
+
+/// The faces of a sheet.
+#[derive(Debug)]
+enum Members {
+    /// A node's, all of them.
+    Node(usize),
+    /// A plane group's.
+    Listed(Vec<usize>),
 }
 
 #[derive(Debug)]
@@ -67,7 +93,10 @@ struct Node {
     start: usize,
     end: usize,
     children: Option<(usize, usize)>,
-    sheet: Option<Sheet>,
+    /// All its faces as one sheet, when they can all turn one way.
+    sheet: Option<usize>,
+    /// Else its plane groups, when they are few ([`MAX_GROUPS`]).
+    groups: std::ops::Range<usize>,
 }
 
 /// The shaft from a point to a convex piece of an emitter, as the tree tests it.
@@ -90,8 +119,8 @@ pub(crate) struct ShaftTest<'a> {
 pub(crate) enum Reached {
     /// An occluder, by index, to be examined on its own.
     Face(usize),
-    /// A node whose faces all turn one way to the point: its outline, reversed when they turn
-    /// away.
+    /// A sheet (a node, or a plane group of one) whose faces all turn one way to the point: its
+    /// outline, reversed when they turn away.
     Outline { node: usize, reversed: bool },
 }
 
@@ -100,6 +129,8 @@ pub(crate) enum Reached {
 pub(crate) struct OccluderTree {
     nodes: Vec<Node>,
     items: Vec<usize>,
+    /// The nodes' sheets and plane groups.
+    sheets: Vec<Sheet>,
 }
 
 impl OccluderTree {
@@ -107,13 +138,15 @@ impl OccluderTree {
         let mut tree = OccluderTree {
             nodes: Vec::new(),
             items: (0..faces.len()).collect(),
+            sheets: Vec::new(),
         };
         if !faces.is_empty() {
             let centroids: Vec<DVec3> = faces
                 .iter()
                 .map(|f| f.polygon.iter().sum::<DVec3>() / f.polygon.len() as f64)
                 .collect();
-            tree.split(faces, &centroids, 0, faces.len());
+            let meshes = Meshes::of(faces, &centroids);
+            tree.split(faces, &centroids, &meshes, 0, faces.len());
         }
         tree
     }
@@ -123,6 +156,7 @@ impl OccluderTree {
         &mut self,
         faces: &[TreeFace],
         centroids: &[DVec3],
+        meshes: &Meshes,
         start: usize,
         end: usize,
     ) -> usize {
@@ -135,9 +169,31 @@ impl OccluderTree {
         }
         let index = self.nodes.len();
         let members = &self.items[start..end];
-        let sheet = (end - start >= OUTLINE_MIN_FACES)
-            .then(|| sheet_of(members.iter().map(|&i| &faces[i])))
-            .flatten();
+        let (mut sheet, mut groups) = (None, self.sheets.len()..self.sheets.len());
+        if end - start >= OUTLINE_MIN_FACES {
+            match sheet_of(members.iter().map(|&i| &faces[i]), Members::Node(index)) {
+                Some(whole) => {
+                    sheet = Some(self.sheets.len());
+                    self.sheets.push(whole);
+                }
+                None => {
+                    let planes = plane_groups(faces, members, centroids);
+                    if planes.len() <= MAX_GROUPS {
+                        let made: Option<Vec<Sheet>> = planes
+                            .into_iter()
+                            .map(|g| {
+                                let of = g.iter().map(|&i| &faces[i]).collect::<Vec<_>>();
+                                sheet_of(of.into_iter(), Members::Listed(g))
+                            })
+                            .collect();
+                        if let Some(made) = made {
+                            self.sheets.extend(made);
+                            groups.end = self.sheets.len();
+                        }
+                    }
+                }
+            }
+        }
         self.nodes.push(Node {
             min,
             max,
@@ -145,41 +201,45 @@ impl OccluderTree {
             end,
             children: None,
             sheet,
+            groups,
         });
         if end - start > LEAF_FACES {
-            // Median split of the centroids along their widest axis; ties by index, so the tree
-            // does not depend on the sort's stability.
-            let (lo, hi) = self.items[start..end]
-                .iter()
-                .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &i| {
-                    (lo.min(centroids[i]), hi.max(centroids[i]))
-                });
-            let axis = (hi - lo).max_position();
-            let mid = (start + end) / 2;
-            self.items[start..end].select_nth_unstable_by(mid - start, |&a, &b| {
-                centroids[a][axis]
-                    .total_cmp(&centroids[b][axis])
-                    .then(a.cmp(&b))
-            });
-            let left = self.split(faces, centroids, start, mid);
-            let right = self.split(faces, centroids, mid, end);
+            let mid = match meshes.split(&mut self.items[start..end]) {
+                Some(at) => start + at,
+                None => {
+                    // Median split of the centroids along their widest axis; ties by index, so
+                    // the tree does not depend on the sort's stability.
+                    let axis = widest_axis(self.items[start..end].iter().map(|&i| centroids[i]));
+                    let mid = (start + end) / 2;
+                    self.items[start..end].select_nth_unstable_by(mid - start, |&a, &b| {
+                        centroids[a][axis]
+                            .total_cmp(&centroids[b][axis])
+                            .then(a.cmp(&b))
+                    });
+                    mid
+                }
+            };
+            let left = self.split(faces, centroids, meshes, start, mid);
+            let right = self.split(faces, centroids, meshes, mid, end);
             self.nodes[index].children = Some((left, right));
         }
         index
     }
 
-    /// The faces of node `node`.
-    pub fn faces_of(&self, node: usize) -> &[usize] {
-        let n = &self.nodes[node];
-        &self.items[n.start..n.end]
+    /// The faces of sheet `sheet` (as [`Reached::Outline`] gives it).
+    pub fn faces_of(&self, sheet: usize) -> &[usize] {
+        match &self.sheets[sheet].faces {
+            Members::Listed(faces) => faces,
+            Members::Node(node) => {
+                let n = &self.nodes[*node];
+                &self.items[n.start..n.end]
+            }
+        }
     }
 
-    /// The outline of node `node` (empty for a node that keeps none).
-    pub fn outline(&self, node: usize) -> &[OutlineEdge] {
-        self.nodes[node]
-            .sheet
-            .as_ref()
-            .map_or(&[], |s| s.outline.as_slice())
+    /// The outline of sheet `sheet`.
+    pub fn outline(&self, sheet: usize) -> &[OutlineEdge] {
+        &self.sheets[sheet].outline
     }
 
     /// Visits what the shaft may hold: whole nodes by their outline where that is exact, else
@@ -204,18 +264,23 @@ impl OccluderTree {
         {
             return;
         }
-        if let Some(sheet) = &node.sheet
-            && low > shaft.lowest
-            && high < shaft.highest
-            && let Some(away) = sheet.turns_away(shaft.point, node.min, node.max, shaft.margin)
-        {
-            if !(away && sheet.closed) {
-                visit(Reached::Outline {
-                    node: index,
-                    reversed: away,
-                });
+        if low > shaft.lowest && high < shaft.highest {
+            let sheets = node.sheet.map_or(node.groups.clone(), |s| s..s + 1);
+            let turns: Option<Vec<bool>> = sheets
+                .clone()
+                .map(|s| self.sheets[s].turns_away(shaft.point, shaft.margin))
+                .collect();
+            if let Some(turns) = turns.filter(|t| !t.is_empty()) {
+                for (s, away) in sheets.zip(turns) {
+                    if !(away && self.sheets[s].closed) {
+                        visit(Reached::Outline {
+                            node: s,
+                            reversed: away,
+                        });
+                    }
+                }
+                return;
             }
-            return;
         }
         match node.children {
             Some((left, right)) => {
@@ -229,6 +294,74 @@ impl OccluderTree {
     }
 }
 
+/// The axis along which `points` spread the most.
+fn widest_axis(points: impl Iterator<Item = DVec3>) -> usize {
+    let (lo, hi) = points.fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
+        (lo.min(p), hi.max(p))
+    });
+    (hi - lo).max_position()
+}
+
+/// The welded meshes among the faces (faces sharing a corner key), each kept in one subtree
+/// until it is alone in its node: a node then holds a whole mesh, which its outlines or plane
+/// groups can stand for at once, rather than parts of several cut along arbitrary lines.
+struct Meshes {
+    /// Each face's mesh.
+    of: Vec<usize>,
+    /// Each mesh's centroid (the mean of its faces' centroids).
+    centroids: Vec<DVec3>,
+}
+
+impl Meshes {
+    fn of(faces: &[TreeFace], centroids: &[DVec3]) -> Meshes {
+        let mut first: std::collections::HashMap<CornerKey, usize> =
+            std::collections::HashMap::new();
+        let mut joined = penumbra_scenes::union_find::UnionFind::new(faces.len());
+        for (i, f) in faces.iter().enumerate() {
+            for &k in f.keys {
+                let j = *first.entry(k).or_insert(i);
+                joined.join(i, j);
+            }
+        }
+        let mut id = std::collections::HashMap::new();
+        let of: Vec<usize> = (0..faces.len())
+            .map(|i| {
+                let root = joined.find(i);
+                let next = id.len();
+                *id.entry(root).or_insert(next)
+            })
+            .collect();
+        let mut sums = vec![(DVec3::ZERO, 0.0); id.len()];
+        for (i, &m) in of.iter().enumerate() {
+            sums[m].0 += centroids[i];
+            sums[m].1 += 1.0;
+        }
+        let centroids = sums.into_iter().map(|(sum, n)| sum / n).collect();
+        Meshes { of, centroids }
+    }
+
+    /// When `items` hold faces of several meshes: orders them by mesh, the meshes by their
+    /// centroids along the widest axis, and returns the mesh boundary nearest the middle.
+    fn split(&self, items: &mut [usize]) -> Option<usize> {
+        let first = self.of[*items.first()?];
+        if items.iter().all(|&i| self.of[i] == first) {
+            return None;
+        }
+        let axis = widest_axis(items.iter().map(|&i| self.centroids[self.of[i]]));
+        items.sort_unstable_by(|&a, &b| {
+            let (m, n) = (self.of[a], self.of[b]);
+            self.centroids[m][axis]
+                .total_cmp(&self.centroids[n][axis])
+                .then(m.cmp(&n))
+                .then(a.cmp(&b))
+        });
+        let middle = items.len() / 2;
+        (1..items.len())
+            .filter(|&k| self.of[items[k]] != self.of[items[k - 1]])
+            .min_by_key(|&k| k.abs_diff(middle))
+    }
+}
+
 /// The least and greatest of `m . p` over the box `[min, max]`.
 fn box_range(min: DVec3, max: DVec3, m: DVec3) -> (f64, f64) {
     let lo = DVec3::select(m.cmpge(DVec3::ZERO), min, max);
@@ -237,15 +370,14 @@ fn box_range(min: DVec3, max: DVec3, m: DVec3) -> (f64, f64) {
 }
 
 impl Sheet {
-    /// `Some(false)` when every face (within the box `[min, max]`) turns towards `point` by
-    /// more than `margin`, `Some(true)` when every face turns away, `None` when the cone and the
-    /// box cannot tell.
-    fn turns_away(&self, point: DVec3, min: DVec3, max: DVec3, margin: f64) -> Option<bool> {
-        // Flat and nearly flat nodes: for a facing normal n and a corner v, n . (point - v) lies
+    /// `Some(false)` when every face turns towards `point` by more than `margin`, `Some(true)`
+    /// when every face turns away, `None` when the cone and the corners cannot tell.
+    fn turns_away(&self, point: DVec3, margin: f64) -> Option<bool> {
+        // Flat and nearly flat sheets: for a facing normal n and a corner v, n . (point - v) lies
         // within deviation * |point - v| of axis . (point - v).
-        let (low, high) = box_range(min, max, self.axis);
+        let (low, high) = self.heights;
         let along = self.axis.dot(point);
-        let far = point.distance((min + max) / 2.0) + (max - min).length() / 2.0;
+        let far = point.distance(self.center) + self.radius;
         let slack = self.deviation * far + margin;
         if along - high > slack {
             return Some(false);
@@ -273,9 +405,12 @@ impl Sheet {
     }
 }
 
-/// The sheet of a group of faces, or `None` when their facing normals spread over a half space
-/// or more (they can never all turn one way) or their outline saves nothing.
-fn sheet_of<'a>(faces: impl Iterator<Item = &'a TreeFace<'a>> + Clone) -> Option<Sheet> {
+/// The sheet of a group of faces (`members`), or `None` when their facing normals spread over a
+/// half space or more (they can never all turn one way) or their outline saves nothing.
+fn sheet_of<'a>(
+    faces: impl Iterator<Item = &'a TreeFace<'a>> + Clone,
+    members: Members,
+) -> Option<Sheet> {
     let axis = faces
         .clone()
         .map(|f| f.facing)
@@ -299,6 +434,12 @@ fn sheet_of<'a>(faces: impl Iterator<Item = &'a TreeFace<'a>> + Clone) -> Option
     }
     let center = (min + max) / 2.0;
     let radius = (max - min).length() / 2.0;
+    let heights = faces
+        .clone()
+        .flat_map(|f| f.polygon.iter().map(|&p| axis.dot(p)))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), h| {
+            (lo.min(h), hi.max(h))
+        });
     let mut edges = Vec::new();
     let mut count = 0;
     let mut closed = true;
@@ -325,7 +466,7 @@ fn sheet_of<'a>(faces: impl Iterator<Item = &'a TreeFace<'a>> + Clone) -> Option
             }
         }
     }
-    let outline = cancel_opposite(edges, |e| (e.from, e.to));
+    let outline = straight_runs(cancel_opposite(edges, |e| (e.from, e.to)));
     // An outline as long as the faces' own edges saves nothing.
     (outline.len() * 2 < count * 3).then_some(Sheet {
         axis,
@@ -333,9 +474,85 @@ fn sheet_of<'a>(faces: impl Iterator<Item = &'a TreeFace<'a>> + Clone) -> Option
         spread,
         center,
         radius,
+        heights,
         closed,
         outline,
+        faces: members,
     })
+}
+
+/// The faces of `members` in groups of one plane and facing each ([`GROUP_DEVIATION`]), in the
+/// order of their first face; stops counting past [`MAX_GROUPS`].
+fn plane_groups(faces: &[TreeFace], members: &[usize], centroids: &[DVec3]) -> Vec<Vec<usize>> {
+    let mut groups: Vec<(DVec3, DVec3, Vec<usize>)> = Vec::new();
+    let same_plane = |n: DVec3, c: DVec3, m: DVec3, d: DVec3| {
+        let reach = c.length() + d.length() + c.distance(d);
+        n.distance(m) <= GROUP_DEVIATION && m.dot(c - d).abs() <= GROUP_DEVIATION * reach
+    };
+    for &i in members {
+        let (n, c) = (faces[i].facing, centroids[i]);
+        match groups.iter().position(|&(m, d, _)| same_plane(n, c, m, d)) {
+            Some(g) => groups[g].2.push(i),
+            None if groups.len() > MAX_GROUPS => break,
+            None => groups.push((n, c, vec![i])),
+        }
+    }
+    groups.into_iter().map(|(_, _, g)| g).collect()
+}
+
+/// The outline with each straight run of edges through corners that no other outline edge
+/// meets ([`COLLINEAR_SINE`]) made one edge, in a fixed order.
+fn straight_runs(outline: Vec<OutlineEdge>) -> Vec<OutlineEdge> {
+    use std::collections::HashMap;
+    let mut leaving: HashMap<CornerKey, (usize, u32)> = HashMap::with_capacity(outline.len());
+    let mut arriving: HashMap<CornerKey, u32> = HashMap::with_capacity(outline.len());
+    for (k, e) in outline.iter().enumerate() {
+        leaving.entry(e.from).or_insert((k, 0)).1 += 1;
+        *arriving.entry(e.to).or_default() += 1;
+    }
+    let direction = |e: &OutlineEdge| (e.to_at - e.from_at).normalize_or_zero();
+    // The edge that continues `e` straight on through a corner of no other edge.
+    let next_straight = |e: &OutlineEdge| -> Option<usize> {
+        let (k, out) = *leaving.get(&e.to)?;
+        let inward = arriving.get(&e.to).copied().unwrap_or(0);
+        let (d, f) = (direction(e), direction(&outline[k]));
+        (out == 1 && inward == 1 && d.dot(f) > 0.0 && d.cross(f).length() < COLLINEAR_SINE)
+            .then_some(k)
+    };
+    // Runs start at edges that no straight edge leads into.
+    let continued: Vec<bool> = {
+        let mut c = vec![false; outline.len()];
+        for e in &outline {
+            if let Some(k) = next_straight(e) {
+                c[k] = true;
+            }
+        }
+        c
+    };
+    let mut used = vec![false; outline.len()];
+    let mut runs = Vec::with_capacity(outline.len());
+    let mut extend = |start: usize, used: &mut Vec<bool>| {
+        let mut run = outline[start];
+        used[start] = true;
+        while let Some(k) = next_straight(&run).filter(|&k| !used[k]) {
+            used[k] = true;
+            run.to = outline[k].to;
+            run.to_at = outline[k].to_at;
+        }
+        runs.push(run);
+    };
+    for start in 0..outline.len() {
+        if !continued[start] && !used[start] {
+            extend(start, &mut used);
+        }
+    }
+    // Loops that are straight all round do not close; what is left are such loops' edges.
+    for start in 0..outline.len() {
+        if !used[start] {
+            extend(start, &mut used);
+        }
+    }
+    runs
 }
 
 #[cfg(test)]
@@ -413,7 +630,7 @@ mod tests {
     }
 
     /// Under an emitter at z = 10, a point below a 16 x 16 sheet at z = 5 meets the sheet as one
-    /// outline: its rim of 64 edges, the inner edges cancelled.
+    /// outline: its rim, the inner edges cancelled and the rim's 64 steps made its 4 sides.
     #[test]
     fn a_sheet_facing_the_point_is_one_outline() {
         let (polygons, keys) = grid(16, 5.0);
@@ -428,7 +645,10 @@ mod tests {
             assert_eq!(outlines.len(), 1);
             let (node, reversed) = outlines[0];
             assert_eq!(reversed, expect_reversed);
-            assert_eq!(tree.outline(node).len(), 64);
+            assert_eq!(tree.outline(node).len(), 4);
+            for e in tree.outline(node) {
+                assert_eq!((e.to_at - e.from_at).length(), 16.0, "{e:?}");
+            }
             assert_eq!(tree.faces_of(node).len(), 512);
             // The rim turns counter-clockwise around +z in the facing order.
             let turn: f64 = tree

@@ -55,6 +55,9 @@ pub(crate) struct ShadowUnion {
     sheet: Vec<SheetEdge>,
     /// Other shadows (clipped to the shaft), counter-clockwise.
     contours: Vec<Vec<DVec2>>,
+    /// Corners of one sheet that no edge joins: the loops of one fused outline (its rim and
+    /// its holes).
+    links: Vec<(CornerKey, CornerKey)>,
 }
 
 /// A visible part of an emitter piece: an outline (counter-clockwise) and its holes (clockwise).
@@ -66,6 +69,7 @@ impl ShadowUnion {
         ShadowUnion {
             sheet: Vec::with_capacity(edges),
             contours: Vec::new(),
+            links: Vec::new(),
         }
     }
 
@@ -90,13 +94,18 @@ impl ShadowUnion {
     }
 
     /// Adds edges of shadows already fused (a node's outline): corner keys, and the projection
-    /// of the first corner.
+    /// of the first corner. They are one shadow: a rim and the holes in it have no edge between
+    /// them, and the rim alone would cover the holes.
     pub fn add_edges(&mut self, edges: &[(CornerKey, CornerKey, DVec2)]) {
         self.sheet.extend(
             edges
                 .iter()
                 .map(|&(from, to, at)| SheetEdge { from, to, at }),
         );
+        if let Some(&(first, _, _)) = edges.first() {
+            self.links
+                .extend(edges.iter().map(|&(from, _, _)| (first, from)));
+        }
     }
 
     /// Adds a shadow given as a counter-clockwise contour.
@@ -123,7 +132,7 @@ impl ShadowUnion {
         limit: &OverlayLimit,
     ) -> Result<Vec<VisibleShape>, Refusal> {
         let mut shadows: Vec<Shadow> = self.contours.into_iter().map(|c| vec![c]).collect();
-        shadows.extend(outlines(self.sheet).ok_or(Refusal::NotFinite)?);
+        shadows.extend(outlines(self.sheet, &self.links).ok_or(Refusal::NotFinite)?);
         if !bound
             .iter()
             .chain(visible_points(&start))
@@ -357,12 +366,16 @@ pub(crate) fn cancel_opposite<E: Copy>(
 }
 
 /// The closed outlines of the sheet's edges once each edge met in both directions cancels
-/// (the winding number of what remains is that of the faces), one shadow per connected set of
-/// faces. `None` if the edges do not close, which faces of distinct corners always do.
-fn outlines(edges: Vec<SheetEdge>) -> Option<Vec<Shadow>> {
+/// (the winding number of what remains is that of the faces), one shadow per set of faces
+/// connected by edges or `links`. `None` if the edges do not close, which faces of distinct
+/// corners always do.
+fn outlines(edges: Vec<SheetEdge>, links: &[(CornerKey, CornerKey)]) -> Option<Vec<Shadow>> {
     let mut sheets = Components::with_capacity(edges.len());
     for e in &edges {
         sheets.join(e.from, e.to);
+    }
+    for &(a, b) in links {
+        sheets.join(a, b);
     }
     let kept = cancel_opposite(edges, |e| (e.from, e.to));
     // Walk the surviving edges into closed loops: every corner has as many edges in as out.
@@ -513,7 +526,7 @@ mod tests {
     #[test]
     fn a_welded_sheet_fuses_into_its_outline() {
         let union = welded_grid(3, 0.25, |_, _| true);
-        let loops = outlines(union.sheet.clone()).expect("closes");
+        let loops = outlines(union.sheet.clone(), &[]).expect("closes");
         assert_eq!(loops.len(), 1);
         assert_eq!(loops[0].len(), 1, "one loop");
         assert_eq!(loops[0][0].len(), 12, "the outline's corners");
@@ -530,12 +543,36 @@ mod tests {
     fn a_sheet_with_a_hole_keeps_its_hole() {
         let middle = |i: u32| (1..3).contains(&i);
         let union = welded_grid(4, 1.0, |i, j| !(middle(i) && middle(j)));
-        let shadows = outlines(union.sheet.clone()).expect("closes");
+        let shadows = outlines(union.sheet.clone(), &[]).expect("closes");
         assert_eq!(shadows.len(), 1);
         let mut loops: Vec<usize> = shadows[0].iter().map(Vec::len).collect();
         loops.sort_unstable();
         assert_eq!(loops, [8, 16]);
         const { assert!(16 <= FIRST_BATCH_EDGES && 16 + 8 > FIRST_BATCH_EDGES) };
+        let visible = union
+            .subtract_from(&crate::clip::sq(-0.5, -0.5, 5.0), &OverlayLimit::NONE)
+            .expect("finite");
+        assert!(
+            (area(&visible) - (25.0 - 16.0 + 4.0)).abs() < 1e-12,
+            "{}",
+            area(&visible)
+        );
+    }
+
+    /// The same ring given as a node's outline, already fused (`add_edges`: its two loops, with
+    /// no inner edge joining them), still keeps its hole.
+    #[test]
+    fn a_fused_outline_keeps_its_hole() {
+        let middle = |i: u32| (1..3).contains(&i);
+        let faces = welded_grid(4, 1.0, |i, j| !(middle(i) && middle(j)));
+        let fused: Vec<(CornerKey, CornerKey, DVec2)> =
+            cancel_opposite(faces.sheet, |e| (e.from, e.to))
+                .into_iter()
+                .map(|e| (e.from, e.to, e.at))
+                .collect();
+        assert_eq!(fused.len(), 24);
+        let mut union = ShadowUnion::default();
+        union.add_edges(&fused);
         let visible = union
             .subtract_from(&crate::clip::sq(-0.5, -0.5, 5.0), &OverlayLimit::NONE)
             .expect("finite");
