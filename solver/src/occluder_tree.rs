@@ -466,7 +466,7 @@ fn sheet_of<'a>(
             }
         }
     }
-    let outline = straight_runs(cancel_opposite(edges, |e| (e.from, e.to)));
+    let outline = straight_runs(&cancel_opposite(edges, |e| (e.from, e.to)));
     // An outline as long as the faces' own edges saves nothing.
     (outline.len() * 2 < count * 3).then_some(Sheet {
         axis,
@@ -502,7 +502,7 @@ fn plane_groups(faces: &[TreeFace], members: &[usize], centroids: &[DVec3]) -> V
 
 /// The outline with each straight run of edges through corners that no other outline edge
 /// meets ([`COLLINEAR_SINE`]) made one edge, in a fixed order.
-fn straight_runs(outline: Vec<OutlineEdge>) -> Vec<OutlineEdge> {
+fn straight_runs(outline: &[OutlineEdge]) -> Vec<OutlineEdge> {
     use std::collections::HashMap;
     let mut leaving: HashMap<CornerKey, (usize, u32)> = HashMap::with_capacity(outline.len());
     let mut arriving: HashMap<CornerKey, u32> = HashMap::with_capacity(outline.len());
@@ -522,7 +522,7 @@ fn straight_runs(outline: Vec<OutlineEdge>) -> Vec<OutlineEdge> {
     // Runs start at edges that no straight edge leads into.
     let continued: Vec<bool> = {
         let mut c = vec![false; outline.len()];
-        for e in &outline {
+        for e in outline {
             if let Some(k) = next_straight(e) {
                 c[k] = true;
             }
