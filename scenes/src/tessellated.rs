@@ -164,6 +164,71 @@ pub fn tessellated(n: usize) -> Scene {
     }
 }
 
+/// A statue-like blob: an icosahedron's faces split `levels` times into four, every corner
+/// pushed out from the centre by a smooth bumpy function of its direction (folds, dents and
+/// overhangs that shade the blob itself), centred at `center` with mean radius `radius`. The
+/// faces are welded (shared corners have the same bits) and turn outwards: a closed solid.
+pub fn bumpy_blob(center: DVec3, radius: f64, levels: usize) -> Vec<[DVec3; 3]> {
+    let t = (1.0 + 5f64.sqrt()) / 2.0;
+    let v = [
+        (-1.0, t, 0.0),
+        (1.0, t, 0.0),
+        (-1.0, -t, 0.0),
+        (1.0, -t, 0.0),
+        (0.0, -1.0, t),
+        (0.0, 1.0, t),
+        (0.0, -1.0, -t),
+        (0.0, 1.0, -t),
+        (t, 0.0, -1.0),
+        (t, 0.0, 1.0),
+        (-t, 0.0, -1.0),
+        (-t, 0.0, 1.0),
+    ]
+    .map(|(x, y, z)| DVec3::new(x, y, z).normalize());
+    let faces = [
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    let mut triangles: Vec<[DVec3; 3]> = faces.iter().map(|f| f.map(|i| v[i])).collect();
+    for _ in 0..levels {
+        // Midpoints on the unit sphere: a + b has the same bits either way round.
+        let mid = |a: DVec3, b: DVec3| (a + b).normalize();
+        triangles = triangles
+            .into_iter()
+            .flat_map(|[a, b, c]| {
+                let (ab, bc, ca) = (mid(a, b), mid(b, c), mid(c, a));
+                [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]
+            })
+            .collect();
+    }
+    let bump = |d: DVec3| {
+        1.0 + 0.25 * (3.0 * d.x + 1.0).sin() * (2.0 * d.y).cos()
+            + 0.15 * (5.0 * d.z + 2.0 * d.x).sin()
+    };
+    triangles
+        .into_iter()
+        .map(|t| t.map(|d| center + d * (radius * bump(d))))
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -204,6 +269,25 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn the_blob_is_a_closed_welded_solid() {
+        let faces = bumpy_blob(DVec3::ZERO, 1.0, 2);
+        assert_eq!(faces.len(), 320);
+        let mut edges: HashMap<([u64; 3], [u64; 3]), usize> = HashMap::new();
+        let mut volume = 0.0;
+        for f in &faces {
+            for i in 0..3 {
+                *edges.entry((key(f[i]), key(f[(i + 1) % 3]))).or_default() += 1;
+            }
+            volume += f[0].dot(f[1].cross(f[2])) / 6.0;
+        }
+        for (&(a, b), &count) in &edges {
+            assert_eq!((count, edges.get(&(b, a))), (1, Some(&1)));
+        }
+        // Turned outwards: a positive volume, near the unit ball's.
+        assert!(volume > 2.0 && volume < 8.0, "{volume}");
     }
 
     #[test]

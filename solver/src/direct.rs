@@ -18,8 +18,8 @@ use penumbra_scenes::{PlaneFrame, Rgb, Scene, SurfaceId, Visibility};
 use smallvec::SmallVec;
 
 use crate::clip::{
-    HalfPlane, area_2d, clip_half_plane, clip_polygon_3d, clip_to_convex, convex_hull_2d,
-    inside_convex, merge_close_vertices, subtract_convex, subtract_half_planes, wider_than,
+    HalfPlane, area_2d, clip_half_plane, clip_polygon_3d, convex_hull_2d, inside_convex,
+    merge_close_vertices, subtract_convex, subtract_half_planes, wider_than,
 };
 use crate::lambert::{ReceivingPoint, contour_sum};
 use crate::occluder_tree::{OccluderTree, Reached, ShaftTest, TreeFace};
@@ -445,50 +445,51 @@ impl<'a> DirectLight<'a> {
         };
         let mut total = 0.0;
         for view in views {
-            let seen: Vec<Vec<DVec2>> = view
-                .visible
+            // What the faces through x hide on the receiver's side.
+            let hidden: Vec<Vec<DVec2>> = view
+                .touching
                 .iter()
-                .flatten()
-                .map(|c| clip_half_plane(c, &front))
-                .filter(|c| c.len() >= 3)
+                .filter(|&&index| self.occluders[index].surface != receiver)
+                .flat_map(|&index| contact_shadow(x, &self.occluders[index], e, tol))
+                .map(|region| {
+                    region
+                        .iter()
+                        .fold(view.piece.clone(), |part, h| clip_half_plane(&part, h))
+                })
+                .filter(|part| part.len() >= 3)
                 .collect();
-            if seen.is_empty() {
-                continue;
-            }
-            let mut sum = signed_sum(&seen);
-            // What the faces through x hide on the receiver's side, as disjoint convex pieces.
-            let mut hidden: Vec<Vec<DVec2>> = Vec::new();
-            let front_piece = clip_half_plane(&view.piece, &front);
-            for &index in &view.touching {
-                let occ = &self.occluders[index];
-                if occ.surface == receiver {
-                    continue;
+            let seen: Vec<Vec<DVec2>> = if hidden.is_empty() {
+                view.visible
+                    .iter()
+                    .flatten()
+                    .map(|c| clip_half_plane(c, &front))
+                    .filter(|c| c.len() >= 3)
+                    .collect()
+            } else {
+                // One difference, as for a receiver on its own: the hidden parts overlap each
+                // other and the part behind the receiver.
+                let mut union = ShadowUnion::default();
+                let behind = HalfPlane {
+                    normal: -front.normal,
+                    offset: -front.offset,
+                };
+                for part in hidden
+                    .into_iter()
+                    .chain(std::iter::once(clip_half_plane(&view.piece, &behind)))
+                {
+                    if part.len() >= 3 {
+                        union.add_contour(part);
+                    }
                 }
-                for region in contact_shadow(x, occ, e, tol) {
-                    let mut part = front_piece.clone();
-                    for h in &region {
-                        part = clip_half_plane(&part, h);
-                    }
-                    if part.len() < 3 {
-                        continue;
-                    }
-                    let mut parts = vec![part];
-                    for earlier in &hidden {
-                        let mut next = Vec::new();
-                        for p in &parts {
-                            subtract_convex(p, earlier, 0.0, &mut next);
-                        }
-                        parts = next;
-                    }
-                    hidden.extend(parts);
+                match union.subtract_within(view.visible.clone(), &view.piece, &self.overlay_limit)
+                {
+                    Ok(shapes) => shapes.into_iter().flatten().collect(),
+                    Err(_) => return f64::NAN,
                 }
+            };
+            if !seen.is_empty() {
+                total += signed_sum(&seen).max(0.0);
             }
-            for h in &hidden {
-                let inside: Vec<Vec<DVec2>> =
-                    seen.iter().filter_map(|c| clip_to_convex(c, h)).collect();
-                sum -= signed_sum(&inside);
-            }
-            total += sum.max(0.0);
         }
         total / (2.0 * PI)
     }

@@ -257,10 +257,10 @@ impl OccluderTree {
         let base = shaft.emitter_normal.dot(shaft.emitter_origin);
         let (low, high) = (low - base, high - base);
         if high < 0.0
-            || shaft
-                .sides
-                .iter()
-                .any(|&m| box_range(node.min, node.max, m).1 < m.dot(shaft.point))
+            || shaft.sides.iter().any(|&m| {
+                // A face through the point (within the margin) stays: it is not outside.
+                box_range(node.min, node.max, m).1 < m.dot(shaft.point) - shaft.margin * m.length()
+            })
         {
             return;
         }
