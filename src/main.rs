@@ -220,6 +220,11 @@ struct RunArgs {
     /// Render height in pixels.
     #[arg(long, default_value_t = 640)]
     height: u32,
+    /// Where the render looks from and at, as EX,EY,EZ:TX,TY,TZ, with the vertical field of view
+    /// in degrees after a third colon (default 45); upright as the default view. It replaces
+    /// the scene's own camera, and the default one that frames the whole scene.
+    #[arg(long, value_name = "EYE:TARGET[:FOV]")]
+    camera: Option<String>,
     /// Which surfaces get an SVG in OUT/surfaces: `auto` (every surface of a scene of at most 24,
     /// else the 24 with the most discontinuity segments, then the largest), `all`, `none`, or
     /// surface names, comma-separated.
@@ -672,6 +677,43 @@ fn traced_reference(
     Ok(cached.values)
 }
 
+/// `--camera EX,EY,EZ:TX,TY,TZ[:FOV]`.
+fn camera_of(
+    text: &str,
+    scene: &penumbra_scenes::Scene,
+) -> Result<penumbra_scenes::Camera, String> {
+    let parts: Vec<&str> = text.split(':').collect();
+    let point = |part: &str, what: &str| -> Result<glam::DVec3, String> {
+        let numbers: Result<Vec<f64>, _> = part.split(',').map(|n| n.trim().parse()).collect();
+        match numbers.as_deref() {
+            Ok(&[x, y, z]) if [x, y, z].iter().all(|v| v.is_finite()) => {
+                Ok(glam::DVec3::new(x, y, z))
+            }
+            _ => Err(format!(
+                "the {what} must be three finite numbers x,y,z, not {part:?}"
+            )),
+        }
+    };
+    let (eye, target, fov) = match parts.as_slice() {
+        [eye, target] => (point(eye, "eye")?, point(target, "target")?, None),
+        [eye, target, fov] => {
+            let fov: f64 = fov
+                .trim()
+                .parse()
+                .map_err(|_| format!("the field of view must be a number, not {fov:?}"))?;
+            (point(eye, "eye")?, point(target, "target")?, Some(fov))
+        }
+        _ => return Err("write it EX,EY,EZ:TX,TY,TZ or EX,EY,EZ:TX,TY,TZ:FOV".into()),
+    };
+    if eye == target {
+        return Err("the eye and the target are the same point".into());
+    }
+    if fov.is_some_and(|f| !(f > 0.0 && f < 180.0)) {
+        return Err("the field of view must lie between 0 and 180 degrees".into());
+    }
+    Ok(penumbra_viz::camera_looking(scene, eye, target, fov))
+}
+
 fn obj_options(no_merge: bool) -> ObjOptions {
     ObjOptions {
         merge_coplanar: !no_merge,
@@ -782,12 +824,15 @@ fn merge(args: &MergeArgs) -> Result<(), Failure> {
         .map(|(_, f)| f.scene.clone())
         .ok_or_else(|| fail(MergeError::Nothing))?;
     let spec = args.scene.clone().unwrap_or(origin.spec);
-    let loaded = load_scene_with(&spec, &obj_options(origin.no_merge)).map_err(|e| {
+    let mut loaded = load_scene_with(&spec, &obj_options(origin.no_merge)).map_err(|e| {
         usage(anyhow::anyhow!(
             "{}; give the scene with --scene",
             MergeError::Scene(e)
         ))
     })?;
+    if origin.camera.is_some() {
+        loaded.scene.camera = origin.camera;
+    }
     let merged = merge(shards, &loaded).map_err(|e| match e {
         MergeError::SceneChanged { .. } if args.scene.is_none() => usage(anyhow::anyhow!(
             "{e}; give the scene the shards were run on with --scene"
@@ -864,7 +909,12 @@ fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
         .as_deref()
         .map(|text| shard_of(text, args))
         .transpose()?;
-    let loaded = load(&args.scene, obj_options(args.no_merge))?;
+    let mut loaded = load(&args.scene, obj_options(args.no_merge))?;
+    if let Some(text) = &args.camera {
+        let camera = camera_of(text, &loaded.scene)
+            .map_err(|e| usage(anyhow::anyhow!("--camera {text:?}: {e}")))?;
+        loaded.scene.camera = Some(camera);
+    }
     if !args.quiet {
         for w in &loaded.warnings {
             eprintln!("warning: {w}");
@@ -959,6 +1009,11 @@ fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
         let origin = penumbra::shard::SceneOrigin {
             spec: args.scene.clone(),
             no_merge: args.no_merge,
+            camera: args
+                .camera
+                .is_some()
+                .then(|| result.loaded.scene.camera)
+                .flatten(),
         };
         let written = penumbra::shard::write_shard(&result, shard, origin, &args.out, &svgs)?;
         if !args.quiet {

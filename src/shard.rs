@@ -150,6 +150,9 @@ pub struct SceneOrigin {
     pub spec: String,
     /// OBJ files: whether coplanar faces were left unmerged.
     pub no_merge: bool,
+    /// The camera `--camera` gave, which replaced the scene's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub camera: Option<penumbra_scenes::Camera>,
 }
 
 /// [`SHARD_FILE`]: what a shard hands to [`merge`].

@@ -187,6 +187,36 @@ fn bad_input_exits_2_names_the_problem_and_writes_nothing() {
             .code(),
         Some(2)
     );
+    for (camera, words) in [
+        ("1,2:3,4,5", "three finite numbers"),
+        ("1,2,3:1,2,3", "the same point"),
+        ("0,-4,3:0,0,0:180", "between 0 and 180"),
+        ("0,-4,3", "EX,EY,EZ:TX,TY,TZ"),
+    ] {
+        let o = penumbra(&["run", "textbook", "--camera", camera]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{camera}: {err}");
+        assert!(
+            err.contains("--camera") && err.contains(words),
+            "{camera}: {err}"
+        );
+    }
+}
+
+/// `--camera` moves the render's view, and only it: the solution is the same.
+#[test]
+fn the_camera_moves_the_render_only() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+    run_quietly("textbook", &a, &["--direct-only"]);
+    run_quietly(
+        "textbook",
+        &b,
+        &["--direct-only", "--camera", "0.2,0.3,5:0.2,0.3,0:60"],
+    );
+    let read = |d: &Path, f: &str| std::fs::read(d.join(f)).expect("written");
+    assert_eq!(read(&a, "solution.json"), read(&b, "solution.json"));
+    assert_ne!(read(&a, "render.png"), read(&b, "render.png"));
 }
 
 /// EEE events are on by default where a scene has them, counted in the report, listed in the

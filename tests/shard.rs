@@ -107,8 +107,10 @@ fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
 #[test]
 fn shards_merge_into_the_run_not_split_byte_for_byte() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let cases: [(&str, &[&str]); 4] = [
+    let cases: [(&str, &[&str]); 5] = [
         ("cornell", &[]),
+        // The merge renders from the shards' camera.
+        ("textbook", &["--camera", "0.2,0.3,5:0.2,0.3,0:60"]),
         ("boxworld-12", &[]),
         ("tessellated-2", &[]),
         ("boxworld-1000", &["--fit"]),

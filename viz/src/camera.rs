@@ -27,13 +27,13 @@ pub fn default_camera(scene: &Scene) -> Camera {
     } else {
         (DVec3::ZERO, 1.0)
     };
-    let (direction, up) = if lights_face_minus_y(scene) {
+    let d = DEFAULT_VIEW_DIRECTION;
+    let direction = match scene_up(scene) {
         // z up, -y front turned into y up, +z front.
-        let d = DEFAULT_VIEW_DIRECTION;
-        (DVec3::new(d.x, d.z, -d.y), DVec3::Y)
-    } else {
-        (DEFAULT_VIEW_DIRECTION, DVec3::Z)
+        up if up == DVec3::Y => DVec3::new(d.x, d.z, -d.y),
+        _ => d,
     };
+    let up = scene_up(scene);
     let direction = direction.normalize();
     let half_fov = (0.5 * DEFAULT_FOV_DEG).to_radians();
     let distance = radius / half_fov.sin();
@@ -42,6 +42,37 @@ pub fn default_camera(scene: &Scene) -> Camera {
         target: center,
         up,
         fov_deg: DEFAULT_FOV_DEG,
+    }
+}
+
+/// A view whose direction's cosine with the up axis is within this of 1 runs along it.
+const ALONG_UP: f64 = 1e-6;
+
+/// A camera at `eye` looking at `target` with a vertical field of view of `fov_deg` (default
+/// [`DEFAULT_FOV_DEG`]), upright as [`default_camera`] is: +z up, or +y for scenes lit along -y;
+/// when the view runs along that axis, the other one.
+pub fn camera_looking(scene: &Scene, eye: DVec3, target: DVec3, fov_deg: Option<f64>) -> Camera {
+    let up = scene_up(scene);
+    let along = (target - eye).normalize_or_zero().dot(up).abs();
+    let up = if along > 1.0 - ALONG_UP {
+        if up == DVec3::Z { DVec3::Y } else { DVec3::Z }
+    } else {
+        up
+    };
+    Camera {
+        eye,
+        target,
+        up,
+        fov_deg: fov_deg.unwrap_or(DEFAULT_FOV_DEG),
+    }
+}
+
+/// The up direction of a scene's views: +y when its lights face -y (OBJ files), else +z.
+fn scene_up(scene: &Scene) -> DVec3 {
+    if lights_face_minus_y(scene) {
+        DVec3::Y
+    } else {
+        DVec3::Z
     }
 }
 

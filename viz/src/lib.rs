@@ -42,7 +42,7 @@ pub mod surface_svg;
 mod svg_plot;
 pub mod tonemap;
 
-pub use camera::default_camera;
+pub use camera::{camera_looking, default_camera};
 pub use chart::{LogLogChart, Series};
 pub use error::VizError;
 pub use render::{Render, RenderOptions, encode_png, render};
