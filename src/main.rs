@@ -223,7 +223,7 @@ struct RunArgs {
     /// Where the render looks from and at, as EX,EY,EZ:TX,TY,TZ, with the vertical field of view
     /// in degrees after a third colon (default 45); upright as the default view. It replaces
     /// the scene's own camera, and the default one that frames the whole scene.
-    #[arg(long, value_name = "EYE:TARGET[:FOV]")]
+    #[arg(long, value_name = "EYE:TARGET[:FOV]", allow_hyphen_values = true)]
     camera: Option<String>,
     /// Which surfaces get an SVG in OUT/surfaces: `auto` (every surface of a scene of at most 24,
     /// else the 24 with the most discontinuity segments, then the largest), `all`, `none`, or

@@ -212,7 +212,7 @@ fn the_camera_moves_the_render_only() {
     run_quietly(
         "textbook",
         &b,
-        &["--direct-only", "--camera", "0.2,0.3,5:0.2,0.3,0:60"],
+        &["--direct-only", "--camera", "-0.2,0.3,5:0.2,-0.3,0:60"],
     );
     let read = |d: &Path, f: &str| std::fs::read(d.join(f)).expect("written");
     assert_eq!(read(&a, "solution.json"), read(&b, "solution.json"));
