@@ -1009,11 +1009,7 @@ fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
         let origin = penumbra::shard::SceneOrigin {
             spec: args.scene.clone(),
             no_merge: args.no_merge,
-            camera: args
-                .camera
-                .is_some()
-                .then(|| result.loaded.scene.camera)
-                .flatten(),
+            camera: args.camera.as_ref().and(result.loaded.scene.camera),
         };
         let written = penumbra::shard::write_shard(&result, shard, origin, &args.out, &svgs)?;
         if !args.quiet {
