@@ -70,6 +70,15 @@ enum MeshArg {
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
+enum EventsArg {
+    /// Every EV and VE event: each light edge with each blocker vertex on the blocker's outline,
+    /// each light vertex with each blocker edge on it.
+    Complete,
+    /// Only the umbra and outer penumbra boundaries (and contact lines, and EEE events).
+    Extremal,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
 enum FormFactorArg {
     Analytic,
     MonteCarlo,
@@ -184,6 +193,9 @@ struct RunArgs {
     /// Discontinuity meshes: leave out EEE events (emitter edge with two blocker edges).
     #[arg(long)]
     no_eee: bool,
+    /// Discontinuity meshes: which EV and VE events become mesh edges.
+    #[arg(long, value_enum, default_value_t = EventsArg::Extremal)]
+    events: EventsArg,
     /// Discontinuity meshes: blockers (flat patches of faces) that can hide less than this
     /// fraction of a light from a receiver start no events there; adaptive refinement and the
     /// penumbra grading mesh their shadows instead.
@@ -948,6 +960,10 @@ fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
             }),
         discontinuity: penumbra_meshing::discontinuity::DiscontinuityOptions {
             eee: !args.no_eee,
+            events: match args.events {
+                EventsArg::Complete => penumbra_meshing::discontinuity::EventSet::Complete,
+                EventsArg::Extremal => penumbra_meshing::discontinuity::EventSet::Extremal,
+            },
             event_tolerance: args.event_tol,
             ..Default::default()
         },

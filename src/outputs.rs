@@ -149,6 +149,8 @@ struct Method {
     max_elements_requested: BudgetRequested,
     penumbra_density: f64,
     eee: bool,
+    /// Which EV and VE events: `complete` or `extremal`.
+    events: penumbra_meshing::discontinuity::EventSet,
     eee_tolerance: f64,
     event_tolerance: f64,
     /// Seconds the run was allowed (absent: no limit).
@@ -259,6 +261,7 @@ pub fn report_json(result: &RunResult, svgs: &SvgSelection) -> String {
             max_elements_requested: opts.max_elements.into(),
             penumbra_density: opts.penumbra_density,
             eee: opts.discontinuity.eee,
+            events: opts.discontinuity.events,
             eee_tolerance: opts.discontinuity.eee_tolerance,
             event_tolerance: opts.discontinuity.event_tolerance,
             time_budget: opts.time_budget,

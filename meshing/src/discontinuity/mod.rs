@@ -67,6 +67,20 @@ pub struct DiscontinuitySegment {
     pub order: u8,
 }
 
+/// Which EV and VE events discontinuity finding inserts.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum EventSet {
+    /// Every one: an emitter edge with each blocker vertex on the blocker's outline as seen from
+    /// the edge, and each emitter vertex with each blocker edge on the outline as seen from it.
+    /// The visible area's second derivative jumps across each.
+    Complete,
+    /// Only those whose plane is tangent to both the emitter and the blocker: the umbra and
+    /// outer penumbra boundaries.
+    #[default]
+    Extremal,
+}
+
 /// Options of discontinuity finding.
 #[derive(Clone, Debug, PartialEq)]
 pub struct DiscontinuityOptions {
@@ -76,6 +90,8 @@ pub struct DiscontinuityOptions {
     pub trim_tolerance: f64,
     /// Whether to find EEE events (emitter edge with two blocker edges).
     pub eee: bool,
+    /// Which EV and VE events to insert.
+    pub events: EventSet,
     /// EEE curves become polylines within this fraction of the receiver's diameter.
     pub eee_tolerance: f64,
     /// Blocker patches that can hide less than this fraction of an emitter from a receiver start
@@ -123,6 +139,7 @@ impl Default for DiscontinuityOptions {
             trim_samples: 16,
             trim_tolerance: 1e-9,
             eee: true,
+            events: EventSet::default(),
             eee_tolerance: 1e-4,
             event_tolerance: DEFAULT_EVENT_TOLERANCE,
             element_area: None,

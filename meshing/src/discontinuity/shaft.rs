@@ -13,7 +13,7 @@ use super::topology::Topology;
 use super::wedge::{Event, Wedge};
 use super::{
     Boundary, DiscontinuityOptions, DiscontinuitySegment, DiscontinuityStats, EEE_MAX_EDGES,
-    MIN_RECEIVER_ELEMENTS, clip_to_polygon, eee, hull, trim,
+    EventSet, MIN_RECEIVER_ELEMENTS, clip_to_polygon, eee, hull, trim,
 };
 
 /// What the whole search shares: the scene, its welded topology and every surface's frame.
@@ -276,7 +276,11 @@ impl Shaft<'_> {
                 let n = (self.point(ib) - self.point(ia)).cross(pv - self.point(ia));
                 let Some(n) = n.try_normalize() else { continue };
                 stats.wedges_considered += 1;
-                if !topology.vertex_is_tangent(v, n, self.not_pair()) {
+                let event = match self.context.options.events {
+                    EventSet::Complete => topology.vertex_on_outline(v, &source, self.not_pair()),
+                    EventSet::Extremal => topology.vertex_is_tangent(v, n, self.not_pair()),
+                };
+                if !event {
                     stats.wedges_culled += 1;
                     continue;
                 }
@@ -322,7 +326,8 @@ impl Shaft<'_> {
                     continue;
                 };
                 stats.wedges_considered += 1;
-                if !topology.vertex_is_tangent(ia, n, |s| s == e)
+                let extremal = self.context.options.events == EventSet::Extremal;
+                if (extremal && !topology.vertex_is_tangent(ia, n, |s| s == e))
                     || !topology.edge_is_tangent(u, w, n, self.not_pair())
                 {
                     stats.wedges_culled += 1;

@@ -138,6 +138,41 @@ impl Topology {
         true
     }
 
+    /// Whether vertex `v` is on the outline of the faces around it (those for which `include`
+    /// holds) as seen from one of `viewpoints`: it lies on the rim of an open sheet (an edge at `v`
+    /// with one such face: every corner of a single polygon), or some of its faces turn towards
+    /// the viewpoint and some away (a silhouette vertex of a solid).
+    pub fn vertex_on_outline(
+        &self,
+        v: usize,
+        viewpoints: &[DVec3],
+        include: impl Fn(SurfaceId) -> bool,
+    ) -> bool {
+        let faces: Vec<&Corner> = self.corners[v]
+            .iter()
+            .filter(|c| include(c.surface))
+            .collect();
+        let faces_on = |a: usize, b: usize| {
+            self.edges
+                .get(&(a.min(b), a.max(b)))
+                .map_or(0, |f| f.iter().filter(|&&(s, _)| include(s)).count())
+        };
+        if faces
+            .iter()
+            .any(|c| faces_on(v, c.prev) == 1 || faces_on(v, c.next) == 1)
+        {
+            return true;
+        }
+        let origin = self.points[v];
+        viewpoints.iter().any(|&q| {
+            let mut seen = 0i8;
+            !faces.iter().all(|c| {
+                let side = self.side(self.normals[c.surface], origin, q);
+                keeps_side(&mut seen, side)
+            })
+        })
+    }
+
     /// Whether every face along the edge `(a, b)` for which `include` holds lies on one side of
     /// the plane through the edge with unit normal `n`.
     pub fn edge_is_tangent(
