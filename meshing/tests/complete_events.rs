@@ -65,6 +65,17 @@ fn a_convex_blocker_parallel_to_a_convex_light_gets_every_ev_and_ve_line() {
         };
         let found = find_discontinuities(&scene, &vis, &options);
         let floor: Vec<[DVec3; 2]> = found.segments[2].iter().map(|g| [g.from, g.to]).collect();
+        // Counted by kind: the blocker touches nothing, and every segment is of one kind.
+        let st = &found.stats;
+        assert_eq!(st.contact_lines, 0);
+        assert_eq!(
+            st.ev_segments + st.ve_segments + st.eee_segments,
+            st.segments
+        );
+        assert_eq!(
+            st.order_0_segments + st.order_1_segments + st.order_2_segments,
+            st.segments
+        );
         let mut expected = Vec::new();
         for i in 0..n {
             let (a, b) = (light[i], light[(i + 1) % n]);

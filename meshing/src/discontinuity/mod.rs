@@ -172,7 +172,9 @@ pub struct DiscontinuityStats {
     pub eee_shafts_skipped: usize,
     /// Feature pairs that could form a wedge (in front of both emitter and receiver).
     pub wedges_considered: usize,
-    /// Of those, not tangent to the emitter or the blocker's silhouette.
+    /// Of those, not events of the set asked for ([`EventSet`]): with `Extremal`, not tangent
+    /// to the emitter or the blocker's silhouette; with `Complete`, a blocker feature not on
+    /// its outline.
     pub wedges_culled: usize,
     /// Wedges that left a segment on their receiver.
     pub wedges_kept: usize,
@@ -188,10 +190,37 @@ pub struct DiscontinuityStats {
     pub eee_events: usize,
     /// Segments after merging coincident ones.
     pub segments: usize,
+    /// Of those, by event (coincident events of several kinds count as the merged line's).
+    pub ev_segments: usize,
+    pub ve_segments: usize,
+    pub eee_segments: usize,
+    pub contact_lines: usize,
+    /// Of those, by order: where the value (0), the slope (1) or the curvature (2) jumps.
+    pub order_0_segments: usize,
+    pub order_1_segments: usize,
+    pub order_2_segments: usize,
     pub seconds: f64,
 }
 
 impl DiscontinuityStats {
+    /// Counts the merged segments, by event and by order.
+    fn count_kinds<'s>(&mut self, segments: impl Iterator<Item = &'s DiscontinuitySegment>) {
+        for g in segments {
+            self.segments += 1;
+            match g.event {
+                Event::Ev => self.ev_segments += 1,
+                Event::Ve => self.ve_segments += 1,
+                Event::Eee => self.eee_segments += 1,
+                Event::Contact => self.contact_lines += 1,
+            }
+            match g.order {
+                0 => self.order_0_segments += 1,
+                1 => self.order_1_segments += 1,
+                _ => self.order_2_segments += 1,
+            }
+        }
+    }
+
     /// Adds the counts of another part of the search (times excepted).
     fn add(&mut self, other: &DiscontinuityStats) {
         self.pairs += other.pairs;
@@ -305,7 +334,7 @@ pub fn find_discontinuities_reporting(
             None => Vec::new(),
         })
         .collect();
-    stats.segments = segments.iter().map(Vec::len).sum();
+    stats.count_kinds(segments.iter().flatten());
     stats.seconds = started.elapsed().as_secs_f64();
     Discontinuities {
         segments,
