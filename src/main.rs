@@ -303,8 +303,9 @@ struct SweepArgs {
     /// not emit).
     #[arg(long, value_delimiter = ',')]
     surfaces: Vec<String>,
-    /// The methods to run (comma-separated; default: all four).
-    #[arg(long, value_delimiter = ',', value_parser = ["uniform", "uniform+adaptive", "discontinuity", "discontinuity+adaptive"])]
+    /// The methods to run (comma-separated; default: the first four). `discontinuity-complete`
+    /// meshes every EV and VE event (`run --events complete`).
+    #[arg(long, value_delimiter = ',', value_parser = ["uniform", "uniform+adaptive", "discontinuity", "discontinuity+adaptive", "discontinuity-complete"])]
     methods: Vec<String>,
     /// The solvers to compare, comma-separated (default: progressive). Adaptive runs use
     /// progressive refinement only.
@@ -526,10 +527,13 @@ fn sweep(args: &SweepArgs) -> Result<(), Failure> {
             ))
         })?);
     }
-    let methods = penumbra::sweep::SweepMethod::ALL
-        .into_iter()
-        .filter(|m| args.methods.is_empty() || args.methods.iter().any(|n| n == m.name()))
-        .collect();
+    let methods = match args.methods.is_empty() {
+        true => penumbra::sweep::SweepMethod::DEFAULT.to_vec(),
+        false => penumbra::sweep::SweepMethod::ALL
+            .into_iter()
+            .filter(|m| args.methods.iter().any(|n| n == m.name()))
+            .collect(),
+    };
     let options = penumbra::sweep::SweepOptions {
         budgets: args.budgets.clone(),
         methods,

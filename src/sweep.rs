@@ -8,7 +8,7 @@
 //! penumbra subset, scored on its own.
 
 use glam::DVec3;
-use penumbra_meshing::discontinuity::EmitterProbe;
+use penumbra_meshing::discontinuity::{DiscontinuityOptions, EmitterProbe, EventSet};
 use penumbra_meshing::grading::DEFAULT_PENUMBRA_DENSITY;
 use penumbra_meshing::locate::TriangleLocator;
 use penumbra_scenes::rng::SplitMix64;
@@ -26,16 +26,28 @@ use crate::pipeline::{MeshMethod, RunError, RunOptions, run};
 pub enum SweepMethod {
     Uniform,
     UniformAdaptive,
+    /// Discontinuity meshes of the default events ([`EventSet::Extremal`]).
     Discontinuity,
     DiscontinuityAdaptive,
+    /// Discontinuity meshes of every EV and VE event ([`EventSet::Complete`]).
+    DiscontinuityComplete,
 }
 
 impl SweepMethod {
-    pub const ALL: [SweepMethod; 4] = [
+    /// What a sweep runs unless told otherwise.
+    pub const DEFAULT: [SweepMethod; 4] = [
         SweepMethod::Uniform,
         SweepMethod::UniformAdaptive,
         SweepMethod::Discontinuity,
         SweepMethod::DiscontinuityAdaptive,
+    ];
+    /// Every method a sweep can run.
+    pub const ALL: [SweepMethod; 5] = [
+        SweepMethod::Uniform,
+        SweepMethod::UniformAdaptive,
+        SweepMethod::Discontinuity,
+        SweepMethod::DiscontinuityAdaptive,
+        SweepMethod::DiscontinuityComplete,
     ];
 
     pub fn name(self) -> &'static str {
@@ -44,6 +56,14 @@ impl SweepMethod {
             SweepMethod::UniformAdaptive => "uniform+adaptive",
             SweepMethod::Discontinuity => "discontinuity",
             SweepMethod::DiscontinuityAdaptive => "discontinuity+adaptive",
+            SweepMethod::DiscontinuityComplete => "discontinuity-complete",
+        }
+    }
+
+    fn events(self) -> EventSet {
+        match self {
+            SweepMethod::DiscontinuityComplete => EventSet::Complete,
+            _ => EventSet::default(),
         }
     }
 
@@ -213,6 +233,10 @@ pub fn sweep(
                     width: 1,
                     height: 1,
                     ..Default::default()
+                },
+                discontinuity: DiscontinuityOptions {
+                    events: method.events(),
+                    ..DiscontinuityOptions::default()
                 },
                 ..RunOptions::default()
             };
