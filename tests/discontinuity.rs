@@ -331,3 +331,85 @@ fn a_hovering_light_casts_contact_lines_on_the_ceiling() {
     }
     assert!(lifted >= 8, "{lifted} vertices on the outline");
 }
+
+/// Complete events are classified by what each side of them sees: a square blocker turned 45°
+/// under a square light, and a pentagon under a triangle, in parallel planes. A line with one
+/// side in full light is an outer penumbra boundary, one with a side in full shadow an umbra
+/// boundary, and the lines that completeness adds lie inside the penumbra, of order 2 (no edge of
+/// the blocker is parallel to one of the light's).
+#[test]
+fn complete_events_are_classified_by_what_each_side_sees() {
+    use penumbra_meshing::discontinuity::EventSet;
+    use penumbra_scenes::{Rgb, Surface};
+    use penumbra_solver::ReceivingPoint;
+    let regular = |n: usize, radius: f64, center: DVec3, turn: f64| -> Vec<DVec3> {
+        // Listed clockwise seen from above: facing down.
+        (0..n)
+            .rev()
+            .map(|i| {
+                let a = turn + std::f64::consts::TAU * i as f64 / n as f64;
+                center + DVec3::new(radius * a.cos(), radius * a.sin(), 0.0)
+            })
+            .collect()
+    };
+    for (n, k, blocker_turn) in [(4, 4, std::f64::consts::FRAC_PI_4), (3, 5, 1.3)] {
+        let grey = Rgb::splat(0.5);
+        let mut floor = regular(4, 20.0, DVec3::ZERO, 0.3);
+        floor.reverse();
+        let scene = Scene {
+            name: "parallel".into(),
+            camera: None,
+            surfaces: vec![
+                Surface::new(
+                    "light",
+                    regular(n, 0.6, DVec3::new(0.0, 0.0, 3.0), 0.0),
+                    Rgb::ZERO,
+                )
+                .with_emission(Rgb::splat(1.0)),
+                Surface::new(
+                    "blocker",
+                    regular(k, 0.45, DVec3::new(0.05, -0.02, 1.2), blocker_turn),
+                    grey,
+                ),
+                Surface::new("floor", floor, grey),
+            ],
+        };
+        let vis = Visibility::build(&scene);
+        let options = DiscontinuityOptions {
+            events: EventSet::Complete,
+            ..DiscontinuityOptions::default()
+        };
+        let found = find_discontinuities(&scene, &vis, &options);
+        let direct = DirectLight::new(&scene, &vis);
+        let light = &scene.surfaces[0].polygon;
+        let tol = vis.contact_distance();
+        // The share of the light seen from a floor point.
+        let seen = |p: DVec3| {
+            let x = ReceivingPoint::interior(p, DVec3::Z);
+            direct.form_factor_visible(&x, 2, 0) / penumbra_solver::form_factor(&x, light, tol)
+        };
+        let mut inner = 0;
+        for g in &found.segments[2] {
+            let mid = (g.from + g.to) / 2.0;
+            let across = (g.to - g.from).cross(DVec3::Z).normalize() * 1e-6;
+            let sides = [seen(mid + across), seen(mid - across)];
+            let expected = if sides.iter().any(|&f| f < 1e-9) {
+                Boundary::Umbra
+            } else if sides.iter().any(|&f| f > 1.0 - 1e-9) {
+                Boundary::Penumbra
+            } else {
+                Boundary::Inner
+            };
+            assert_eq!(
+                g.boundary, expected,
+                "{n}-gon over {k}-gon: {g:?} sees {sides:?}"
+            );
+            // No edge of the blocker is parallel to one of the light's: the curvature jumps.
+            if expected == Boundary::Inner {
+                assert_eq!(g.order, 2, "{n}-gon over {k}-gon: {g:?}");
+                inner += 1;
+            }
+        }
+        assert!(inner > 0, "{n}-gon over {k}-gon: no inner lines");
+    }
+}
