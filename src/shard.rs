@@ -736,9 +736,8 @@ fn sum_mesh_figures(report: &mut serde_json::Value, shards: &[&serde_json::Value
     }
 }
 
-/// The ambient term of a solution that left `unshot` power unshot: spread over the scene's area
-/// and reflected on without end at its mean reflectance (as the solver makes it from its
-/// elements, which cover the polygons).
+/// The ambient term of a solution that left `unshot` power unshot, over the scene's polygons
+/// (which the solver's elements cover).
 fn ambient_of(scene: &Scene, unshot: Rgb) -> Rgb {
     let area: f64 = scene.surfaces.iter().map(|s| s.area()).sum();
     let mean_reflectance = scene
@@ -747,7 +746,7 @@ fn ambient_of(scene: &Scene, unshot: Rgb) -> Rgb {
         .map(|s| s.reflectance * s.area())
         .sum::<Rgb>()
         / area;
-    (unshot / area).mul_rgb(mean_reflectance.map(|r| 1.0 / (1.0 - r)))
+    penumbra_solver::progressive::ambient_term(unshot, area, mean_reflectance)
 }
 
 /// An RGB triple at `path` in a report, zero if absent.

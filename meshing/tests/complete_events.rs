@@ -91,24 +91,20 @@ fn a_convex_blocker_parallel_to_a_convex_light_gets_every_ev_and_ve_line() {
         }
         let tol = 1e-9 * scene.diagonal();
         let case = format!("{n}-gon light, {k}-gon blocker turned {blocker_turn}");
-        // Events that coincide are one line: every point of a segment lies on some event.
-        for s in &floor {
-            for step in 0..=20 {
-                let x = s[0].lerp(s[1], f64::from(step) / 20.0);
-                assert!(
-                    expected.iter().any(|&e| distance_to_segment(x, e) <= tol),
-                    "{case}: {x} of the segment {s:?} is on no EV or VE event"
-                );
+        // Events that coincide are one line: every point of a segment lies on some event, and
+        // every point of an event on some segment.
+        let on_some = |from: &[[DVec3; 2]], onto: &[[DVec3; 2]], what: &str| {
+            for s in from {
+                for step in 0..=20 {
+                    let x = s[0].lerp(s[1], f64::from(step) / 20.0);
+                    assert!(
+                        onto.iter().any(|&e| distance_to_segment(x, e) <= tol),
+                        "{case}: {x} of {s:?} is on no {what}"
+                    );
+                }
             }
-        }
-        for e in &expected {
-            for step in 0..=20 {
-                let x = e[0].lerp(e[1], f64::from(step) / 20.0);
-                assert!(
-                    floor.iter().any(|&s| distance_to_segment(x, s) <= tol),
-                    "{case}: nothing at {x} of the event {e:?}"
-                );
-            }
-        }
+        };
+        on_some(&floor, &expected, "EV or VE event");
+        on_some(&expected, &floor, "segment on the floor");
     }
 }

@@ -123,10 +123,10 @@ enum Blocking<'a> {
         corners: FaceCorners,
         keys: Option<&'a [CornerKey]>,
     },
-    /// The faces of a node of the occluder tree, projected whole: their outline's edges
-    /// (corner keys and the projection of the first), all turned one way.
+    /// The faces of a sheet of the occluder tree (a node, or a plane of one), projected whole:
+    /// their outline's edges (corner keys and the projection of the first), all turned one way.
     Outline {
-        node: usize,
+        sheet: usize,
         edges: Vec<(CornerKey, CornerKey, DVec2)>,
     },
 }
@@ -694,9 +694,9 @@ impl<'a> DirectLight<'a> {
             start.is_some() || !outlines.is_empty() || candidates.len() > self.sequential_shadows;
 
         let mut blockings = Vec::with_capacity(candidates.len() + outlines.len());
-        for (node, reversed) in outlines {
-            let edges = self.outline_edges(node, reversed, project);
-            blockings.push(Blocking::Outline { node, edges });
+        for (sheet, reversed) in outlines {
+            let edges = self.outline_edges(sheet, reversed, project);
+            blockings.push(Blocking::Outline { sheet, edges });
         }
         for index in candidates {
             let occ = &self.occluders[index];
@@ -754,14 +754,14 @@ impl<'a> DirectLight<'a> {
         Some(Blocked { blockings, start })
     }
 
-    /// A node's outline, turned as its faces face x, with each edge's first corner projected.
+    /// A sheet's outline, turned as its faces face x, with each edge's first corner projected.
     fn outline_edges(
         &self,
-        node: usize,
+        sheet: usize,
         reversed: bool,
         project: impl Fn(DVec3) -> DVec2,
     ) -> Vec<(CornerKey, CornerKey, DVec2)> {
-        let edges = self.tree.outline(node).iter();
+        let edges = self.tree.outline(sheet).iter();
         if reversed {
             edges.map(|e| (e.to, e.from, project(e.to_at))).collect()
         } else {
@@ -769,7 +769,7 @@ impl<'a> DirectLight<'a> {
         }
     }
 
-    /// The faces (sorted) and outline nodes of the occluder tree in the shaft with these sides,
+    /// The faces (sorted) and outline sheets of the occluder tree in the shaft with these sides,
     /// less the receiver's own faces, the emitter's, and faces of closed solids turned away.
     fn reached(
         &self,
@@ -794,7 +794,7 @@ impl<'a> DirectLight<'a> {
             },
             &mut |reached| match reached {
                 Reached::Face(index) => candidates.push(index),
-                Reached::Outline { node, reversed } => outlines.push((node, reversed)),
+                Reached::Outline { sheet, reversed } => outlines.push((sheet, reversed)),
             },
         );
         candidates.sort_unstable();
@@ -810,7 +810,7 @@ impl<'a> DirectLight<'a> {
         (candidates, outlines)
     }
 
-    /// What the tree's outline nodes in the shaft and the faces filling the largest solid
+    /// What the tree's outline sheets in the shaft and the faces filling the largest solid
     /// angles from x leave visible of `piece`, when its hull is much smaller than the piece: no
     /// other face matters outside that hull.
     #[allow(clippy::too_many_arguments)]
@@ -839,8 +839,8 @@ impl<'a> DirectLight<'a> {
         ranked.select_nth_unstable_by(count - 1, |a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
         let project = |p: DVec3| project_onto(e, point, h_x, p);
         let mut union = ShadowUnion::default();
-        for &(node, reversed) in outlines {
-            union.add_edges(&self.outline_edges(node, reversed, project));
+        for &(sheet, reversed) in outlines {
+            union.add_edges(&self.outline_edges(sheet, reversed, project));
         }
         for &(_, index) in &ranked[..count] {
             let occ = &self.occluders[index];
@@ -868,7 +868,7 @@ impl<'a> DirectLight<'a> {
 }
 
 impl DirectLight<'_> {
-    /// The blockings with each outline replaced by its node's faces, projected whole, for the
+    /// The blockings with each outline replaced by its sheet's faces, projected whole, for the
     /// one-by-one subtraction.
     fn faces_of_outlines<'b>(
         &self,
@@ -879,11 +879,11 @@ impl DirectLight<'_> {
     ) -> Vec<Blocking<'b>> {
         let mut out = Vec::with_capacity(blockings.len());
         for b in blockings {
-            let Blocking::Outline { node, .. } = b else {
+            let Blocking::Outline { sheet, .. } = b else {
                 out.push(b);
                 continue;
             };
-            for &index in self.tree.faces_of(node) {
+            for &index in self.tree.faces_of(sheet) {
                 let corners = self.occluders[index]
                     .polygon
                     .iter()

@@ -93,10 +93,9 @@ struct Node {
     start: usize,
     end: usize,
     children: Option<(usize, usize)>,
-    /// All its faces as one sheet, when they can all turn one way.
-    sheet: Option<usize>,
-    /// Else its plane groups, when they are few ([`MAX_GROUPS`]).
-    groups: std::ops::Range<usize>,
+    /// Its sheets: all its faces as one, when they can all turn one way; else its plane groups,
+    /// when they are few ([`MAX_GROUPS`]); else none.
+    sheets: std::ops::Range<usize>,
 }
 
 /// The shaft from a point to a convex piece of an emitter, as the tree tests it.
@@ -121,7 +120,7 @@ pub(crate) enum Reached {
     Face(usize),
     /// A sheet (a node, or a plane group of one) whose faces all turn one way to the point: its
     /// outline, reversed when they turn away.
-    Outline { node: usize, reversed: bool },
+    Outline { sheet: usize, reversed: bool },
 }
 
 /// The tree over a scene's occluder pieces.
@@ -169,13 +168,10 @@ impl OccluderTree {
         }
         let index = self.nodes.len();
         let members = &self.items[start..end];
-        let (mut sheet, mut groups) = (None, self.sheets.len()..self.sheets.len());
+        let first = self.sheets.len();
         if end - start >= OUTLINE_MIN_FACES {
             match sheet_of(members.iter().map(|&i| &faces[i]), Members::Node(index)) {
-                Some(whole) => {
-                    sheet = Some(self.sheets.len());
-                    self.sheets.push(whole);
-                }
+                Some(whole) => self.sheets.push(whole),
                 None => {
                     let planes = plane_groups(faces, members, centroids);
                     if planes.len() <= MAX_GROUPS {
@@ -188,7 +184,6 @@ impl OccluderTree {
                             .collect();
                         if let Some(made) = made {
                             self.sheets.extend(made);
-                            groups.end = self.sheets.len();
                         }
                     }
                 }
@@ -200,8 +195,7 @@ impl OccluderTree {
             start,
             end,
             children: None,
-            sheet,
-            groups,
+            sheets: first..self.sheets.len(),
         });
         if end - start > LEAF_FACES {
             let mid = match meshes.split(&mut self.items[start..end]) {
@@ -265,8 +259,9 @@ impl OccluderTree {
             return;
         }
         if low > shaft.lowest && high < shaft.highest {
-            let sheets = node.sheet.map_or(node.groups.clone(), |s| s..s + 1);
-            let turns: Option<Vec<bool>> = sheets
+            let sheets = node.sheets.clone();
+            // At most MAX_GROUPS: kept inline, as this runs at every node a shaft meets.
+            let turns: Option<smallvec::SmallVec<[bool; MAX_GROUPS]>> = sheets
                 .clone()
                 .map(|s| self.sheets[s].turns_away(shaft.point, shaft.margin))
                 .collect();
@@ -274,7 +269,7 @@ impl OccluderTree {
                 for (s, away) in sheets.zip(turns) {
                     if !(away && self.sheets[s].closed) {
                         visit(Reached::Outline {
-                            node: s,
+                            sheet: s,
                             reversed: away,
                         });
                     }
@@ -604,7 +599,7 @@ mod tests {
             },
             &mut |r| match r {
                 Reached::Face(i) => faces.push(i),
-                Reached::Outline { node, reversed } => outlines.push((node, reversed)),
+                Reached::Outline { sheet, reversed } => outlines.push((sheet, reversed)),
             },
         );
         (faces, outlines)

@@ -247,7 +247,7 @@ struct Limits<'o> {
 /// Receivers closer than this fraction of the scene's diagonal share one evaluation of what
 /// their light's occluders hide: the meshes of faces meeting at a vertex put their vertices
 /// there a few ulps apart, and the light seen from points that close differs by as little.
-const SHARED_POINT: f64 = 1e-12;
+pub const SHARED_POINT: f64 = 1e-12;
 
 /// Edges one polygon difference of the direct light may hold; points that would need more get
 /// the estimate by rays, and the report counts them. The overlay's cost grows with the
@@ -270,8 +270,8 @@ fn direct_at(
     progress: &dyn Progress,
 ) -> Result<(Vec<Rgb>, Estimated), SolveError> {
     // Groups in order of first appearance, so the work and its result do not depend on hashing.
-    let mut groups: Vec<Vec<usize>> = Vec::new();
-    let mut points: Vec<DVec3> = Vec::new();
+    // Each group: the grid point its receivers round to, and the receivers.
+    let mut groups: Vec<(DVec3, Vec<usize>)> = Vec::new();
     let mut at_point: HashMap<[i64; 3], usize> = HashMap::new();
     let quantum = SHARED_POINT * direct.scene_diagonal();
     let gridded = quantum > 0.0 && quantum.is_finite();
@@ -290,11 +290,10 @@ fn direct_at(
             )
         };
         let g = *at_point.entry(key).or_insert_with(|| {
-            groups.push(Vec::new());
-            points.push(at);
+            groups.push((at, Vec::new()));
             groups.len() - 1
         });
-        groups[g].push(i);
+        groups[g].1.push(i);
     }
     let members = |g: &[usize]| -> Vec<(ReceivingPoint, SurfaceId)> {
         g.iter()
@@ -304,10 +303,9 @@ fn direct_at(
             })
             .collect()
     };
-    let order: Vec<usize> = (0..groups.len()).collect();
     let late = || limits.deadline.is_some_and(|d| Instant::now() >= d);
-    let exact = par_map_with_progress(&order, "direct light", limits.interrupt, progress, |&g| {
-        (!late()).then(|| direct.irradiance_group(points[g], &members(&groups[g])))
+    let exact = par_map_with_progress(&groups, "direct light", limits.interrupt, progress, |g| {
+        (!late()).then(|| direct.irradiance_group(g.0, &members(&g.1)))
     })?;
     // A point whose view of a light is beyond the overlay cap gets NaN: estimated, like the
     // points left at the deadline.
@@ -323,7 +321,7 @@ fn direct_at(
     } else {
         (0..groups.len())
             .filter(|&g| too_complex(&exact[g]))
-            .map(|g| groups[g].len())
+            .map(|g| groups[g].1.len())
             .sum()
     };
     let exact: Vec<Option<Vec<Rgb>>> = exact
@@ -335,15 +333,15 @@ fn direct_at(
     let left: Vec<usize> = (0..groups.len()).filter(|&g| exact[g].is_none()).collect();
     let estimates =
         par_map_with_progress(&left, "direct light, estimated", None, progress, |&g| {
-            members(&groups[g])
+            members(&groups[g].1)
                 .iter()
                 .map(|(x, r)| direct.irradiance_sampled(x, *r, limits.rays))
                 .collect::<Vec<Rgb>>()
         })?;
-    let estimated: usize = left.iter().map(|&g| groups[g].len()).sum();
+    let estimated: usize = left.iter().map(|&g| groups[g].1.len()).sum();
     let mut estimates = estimates.into_iter();
     let mut out = vec![Rgb::ZERO; receivers.len()];
-    for (g, exact) in groups.iter().zip(exact) {
+    for ((_, g), exact) in groups.iter().zip(exact) {
         let values = exact.or_else(|| estimates.next()).unwrap_or_default();
         for (&i, h) in g.iter().zip(values) {
             out[i] = h;
@@ -409,6 +407,12 @@ fn par_map_with_progress<T: Sync, U: Send + Default>(
         return Err(SolveError::Interrupted);
     }
     Ok(out)
+}
+
+/// The ambient term of a solution that left `unshot` power unshot: spread over `area` and
+/// reflected on without end at the mean reflectance.
+pub fn ambient_term(unshot: Rgb, area: f64, mean_reflectance: Rgb) -> Rgb {
+    (unshot / area).mul_rgb(mean_reflectance.map(|r| 1.0 / (1.0 - r)))
 }
 
 /// Solves a meshed scene by progressive refinement.
@@ -935,7 +939,7 @@ impl<'a> ProgressiveSolver<'a> {
             .map(|e| scene.surfaces[e.surface].reflectance * e.area)
             .sum::<Rgb>()
             / total_area;
-        let ambient = (unshot / total_area).mul_rgb(mean_rho.map(|r| 1.0 / (1.0 - r)));
+        let ambient = ambient_term(unshot, total_area, mean_rho);
         let emitted = scene.emitted_power();
         let stats = SolveStats {
             stop: self.stop,

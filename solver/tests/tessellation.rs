@@ -165,8 +165,8 @@ fn the_faces_at_a_blob_corner_share_their_view_exactly() {
     let least = penumbra_meshing::polygon_minimum(&scene);
     let mesh = penumbra_meshing::mesh_scene_uniform(&scene, least).expect("meshes");
     let disc = Discretization::new(&scene, &mesh, 24);
-    // Grouped as the solver groups them: by the grid point of 10⁻¹² of the scene.
-    let quantum = 1e-12 * direct.scene_diagonal();
+    // Grouped as the solver groups them: by the grid point they round to.
+    let quantum = penumbra_solver::progressive::SHARED_POINT * direct.scene_diagonal();
     let mut at_point: BTreeMap<[i64; 3], Vec<usize>> = BTreeMap::new();
     for (v, x) in disc.receivers.iter().enumerate() {
         let q = (x.point / quantum).round();

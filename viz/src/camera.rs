@@ -28,12 +28,13 @@ pub fn default_camera(scene: &Scene) -> Camera {
         (DVec3::ZERO, 1.0)
     };
     let d = DEFAULT_VIEW_DIRECTION;
-    let direction = match scene_up(scene) {
-        // z up, -y front turned into y up, +z front.
-        up if up == DVec3::Y => DVec3::new(d.x, d.z, -d.y),
-        _ => d,
-    };
     let up = scene_up(scene);
+    let direction = if up == DVec3::Y {
+        // z up, -y front turned into y up, +z front.
+        DVec3::new(d.x, d.z, -d.y)
+    } else {
+        d
+    };
     let direction = direction.normalize();
     let half_fov = (0.5 * DEFAULT_FOV_DEG).to_radians();
     let distance = radius / half_fov.sin();
