@@ -44,6 +44,14 @@ pub(crate) struct PairEvents {
     pub stats: DiscontinuityStats,
 }
 
+/// A wedge to follow onto the receiver. A complete EV wedge may hold the blocker vertex on the
+/// outline from only part of its emitter edge: `outline_vertex` names the vertex, checked again
+/// for each generating ray (beyond that part, the ray enters the blocker at the vertex).
+struct Candidate {
+    wedge: Wedge,
+    outline_vertex: Option<usize>,
+}
+
 /// One emitter–receiver pair with the blockers in the shaft between them.
 struct Shaft<'a> {
     context: &'a SearchContext<'a>,
@@ -121,7 +129,15 @@ impl<'a> SearchContext<'a> {
             return out;
         };
         let mut wedges = shaft.ev_wedges(&mut out.stats);
-        wedges.extend(shaft.ve_wedges(&mut out.stats));
+        wedges.extend(
+            shaft
+                .ve_wedges(&mut out.stats)
+                .into_iter()
+                .map(|wedge| Candidate {
+                    wedge,
+                    outline_vertex: None,
+                }),
+        );
         if self.options.eee {
             if shaft.edges.len() > EEE_MAX_EDGES {
                 out.stats.eee_shafts_skipped += 1;
@@ -129,8 +145,8 @@ impl<'a> SearchContext<'a> {
                 shaft.eee_segments(&mut out);
             }
         }
-        for wedge in wedges {
-            shaft.wedge_segments(&wedge, &mut out);
+        for candidate in wedges {
+            shaft.wedge_segments(&candidate, &mut out);
         }
         out
     }
@@ -256,7 +272,7 @@ impl Shaft<'_> {
 
     /// EV: each emitter edge (the part in front of the receiver) with each blocker vertex on the
     /// silhouette as seen from it.
-    fn ev_wedges(&self, stats: &mut DiscontinuityStats) -> Vec<Wedge> {
+    fn ev_wedges(&self, stats: &mut DiscontinuityStats) -> Vec<Candidate> {
         let topology = &self.context.topology;
         let e_loop = self.emitter_loop();
         let tol = self.context.tol;
@@ -276,9 +292,11 @@ impl Shaft<'_> {
                 let n = (self.point(ib) - self.point(ia)).cross(pv - self.point(ia));
                 let Some(n) = n.try_normalize() else { continue };
                 stats.wedges_considered += 1;
-                let event = match self.context.options.events {
-                    EventSet::Complete => topology.vertex_on_outline(v, &source, self.not_pair()),
-                    EventSet::Extremal => topology.vertex_is_tangent(v, n, self.not_pair()),
+                let complete = self.context.options.events == EventSet::Complete;
+                let event = if complete {
+                    topology.vertex_on_outline(v, &source, self.not_pair())
+                } else {
+                    topology.vertex_is_tangent(v, n, self.not_pair())
                 };
                 if !event {
                     stats.wedges_culled += 1;
@@ -289,12 +307,15 @@ impl Shaft<'_> {
                 } else {
                     2
                 };
-                wedges.push(Wedge {
-                    emitter: self.emitter,
-                    event: Event::Ev,
-                    source,
-                    through: [pv, pv],
-                    order,
+                wedges.push(Candidate {
+                    wedge: Wedge {
+                        emitter: self.emitter,
+                        event: Event::Ev,
+                        source,
+                        through: [pv, pv],
+                        order,
+                    },
+                    outline_vertex: complete.then_some(v),
                 });
             }
         }
@@ -393,26 +414,27 @@ impl Shaft<'_> {
     }
 
     /// Where a wedge meets the receiver, clipped to its polygon and trimmed to where the wedge's
-    /// rays are unobstructed.
-    fn wedge_segments(&self, wedge: &Wedge, out: &mut PairEvents) {
+    /// rays are unobstructed (and, for a complete EV wedge, graze its vertex from outside).
+    fn wedge_segments(&self, candidate: &Candidate, out: &mut PairEvents) {
         let context = self.context;
+        let wedge = &candidate.wedge;
         let rf = &self.receiver_frame;
         let Some([p, q]) = wedge.meet_plane(rf.origin, rf.normal, context.reach) else {
             return;
         };
         let receiver_polygon = &context.scene.surfaces[self.receiver].polygon;
         let trim_tol = self.on_receiver(context.options.trim_tolerance);
+        let generates = |x: DVec3| {
+            candidate.outline_vertex.is_none_or(|v| {
+                let (_, source) = wedge.generator(x);
+                context
+                    .topology
+                    .vertex_on_outline(v, &[source, source], self.not_pair())
+            }) && trim::generator_visible(context.visibility, wedge, x, self.receiver)
+        };
         let mut kept = false;
         for [a, b] in clip_to_polygon(rf, receiver_polygon, p, q) {
-            let runs = trim::visible_runs(
-                context.visibility,
-                wedge,
-                self.receiver,
-                a,
-                b,
-                context.options.trim_samples,
-                trim_tol,
-            );
+            let runs = trim::runs_where(a, b, context.options.trim_samples, trim_tol, generates);
             match runs.as_slice() {
                 [] => out.stats.segments_hidden += 1,
                 [[x, y]] if x.distance(a) <= trim_tol && y.distance(b) <= trim_tol => {}

@@ -139,13 +139,16 @@ impl Topology {
     }
 
     /// Whether vertex `v` is on the outline of the faces around it (those for which `include`
-    /// holds) as seen from one of `viewpoints`: it lies on the rim of an open sheet (an edge at `v`
-    /// with one such face: every corner of a single polygon), or some of its faces turn towards
-    /// the viewpoint and some away (a silhouette vertex of a solid).
+    /// holds) as seen from some point of the segment `viewpoints` (a point when both ends are
+    /// one): it lies on the rim of an open sheet (an edge at `v` with one such face: every corner
+    /// of a single polygon), or some of its faces turn towards the viewpoint and some away (a
+    /// silhouette vertex of a solid). Between two viewpoints that each see all the faces from one
+    /// side, the segment meets the outline when the sides differ: the viewpoints from which all
+    /// faces turn one way form a convex cone at a convex vertex.
     pub fn vertex_on_outline(
         &self,
         v: usize,
-        viewpoints: &[DVec3],
+        viewpoints: &[DVec3; 2],
         include: impl Fn(SurfaceId) -> bool,
     ) -> bool {
         let faces: Vec<&Corner> = self.corners[v]
@@ -164,13 +167,18 @@ impl Topology {
             return true;
         }
         let origin = self.points[v];
-        viewpoints.iter().any(|&q| {
+        // The one side of every face's plane that `q` is on, or `None` when the sides differ.
+        let one_side = |q: DVec3| {
             let mut seen = 0i8;
-            !faces.iter().all(|c| {
-                let side = self.side(self.normals[c.surface], origin, q);
-                keeps_side(&mut seen, side)
-            })
-        })
+            faces
+                .iter()
+                .all(|c| keeps_side(&mut seen, self.side(self.normals[c.surface], origin, q)))
+                .then_some(seen)
+        };
+        match (one_side(viewpoints[0]), one_side(viewpoints[1])) {
+            (Some(a), Some(b)) => a != b && a != 0 && b != 0,
+            _ => true,
+        }
     }
 
     /// Whether every face along the edge `(a, b)` for which `include` holds lies on one side of

@@ -8,7 +8,7 @@ use penumbra_scenes::{SurfaceId, Visibility};
 use super::wedge::Wedge;
 
 /// Whether the generating ray of `wedge` through the receiver point `x` is unobstructed.
-fn generator_visible(
+pub fn generator_visible(
     visibility: &Visibility,
     wedge: &Wedge,
     x: DVec3,
@@ -18,22 +18,6 @@ fn generator_visible(
     // Hits within the contact distance of the grazing point are the blocker feature itself.
     !visibility.occluded(x, graze, [receiver, receiver])
         && !visibility.occluded(graze, source, [wedge.emitter, wedge.emitter])
-}
-
-/// The runs of `from -> to` along which the wedge's generating rays are unobstructed, with ends
-/// located to `tol` (a length). `samples` points along the segment find the runs.
-pub fn visible_runs(
-    visibility: &Visibility,
-    wedge: &Wedge,
-    receiver: SurfaceId,
-    from: DVec3,
-    to: DVec3,
-    samples: usize,
-    tol: f64,
-) -> Vec<[DVec3; 2]> {
-    runs_where(from, to, samples, tol, |x| {
-        generator_visible(visibility, wedge, x, receiver)
-    })
 }
 
 /// The runs of `from -> to` where `holds`, with ends located to `tol` (a length) by bisection.
