@@ -272,15 +272,29 @@ fn across_segments(
             s.iter()
                 .all(|&p| (p - a).perp_dot(dir).abs() <= 1e-9 * half.max(1.0))
         };
+        // A piece that carries the line on from one of its ends (the chords of an EEE curve):
+        // a probe across this one does not cross it.
+        let touches = |p: DVec2, s: [DVec2; 2]| s.iter().any(|&q| q.distance(p) <= 1e-9 * half);
+        let carries_on = |s: [DVec2; 2]| {
+            (touches(a, s) || touches(b, s)) && (s[1] - s[0]).normalize().dot(dir).abs() > 0.7
+        };
+        let free_ends: Vec<DVec2> = [a, b]
+            .into_iter()
+            .filter(|&p| {
+                !segments
+                    .iter()
+                    .enumerate()
+                    .any(|(o, &s)| o != k && touches(p, s) && carries_on(s))
+            })
+            .collect();
         let spot = [0.5, 0.3, 0.7, 0.15, 0.85]
             .into_iter()
             .map(|u| a.lerp(b, u))
             .find(|&m| {
-                m.distance(a).min(m.distance(b)) > half
-                    && segments
-                        .iter()
-                        .enumerate()
-                        .all(|(o, &s)| o == k || collinear(s) || distance_to(m, s) > half)
+                free_ends.iter().all(|&p| m.distance(p) > half)
+                    && segments.iter().enumerate().all(|(o, &s)| {
+                        o == k || collinear(s) || carries_on(s) || distance_to(m, s) > half
+                    })
             });
         let Some(m) = spot else {
             verdict.segments_crowded += 1;
@@ -408,7 +422,10 @@ fn assert_complete(scene: &Scene, receiver: &str, lines: usize) {
     let line = report(&format!("{} {receiver}", scene.name), &v);
     eprintln!("{line}");
     assert!(v.unexplained.is_empty() && v.silent.is_empty(), "{line}");
-    assert!(v.jumps >= lines && v.segments_probed >= 8, "{line}");
+    assert!(
+        v.jumps >= lines && v.segments_probed >= 8 && v.segments_probed >= 2 * v.segments_crowded,
+        "{line}"
+    );
 }
 
 #[test]
@@ -506,31 +523,66 @@ fn boxes_tetrahedra_and_overlapping_blockers() {
     }
 }
 
+/// Scenes rich in EEE events (skew edges of different blockers one above the other). Each of the
+/// EEE search's culling rules (silhouette from the emitter edge, the shadow reaching the receiver,
+/// the second edge inside the first one's shadow region, each edge crossing the other's sweep,
+/// grazing, trimming) would show here as a jump without its segment if it dropped a real event.
 #[test]
 fn eee_rich_scenes() {
     assert_complete(&builtin::crossed_bars(), "floor", 60);
+    let skew = [
+        vec![light(regular(
+            3,
+            0.7,
+            0.3,
+            0.1,
+            DVec3::new(0.1, 0.0, 3.0),
+            true,
+        ))],
+        cuboid(
+            "upper",
+            DVec3::new(0.7, 0.06, 0.05),
+            glam::DQuat::from_euler(glam::EulerRot::XYZ, 0.2, 0.1, 0.5),
+            DVec3::new(0.0, 0.1, 1.7),
+        ),
+        cuboid(
+            "lower",
+            DVec3::new(0.08, 0.8, 0.06),
+            glam::DQuat::from_euler(glam::EulerRot::XYZ, -0.15, 0.25, 0.3),
+            DVec3::new(0.1, -0.05, 1.0),
+        ),
+        vec![floor(2.5)],
+    ]
+    .concat();
+    assert_complete(&scene_of("skew boxes", skew), "floor", 60);
 }
 
+/// Any convex light over any convex blocker, in parallel planes and tilted: every jump has its
+/// segment with complete events. With extremal ones the inner lines are missing, and the oracle
+/// finds their jumps: it can fail.
 #[test]
-fn single_faces() {
+fn single_faces_parallel_and_tilted() {
     let mut rng = SplitMix64::new(14);
-    for case in 0..6 {
+    for case in 0..8 {
         let n = 3 + (rng.next_u64() % 4) as usize;
         let k = 3 + (rng.next_u64() % 4) as usize;
-        let parallel = case < 2;
-        let tilt = |rng: &mut SplitMix64| {
+        let parallel = case < 3;
+        let mut tilt = || {
             if parallel {
                 0.0
             } else {
                 0.6 * (rng.next_f64() - 0.5)
             }
         };
-        let lt = tilt(&mut rng);
-        let bt = tilt(&mut rng);
-        let scene = Scene {
-            name: format!("face{case}"),
-            camera: None,
-            surfaces: vec![
+        let (lt, bt) = (tilt(), tilt());
+        let centre = DVec3::new(
+            0.3 * (rng.next_f64() - 0.5),
+            0.3 * (rng.next_f64() - 0.5),
+            1.2,
+        );
+        let scene = scene_of(
+            &format!("{n}-gon over {k}-gon, case {case}"),
+            vec![
                 light(regular(
                     n,
                     0.6,
@@ -541,38 +593,26 @@ fn single_faces() {
                 )),
                 Surface::new(
                     "blocker",
-                    regular(
-                        k,
-                        0.45,
-                        rng.next_f64() * 3.0,
-                        bt,
-                        DVec3::new(
-                            0.3 * (rng.next_f64() - 0.5),
-                            0.3 * (rng.next_f64() - 0.5),
-                            1.2,
-                        ),
-                        true,
-                    ),
+                    regular(k, 0.45, 3.0 * rng.next_f64(), bt, centre, true),
                     Rgb::splat(0.5),
                 ),
                 floor(2.5),
             ],
-        };
-        for events in [EventSet::Complete, EventSet::Extremal] {
-            let v = oracle(&scene, "floor", events, 40, 7);
-            eprintln!(
-                "{}",
-                report(&format!("{} {n}/{k} {events:?}", scene.name), &v)
-            );
-        }
+        );
+        assert_complete(&scene, "floor", 40);
+        let extremal = oracle(&scene, "floor", EventSet::Extremal, 40, 7);
+        assert!(
+            extremal.unexplained.len() >= 4,
+            "{}",
+            report(&format!("{} extremal", scene.name), &extremal)
+        );
     }
 }
 
+/// The Cornell box, EEE on: its floor, and the back wall the blocks shade.
 #[test]
-fn cornell_floor() {
+fn cornell_box() {
     let scene = builtin::cornell();
-    for events in [EventSet::Complete, EventSet::Extremal] {
-        let v = oracle(&scene, "floor", events, 30, 3);
-        eprintln!("{}", report(&format!("cornell {events:?}"), &v));
-    }
+    assert_complete(&scene, "floor", 40);
+    assert_complete(&scene, "back_wall", 30);
 }

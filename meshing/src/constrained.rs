@@ -65,6 +65,19 @@ impl ConstrainedSurface {
         surface: &Surface,
         constraints: &[Constraint],
     ) -> Result<ConstrainedSurface, MeshError> {
+        ConstrainedSurface::joining(id, surface, constraints, 0.0)
+    }
+
+    /// [`Self::new`], with constraint ends within `join` (a length in the scene's units, when
+    /// larger than [`MERGE_DISTANCE`] of the mesh) of another end, or of another constraint, put
+    /// on it: the precision to which the constraints were found (a line trimmed where a block
+    /// hides it ends within a few contact distances of that block's foot).
+    pub fn joining(
+        id: SurfaceId,
+        surface: &Surface,
+        constraints: &[Constraint],
+        join: f64,
+    ) -> Result<ConstrainedSurface, MeshError> {
         // The constraints are in the polygon's own frame; the mesh's starts at the corner the
         // constraints pick among those it could start at, which for a polygon without a
         // rotational symmetry is the same.
@@ -86,7 +99,8 @@ impl ConstrainedSurface {
             let q = p / coords.scale;
             DVec2::new(snap(q.x), snap(q.y))
         };
-        let mut welder = Welder::new(MERGE_DISTANCE);
+        let merge = MERGE_DISTANCE.max(join / coords.scale);
+        let mut welder = Welder::new(merge);
         for &b in &coords.boundary {
             welder.weld(b);
         }
@@ -104,8 +118,7 @@ impl ConstrainedSurface {
                 }
             }
         }
-        let (segments, boundary_splits) =
-            snap_t_junctions(&coords.boundary, segments, MERGE_DISTANCE);
+        let (segments, boundary_splits) = snap_t_junctions(&coords.boundary, segments, merge);
 
         let mut cdt = Cdt::new();
         // spade panicked on some near-collinear input in the past; a panic here must become an

@@ -176,6 +176,11 @@ pub fn mesh_scene_discontinuity(
     mesh_scene_discontinuity_on(scene, visibility, found, budget, penumbra_density, None)
 }
 
+/// Discontinuity segment ends within this many contact distances of another end or segment are
+/// joined to it in the mesh: the search places a trimmed end to within a contact distance (where
+/// hits stop counting) plus its trimming tolerance (at most one more).
+pub const JOIN_CONTACT_DISTANCES: f64 = 4.0;
+
 /// [`mesh_scene_discontinuity`] of the surfaces `on` holds (all when `None`), when each
 /// surface's share of the budget depends on it alone ([`ElementBudget::shared_extra`]): the
 /// others get an empty mesh, and the budget, counts and least mesh are those of the surfaces
@@ -190,6 +195,7 @@ pub fn mesh_scene_discontinuity_on(
     on: Option<&[bool]>,
 ) -> Result<SceneMesh, MeshError> {
     let budget = budget.into();
+    let join = JOIN_CONTACT_DISTANCES * visibility.contact_distance();
     let alone = budget.shared_extra(polygon_minimum(scene), scene.surfaces.len());
     let meshed: Vec<bool> = (0..scene.surfaces.len())
         .map(|id| alone.is_none() || on.is_none_or(|on| on.get(id).copied().unwrap_or(false)))
@@ -214,7 +220,7 @@ pub fn mesh_scene_discontinuity_on(
                     .collect(),
                 None => Vec::new(),
             };
-            ConstrainedSurface::new(id, s, &constraints).map(Some)
+            ConstrainedSurface::joining(id, s, &constraints, join).map(Some)
         })
         .collect::<Result<Vec<_>, _>>()?;
     let areas: Vec<f64> = scene

@@ -71,6 +71,36 @@ pub(crate) struct EeeSearch<'a> {
     pub trim_tolerance: f64,
 }
 
+/// Points whose convex hull holds every point beyond the points `through` on a line from the
+/// points `sources` towards the receiver's plane (of frame `rf`): `through` and their shadows from
+/// each source on that plane (the shadow of a convex set from a convex set is the hull of its
+/// corners' shadows), followed out to `reach` where a line never comes down to it. Heights under
+/// `tol` are on the plane.
+pub(super) fn shadow_region(
+    rf: &PlaneFrame,
+    tol: f64,
+    reach: f64,
+    sources: &[DVec3],
+    through: &[DVec3],
+) -> Vec<DVec3> {
+    let mut out = through.to_vec();
+    for &p in sources {
+        for &q in through {
+            let d = q - p;
+            let (hq, hd) = (rf.height(q), rf.normal.dot(d));
+            out.push(if hq <= tol {
+                // On the receiver's plane already: its own shadow.
+                q - rf.normal * hq
+            } else if hd < 0.0 {
+                q + d * (hq / -hd).min(reach / d.length().max(f64::MIN_POSITIVE))
+            } else {
+                q + d.normalize_or_zero() * reach
+            });
+        }
+    }
+    out
+}
+
 /// A line through the three edges: its points on the emitter edge, the first and second blocker
 /// edges, and the receiver's plane.
 #[derive(Clone, Copy, Debug)]
@@ -85,7 +115,7 @@ struct Transversal {
 const FEW_BLOCKERS: usize = 64;
 
 /// How a shaft finds its blockers near a region (by their place in the shaft's list).
-enum NearBlockers {
+pub(super) enum NearBlockers {
     /// Few blockers: each blocker's box, grown by the tolerance, against the region's.
     Few(Vec<Bounds>),
     /// Many: the boxes of the visibility index's leaves holding each blocker's triangles,
@@ -99,8 +129,41 @@ enum NearBlockers {
 }
 
 impl NearBlockers {
+    /// How a shaft with blockers `blockers` finds those near a region: one by one when they are
+    /// few, else through the visibility index (`surface_leaves`: [`Visibility::leaf_boxes`] by
+    /// surface, when the index has them).
+    pub fn new(
+        topology: &Topology,
+        blockers: &[SurfaceId],
+        surface_leaves: Option<&[Vec<IndexBox>]>,
+    ) -> NearBlockers {
+        let t = topology;
+        if blockers.len() <= FEW_BLOCKERS {
+            return NearBlockers::Few(
+                blockers
+                    .iter()
+                    .map(|&s| Bounds::from_points(t.loops[s].iter().map(|&v| &t.points[v])))
+                    .collect(),
+            );
+        }
+        match surface_leaves {
+            Some(leaves) => {
+                let mut boxes: Vec<(IndexBox, usize)> = blockers
+                    .iter()
+                    .enumerate()
+                    .flat_map(|(b, &s)| leaves[s].iter().map(move |&x| (x, b)))
+                    .collect();
+                boxes.shrink_to_fit();
+                NearBlockers::Leaves(boxes)
+            }
+            None => {
+                NearBlockers::Index(blockers.iter().enumerate().map(|(b, &s)| (s, b)).collect())
+            }
+        }
+    }
+
     /// Calls `found` with each blocker near the box `region` (some maybe more than once).
-    fn find(
+    pub fn find(
         &self,
         visibility: &Visibility,
         region: Bounds,
@@ -180,7 +243,7 @@ impl EeeSearch<'_> {
             .iter()
             .map(|&(u, w)| t.edge_faces(u, w, not_pair))
             .collect();
-        let near_finder = self.near_finder(blockers);
+        let near_finder = NearBlockers::new(t, blockers, self.surface_leaves);
         let mut near: Vec<usize> = Vec::new();
         // Blockers and edges already taken for the current first edge, stamped to skip repeats.
         let mut blocker_stamp = vec![usize::MAX; blockers.len()];
@@ -270,33 +333,6 @@ impl EeeSearch<'_> {
         (curves, count)
     }
 
-    /// How this shaft finds the blockers near a region ([`NearBlockers`]).
-    fn near_finder(&self, blockers: &[SurfaceId]) -> NearBlockers {
-        let t = self.topology;
-        if blockers.len() <= FEW_BLOCKERS {
-            return NearBlockers::Few(
-                blockers
-                    .iter()
-                    .map(|&s| Bounds::from_points(t.loops[s].iter().map(|&v| &t.points[v])))
-                    .collect(),
-            );
-        }
-        match self.surface_leaves {
-            Some(leaves) => {
-                let mut boxes: Vec<(IndexBox, usize)> = blockers
-                    .iter()
-                    .enumerate()
-                    .flat_map(|(b, &s)| leaves[s].iter().map(move |&x| (x, b)))
-                    .collect();
-                boxes.shrink_to_fit();
-                NearBlockers::Leaves(boxes)
-            }
-            None => {
-                NearBlockers::Index(blockers.iter().enumerate().map(|(b, &s)| (s, b)).collect())
-            }
-        }
-    }
-
     /// Whether blocker edge `(u, w)` is on the silhouette of its faces as seen from some point of
     /// the emitter edge `source`: one face turned towards that point and another away, or a face
     /// seen edge-on (each face's side is linear along the edge, so the ends and the roots tell).
@@ -351,25 +387,11 @@ impl EeeSearch<'_> {
     }
 
     /// Points whose convex hull holds every point beyond the blocker edge `first` on a line from
-    /// `source` towards the receiver's plane: the edge and its shadow from the emitter edge on
-    /// that plane (the shadow of a segment from a segment is the hull of its corners' shadows).
+    /// `source` towards the receiver's plane ([`shadow_region`]).
     fn beyond(&self, source: [DVec3; 2], first: [DVec3; 2]) -> [DVec3; 6] {
-        let rf = &self.receiver_frame;
-        let mut out = [first[0], first[1], first[0], first[1], first[0], first[1]];
-        for (i, p) in source.into_iter().enumerate() {
-            for (j, q) in first.into_iter().enumerate() {
-                let d = q - p;
-                let (hq, hd) = (rf.height(q), rf.normal.dot(d));
-                out[2 + 2 * i + j] = if hq <= self.tol {
-                    // On the receiver's plane already: its own shadow.
-                    q - rf.normal * hq
-                } else if hd < 0.0 {
-                    q + d * (hq / -hd).min(self.reach / d.length().max(f64::MIN_POSITIVE))
-                } else {
-                    q + d.normalize_or_zero() * self.reach
-                };
-            }
-        }
+        let mut out = [first[0]; 6];
+        let region = shadow_region(&self.receiver_frame, self.tol, self.reach, &source, &first);
+        out.copy_from_slice(&region);
         out
     }
 

@@ -8,6 +8,7 @@
 //! (the parallel case) are merged. Blockers touching the receiver add contact (D0) lines. Every
 //! segment is classified by what lies on either side: umbra, penumbra or lit.
 
+mod between;
 pub mod contact;
 pub mod eee;
 pub mod hull;
@@ -170,7 +171,8 @@ pub struct DiscontinuityStats {
     pub weak_share_max: f64,
     /// Shafts whose EEE search was skipped for their many blocker edges ([`EEE_MAX_EDGES`]).
     pub eee_shafts_skipped: usize,
-    /// Feature pairs that could form a wedge (in front of both emitter and receiver).
+    /// Feature pairs that could form a wedge (in front of both emitter and receiver), blocker
+    /// vertex–blocker edge pairs included.
     pub wedges_considered: usize,
     /// Of those, not events of the set asked for ([`EventSet`]): with `Extremal`, not tangent
     /// to the emitter or the blocker's silhouette; with `Complete`, a blocker feature not on
@@ -194,6 +196,8 @@ pub struct DiscontinuityStats {
     pub ev_segments: usize,
     pub ve_segments: usize,
     pub eee_segments: usize,
+    /// Segments of events between two blockers (complete events only).
+    pub blocker_ev_segments: usize,
     pub contact_lines: usize,
     /// Of those, by order: where the value (0), the slope (1) or the curvature (2) jumps.
     pub order_0_segments: usize,
@@ -211,6 +215,7 @@ impl DiscontinuityStats {
                 Event::Ev => self.ev_segments += 1,
                 Event::Ve => self.ve_segments += 1,
                 Event::Eee => self.eee_segments += 1,
+                Event::BlockerEv => self.blocker_ev_segments += 1,
                 Event::Contact => self.contact_lines += 1,
             }
             match g.order {
@@ -381,6 +386,17 @@ pub(crate) fn clip_to_polygon(
         .into_iter()
         .map(|[s, t]| [p.lerp(q, s), p.lerp(q, t)])
         .collect()
+}
+
+/// The part of segment `a-b` where `h >= 0` (h linear along it), if any length remains.
+pub(crate) fn clip_by_height(a: DVec3, b: DVec3, h: impl Fn(DVec3) -> f64) -> Option<[DVec3; 2]> {
+    let (ha, hb) = (h(a), h(b));
+    match (ha >= 0.0, hb >= 0.0) {
+        (true, true) => Some([a, b]),
+        (false, false) => None,
+        (true, false) => Some([a, a.lerp(b, ha / (ha - hb))]),
+        (false, true) => Some([a.lerp(b, ha / (ha - hb)), b]),
+    }
 }
 
 /// Merges a receiver's coincident segments (per emitter) in its plane frame. Where segments of

@@ -13,7 +13,7 @@ use super::topology::Topology;
 use super::wedge::{Event, Wedge};
 use super::{
     Boundary, DiscontinuityOptions, DiscontinuitySegment, DiscontinuityStats, EEE_MAX_EDGES,
-    EventSet, MIN_RECEIVER_ELEMENTS, clip_to_polygon, eee, hull, trim,
+    EventSet, MIN_RECEIVER_ELEMENTS, between, clip_by_height, clip_to_polygon, eee, hull, trim,
 };
 
 /// What the whole search shares: the scene, its welded topology and every surface's frame.
@@ -46,10 +46,23 @@ pub(crate) struct PairEvents {
 
 /// A wedge to follow onto the receiver. A complete EV wedge may hold the blocker vertex on the
 /// outline from only part of its emitter edge: `outline_vertex` names the vertex, checked again
-/// for each generating ray (beyond that part, the ray enters the blocker at the vertex).
+/// for each generating ray (beyond that part, the ray enters the blocker at the vertex). A wedge
+/// between two blockers also passes `grazed_edge`, which each generating ray must reach
+/// unobstructed too.
 struct Candidate {
     wedge: Wedge,
     outline_vertex: Option<usize>,
+    grazed_edge: Option<(usize, usize)>,
+}
+
+impl Candidate {
+    fn plain(wedge: Wedge) -> Candidate {
+        Candidate {
+            wedge,
+            outline_vertex: None,
+            grazed_edge: None,
+        }
+    }
 }
 
 /// One emitter–receiver pair with the blockers in the shaft between them.
@@ -133,11 +146,11 @@ impl<'a> SearchContext<'a> {
             shaft
                 .ve_wedges(&mut out.stats)
                 .into_iter()
-                .map(|wedge| Candidate {
-                    wedge,
-                    outline_vertex: None,
-                }),
+                .map(Candidate::plain),
         );
+        if self.options.events == EventSet::Complete {
+            wedges.extend(shaft.between_wedges(&mut out.stats));
+        }
         if self.options.eee {
             if shaft.edges.len() > EEE_MAX_EDGES {
                 out.stats.eee_shafts_skipped += 1;
@@ -279,7 +292,7 @@ impl Shaft<'_> {
         let mut wedges = Vec::new();
         for k in 0..e_loop.len() {
             let (ia, ib) = (e_loop[k], e_loop[(k + 1) % e_loop.len()]);
-            let Some(source) = clip_segment(self.point(ia), self.point(ib), |p| {
+            let Some(source) = clip_by_height(self.point(ia), self.point(ib), |p| {
                 self.receiver_frame.height(p) - tol
             }) else {
                 continue;
@@ -316,6 +329,7 @@ impl Shaft<'_> {
                         order,
                     },
                     outline_vertex: complete.then_some(v),
+                    grazed_edge: None,
                 });
             }
         }
@@ -335,7 +349,7 @@ impl Shaft<'_> {
                 continue;
             }
             for &(u, w) in &self.edges {
-                let Some(through) = clip_segment(self.point(u), self.point(w), |p| {
+                let Some(through) = clip_by_height(self.point(u), self.point(w), |p| {
                     (self.emitter_frame.height(p) - tol).min(self.receiver_frame.height(p) - tol)
                 }) else {
                     continue;
@@ -369,6 +383,36 @@ impl Shaft<'_> {
             }
         }
         wedges
+    }
+
+    /// Between blockers: each blocker vertex with each edge of another blocker whose plane cuts
+    /// the emitter ([`between`]).
+    fn between_wedges(&self, stats: &mut DiscontinuityStats) -> Vec<Candidate> {
+        let context = self.context;
+        let search = between::BetweenSearch {
+            topology: &context.topology,
+            visibility: context.visibility,
+            emitter: self.emitter,
+            receiver: self.receiver,
+            emitter_frame: self.emitter_frame,
+            receiver_frame: self.receiver_frame,
+            emitter_polygon: &context.scene.surfaces[self.emitter].polygon,
+            straight: &context.straight,
+            surface_leaves: context.surface_leaves.as_deref(),
+            tol: context.tol,
+            reach: context.reach,
+        };
+        let (found, count) = search.wedges(&self.vertices, &self.edges, &self.blockers);
+        stats.wedges_considered += count.considered;
+        stats.wedges_culled += count.culled;
+        found
+            .into_iter()
+            .map(|b| Candidate {
+                wedge: b.wedge,
+                outline_vertex: Some(b.vertex),
+                grazed_edge: Some(b.edge),
+            })
+            .collect()
     }
 
     /// The receiver's diameter times `fraction`: tolerances of this pair.
@@ -430,7 +474,13 @@ impl Shaft<'_> {
                 context
                     .topology
                     .vertex_on_outline(v, &[source, source], self.not_pair())
-            }) && trim::generator_visible(context.visibility, wedge, x, self.receiver)
+            }) && match candidate.grazed_edge {
+                None => trim::generator_visible(context.visibility, wedge, x, self.receiver),
+                Some((u, w)) => {
+                    let edge = [context.topology.points[u], context.topology.points[w]];
+                    trim::generator_visible_past(context.visibility, wedge, x, self.receiver, edge)
+                }
+            }
         };
         let mut kept = false;
         for [a, b] in clip_to_polygon(rf, receiver_polygon, p, q) {
@@ -492,15 +542,4 @@ fn shaft_blockers(
         }
     });
     found.into_iter().filter(|&s| keep(s)).collect()
-}
-
-/// The part of segment `a-b` where `h >= 0` (h linear along it), if any length remains.
-fn clip_segment(a: DVec3, b: DVec3, h: impl Fn(DVec3) -> f64) -> Option<[DVec3; 2]> {
-    let (ha, hb) = (h(a), h(b));
-    match (ha >= 0.0, hb >= 0.0) {
-        (true, true) => Some([a, b]),
-        (false, false) => None,
-        (true, false) => Some([a, a.lerp(b, ha / (ha - hb))]),
-        (false, true) => Some([a.lerp(b, ha / (ha - hb)), b]),
-    }
 }

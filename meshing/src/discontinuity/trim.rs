@@ -20,6 +20,28 @@ pub fn generator_visible(
         && !visibility.occluded(graze, source, [wedge.emitter, wedge.emitter])
 }
 
+/// Whether the generating ray of `wedge` through the receiver point `x` is unobstructed when it
+/// also passes the blocker edge `edge` (a wedge between two blockers): piece by piece, from `x`
+/// to the vertex and the edge's point in the order the ray meets them, to the emitter.
+pub fn generator_visible_past(
+    visibility: &Visibility,
+    wedge: &Wedge,
+    x: DVec3,
+    receiver: SurfaceId,
+    edge: [DVec3; 2],
+) -> bool {
+    let (graze, source) = wedge.generator(x);
+    let on_edge = super::wedge::line_meet(x, graze, edge[0], edge[1]);
+    let [near, far] = if x.distance_squared(on_edge) < x.distance_squared(graze) {
+        [on_edge, graze]
+    } else {
+        [graze, on_edge]
+    };
+    !visibility.occluded(x, near, [receiver, receiver])
+        && !visibility.occluded(near, far, [receiver, receiver])
+        && !visibility.occluded(far, source, [wedge.emitter, wedge.emitter])
+}
+
 /// The runs of `from -> to` where `holds`, with ends located to `tol` (a length) by bisection.
 /// `samples` points along the segment find the runs.
 pub fn runs_where(

@@ -18,6 +18,8 @@ pub enum Event {
     Eee,
     /// A blocker touching the receiver.
     Contact,
+    /// A blocker vertex and an edge of another blocker, in a plane that cuts the emitter.
+    BlockerEv,
 }
 
 impl Event {
@@ -27,6 +29,7 @@ impl Event {
             Event::Ve => "VE",
             Event::Eee => "EEE",
             Event::Contact => "contact",
+            Event::BlockerEv => "blocker-EV",
         }
     }
 }
@@ -48,7 +51,9 @@ impl Wedge {
     /// Unit normal of the wedge's plane.
     pub fn normal(&self) -> DVec3 {
         let n = match self.event {
-            Event::Ev => (self.source[1] - self.source[0]).cross(self.through[0] - self.source[0]),
+            Event::Ev | Event::BlockerEv => {
+                (self.source[1] - self.source[0]).cross(self.through[0] - self.source[0])
+            }
             _ => (self.through[0] - self.source[0]).cross(self.through[1] - self.source[0]),
         };
         n.normalize_or_zero()
@@ -65,7 +70,7 @@ impl Wedge {
             (p, (p - q).normalize_or_zero())
         };
         match self.event {
-            Event::Ev => {
+            Event::Ev | Event::BlockerEv => {
                 let v = self.through[0];
                 let mut poly = vec![v];
                 poly.extend((0..=FAN).map(|k| {
@@ -106,7 +111,7 @@ impl Wedge {
     /// point where it grazes the blocker, and the point of the emitter it comes from.
     pub fn generator(&self, x: DVec3) -> (DVec3, DVec3) {
         match self.event {
-            Event::Ev => {
+            Event::Ev | Event::BlockerEv => {
                 let v = self.through[0];
                 (v, line_meet(x, v, self.source[0], self.source[1]))
             }
@@ -120,7 +125,7 @@ impl Wedge {
 
 /// The point of line `c + s (d - c)` closest to the line through `a` and `b` (for coplanar
 /// lines, their intersection), clamped to the segment `c-d`.
-fn line_meet(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> DVec3 {
+pub(super) fn line_meet(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> DVec3 {
     let (u, v, w) = (b - a, d - c, c - a);
     let (uu, uv, vv, uw, vw) = (u.dot(u), u.dot(v), v.dot(v), u.dot(w), v.dot(w));
     let den = uu * vv - uv * uv;

@@ -1,0 +1,274 @@
+//! Events between two blockers (complete sets only): a vertex of one blocker and an edge of
+//! another, in a plane that cuts the emitter.
+//!
+//! Seen from a receiver point, each blocker's image covers part of the emitter. Where a vertex of
+//! one image crosses an edge of the other inside the emitter, the overlap of the two images, and
+//! so the visible area, kinks in its derivative: the curvature of the light jumps (Drettakis &
+//! Fiume 1994 count these among the EV events). The lines of such an event pass through the
+//! vertex and the edge and meet the emitter: in the plane of vertex and edge, they come from a
+//! segment of the chord that plane cuts from the emitter, through the vertex, to the receiver, an
+//! EV wedge whose source is that segment. Each vertex is paired with the edges in the region
+//! below it (between it and its shadow on the receiver's plane), each edge with the vertices
+//! below it, so that the pairs found stay local however many blockers the shaft holds.
+
+use std::collections::BTreeSet;
+
+use glam::DVec3;
+use penumbra_scenes::{Bounds, IndexBox, PlaneFrame, SurfaceId, Visibility};
+
+use super::eee::{NearBlockers, shadow_region};
+use super::topology::Topology;
+use super::wedge::{Event, Wedge};
+use super::{clip_by_height, clip_to_polygon};
+
+/// One emitter–receiver pair: the geometry every vertex–edge pair of it shares.
+pub(crate) struct BetweenSearch<'a> {
+    pub topology: &'a Topology,
+    pub visibility: &'a Visibility,
+    pub emitter: SurfaceId,
+    pub receiver: SurfaceId,
+    pub emitter_frame: PlaneFrame,
+    pub receiver_frame: PlaneFrame,
+    /// The emitter's polygon.
+    pub emitter_polygon: &'a [DVec3],
+    /// Vertices inside a straight stretch of edges: no corner, so no event.
+    pub straight: &'a [bool],
+    pub surface_leaves: Option<&'a [Vec<IndexBox>]>,
+    /// Heights under this are on a plane.
+    pub tol: f64,
+    /// How far a line may run (a few scene diagonals).
+    pub reach: f64,
+}
+
+/// A wedge through blocker vertex `vertex` whose lines also pass through blocker edge `edge`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct BetweenWedge {
+    pub wedge: Wedge,
+    pub vertex: usize,
+    pub edge: (usize, usize),
+}
+
+/// What the search over vertex–edge pairs did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct BetweenCount {
+    /// Pairs whose plane was tested against the emitter.
+    pub considered: usize,
+    /// Of those, pairs whose edge is not on its blockers' outline in that plane.
+    pub culled: usize,
+}
+
+impl BetweenSearch<'_> {
+    fn in_front(&self, p: DVec3) -> bool {
+        self.emitter_frame.height(p) > self.tol && self.receiver_frame.height(p) > self.tol
+    }
+
+    fn not_pair(&self) -> impl Fn(SurfaceId) -> bool + use<> {
+        let (e, r) = (self.emitter, self.receiver);
+        move |s| s != e && s != r
+    }
+
+    /// The wedges of the blocker vertices `vertices` with the blocker edges `edges` of the
+    /// surfaces `blockers`.
+    pub fn wedges(
+        &self,
+        vertices: &BTreeSet<usize>,
+        edges: &BTreeSet<(usize, usize)>,
+        blockers: &[SurfaceId],
+    ) -> (Vec<BetweenWedge>, BetweenCount) {
+        let t = self.topology;
+        let emitter = self.emitter_front();
+        let near = NearBlockers::new(t, blockers, self.surface_leaves);
+        let mut pairs: BTreeSet<(usize, (usize, usize))> = BTreeSet::new();
+        let mut found = Vec::new();
+        let in_region = |through: &[DVec3], found: &mut Vec<usize>| {
+            let region = shadow_region(
+                &self.receiver_frame,
+                self.tol,
+                self.reach,
+                &emitter,
+                through,
+            );
+            found.clear();
+            near.find(
+                self.visibility,
+                Bounds::from_points(region.iter()),
+                self.tol,
+                |b| found.push(b),
+            );
+            found.sort_unstable();
+            found.dedup();
+        };
+        let usable_vertex =
+            |v: usize| !self.straight[v] && self.in_front(t.points[v]) && !t.corners[v].is_empty();
+        // Each vertex with the edges below it.
+        for &v in vertices.iter().filter(|&&v| usable_vertex(v)) {
+            in_region(&[t.points[v]], &mut found);
+            for &b in &found {
+                for (u, w) in loop_edges(&t.loops[blockers[b]]) {
+                    if edges.contains(&(u, w)) {
+                        pairs.insert((v, (u, w)));
+                    }
+                }
+            }
+        }
+        // Each edge with the vertices below it.
+        for &(u, w) in edges {
+            in_region(&[t.points[u], t.points[w]], &mut found);
+            for &b in &found {
+                for &v in &t.loops[blockers[b]] {
+                    if vertices.contains(&v) && usable_vertex(v) {
+                        pairs.insert((v, (u, w)));
+                    }
+                }
+            }
+        }
+        let mut count = BetweenCount::default();
+        let mut out = Vec::new();
+        for (v, edge) in pairs {
+            if self.share_a_face(v, edge) {
+                continue;
+            }
+            count.considered += 1;
+            match self.pair_wedges(&emitter, v, edge) {
+                Some(wedges) => out.extend(wedges),
+                None => count.culled += 1,
+            }
+        }
+        (out, count)
+    }
+
+    /// The emitter's polygon, cut to the part in front of the receiver.
+    fn emitter_front(&self) -> Vec<DVec3> {
+        let rf = &self.receiver_frame;
+        let p = self.emitter_polygon;
+        let mut out = Vec::with_capacity(p.len() + 1);
+        for i in 0..p.len() {
+            let (a, b) = (p[i], p[(i + 1) % p.len()]);
+            let (ha, hb) = (rf.height(a) - self.tol, rf.height(b) - self.tol);
+            if ha >= 0.0 {
+                out.push(a);
+            }
+            if (ha >= 0.0) != (hb >= 0.0) {
+                out.push(a.lerp(b, ha / (ha - hb)));
+            }
+        }
+        out
+    }
+
+    /// Whether some face holds both vertex `v` and the edge: their plane is the face's.
+    fn share_a_face(&self, v: usize, (u, w): (usize, usize)) -> bool {
+        let t = self.topology;
+        if v == u || v == w {
+            return true;
+        }
+        t.edges.get(&(u, w)).is_some_and(|faces| {
+            faces
+                .iter()
+                .any(|&(s, _)| t.corners[v].iter().any(|c| c.surface == s))
+        })
+    }
+
+    /// The wedges of vertex `v` with edge `(u, w)`: one per run of the emitter chord in their
+    /// plane whose lines through `v` also meet the edge; `None` when the edge is not on the
+    /// outline of its faces in that plane.
+    fn pair_wedges(
+        &self,
+        emitter: &[DVec3],
+        v: usize,
+        (u, w): (usize, usize),
+    ) -> Option<Vec<BetweenWedge>> {
+        let t = self.topology;
+        let pv = t.points[v];
+        let ends = clip_by_height(t.points[u], t.points[w], |p| {
+            (self.emitter_frame.height(p) - self.tol).min(self.receiver_frame.height(p) - self.tol)
+        })?;
+        let n = (ends[0] - pv).cross(ends[1] - pv).try_normalize()?;
+        if !t.edge_is_tangent(u, w, n, self.not_pair()) {
+            return None;
+        }
+        let ef = &self.emitter_frame;
+        // The line where the plane meets the emitter's: its direction, and its point nearest
+        // the vertex.
+        let along = n.cross(ef.normal).try_normalize()?;
+        let down = n.cross(along);
+        let start = pv + down * (-ef.height(pv) / down.dot(ef.normal));
+        let chord = [start - along * self.reach, start + along * self.reach];
+        let order = if t.plane_holds_an_edge_at(v, n, self.not_pair()) {
+            1
+        } else {
+            2
+        };
+        let mut out = Vec::new();
+        for [c0, c1] in clip_to_polygon(ef, emitter, chord[0], chord[1]) {
+            // Where the line from a chord point through `pv` passes each end of the edge, the
+            // sign of this product changes: the lines meeting the edge are where it is <= 0.
+            let side = |q: DVec3, x: DVec3| n.dot((q - pv).cross(x - pv));
+            let meets =
+                |s: f64| side(c0.lerp(c1, s), ends[0]) * side(c0.lerp(c1, s), ends[1]) <= 0.0;
+            for [s0, s1] in runs_of(
+                &meets,
+                |x| {
+                    let (a, b) = (side(c0, x), side(c1, x));
+                    (a != b).then(|| a / (a - b))
+                },
+                ends,
+            ) {
+                let source = [c0.lerp(c1, s0), c0.lerp(c1, s1)];
+                if source[0].distance(source[1]) <= self.tol
+                    || !t.vertex_on_outline(v, &source, self.not_pair())
+                {
+                    continue;
+                }
+                out.push(BetweenWedge {
+                    wedge: Wedge {
+                        emitter: self.emitter,
+                        event: Event::BlockerEv,
+                        source,
+                        through: [pv, pv],
+                        order,
+                    },
+                    vertex: v,
+                    edge: (u, w),
+                });
+            }
+        }
+        Some(out)
+    }
+}
+
+/// The runs of `[0, 1]` where `meets` holds, given `root`, where the line through one end of the
+/// edge crosses the chord (a parameter, if it does anywhere).
+fn runs_of(
+    meets: &impl Fn(f64) -> bool,
+    root: impl Fn(DVec3) -> Option<f64>,
+    ends: [DVec3; 2],
+) -> Vec<[f64; 2]> {
+    let mut cuts = vec![0.0, 1.0];
+    cuts.extend(
+        ends.iter()
+            .filter_map(|&x| root(x))
+            .filter(|s| (0.0..=1.0).contains(s)),
+    );
+    cuts.sort_by(f64::total_cmp);
+    cuts.dedup();
+    let mut runs: Vec<[f64; 2]> = Vec::new();
+    for k in 0..cuts.len() - 1 {
+        let (a, b) = (cuts[k], cuts[k + 1]);
+        if b <= a || !meets(0.5 * (a + b)) {
+            continue;
+        }
+        match runs.last_mut() {
+            Some(r) if r[1] == a => r[1] = b,
+            _ => runs.push([a, b]),
+        }
+    }
+    runs
+}
+
+/// The edges of a polygon loop as welded vertex pairs, smaller index first.
+fn loop_edges(l: &[usize]) -> impl Iterator<Item = (usize, usize)> + '_ {
+    (0..l.len()).filter_map(move |k| {
+        let (u, w) = (l[k], l[(k + 1) % l.len()]);
+        (u != w).then(|| (u.min(w), u.max(w)))
+    })
+}
