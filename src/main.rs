@@ -72,7 +72,8 @@ enum MeshArg {
 #[derive(Clone, Copy, Debug, ValueEnum)]
 enum EventsArg {
     /// Every EV and VE event: each light edge with each blocker vertex on the blocker's outline,
-    /// each light vertex with each blocker edge on it.
+    /// each light vertex with each blocker edge on it, each blocker vertex with an edge of
+    /// another blocker in a plane through the light.
     Complete,
     /// Only the umbra and outer penumbra boundaries (and contact lines, and EEE events).
     Extremal,
@@ -194,7 +195,7 @@ struct RunArgs {
     #[arg(long)]
     no_eee: bool,
     /// Discontinuity meshes: which EV and VE events become mesh edges.
-    #[arg(long, value_enum, default_value_t = EventsArg::Extremal)]
+    #[arg(long, value_enum, default_value_t = EventsArg::Complete)]
     events: EventsArg,
     /// Discontinuity meshes: blockers (flat patches of faces) that can hide less than this
     /// fraction of a light from a receiver start no events there; adaptive refinement and the
@@ -303,9 +304,10 @@ struct SweepArgs {
     /// not emit).
     #[arg(long, value_delimiter = ',')]
     surfaces: Vec<String>,
-    /// The methods to run (comma-separated; default: the first four). `discontinuity-complete`
-    /// meshes every EV and VE event (`run --events complete`).
-    #[arg(long, value_delimiter = ',', value_parser = ["uniform", "uniform+adaptive", "discontinuity", "discontinuity+adaptive", "discontinuity-complete"])]
+    /// The methods to run (comma-separated; default: the first four). `discontinuity` meshes the
+    /// default events (complete); `discontinuity-complete` and `discontinuity-extremal` name
+    /// them (`run --events complete|extremal`).
+    #[arg(long, value_delimiter = ',', value_parser = ["uniform", "uniform+adaptive", "discontinuity", "discontinuity+adaptive", "discontinuity-complete", "discontinuity-extremal"])]
     methods: Vec<String>,
     /// The solvers to compare, comma-separated (default: progressive). Adaptive runs use
     /// progressive refinement only.

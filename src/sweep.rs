@@ -26,11 +26,13 @@ use crate::pipeline::{MeshMethod, RunError, RunOptions, run};
 pub enum SweepMethod {
     Uniform,
     UniformAdaptive,
-    /// Discontinuity meshes of the default events ([`EventSet::Extremal`]).
+    /// Discontinuity meshes of the default events ([`EventSet::Complete`]).
     Discontinuity,
     DiscontinuityAdaptive,
-    /// Discontinuity meshes of every EV and VE event ([`EventSet::Complete`]).
+    /// Discontinuity meshes of every vertex–edge event ([`EventSet::Complete`]).
     DiscontinuityComplete,
+    /// Discontinuity meshes of the umbra and outer penumbra boundaries ([`EventSet::Extremal`]).
+    DiscontinuityExtremal,
 }
 
 impl SweepMethod {
@@ -42,12 +44,13 @@ impl SweepMethod {
         SweepMethod::DiscontinuityAdaptive,
     ];
     /// Every method a sweep can run.
-    pub const ALL: [SweepMethod; 5] = [
+    pub const ALL: [SweepMethod; 6] = [
         SweepMethod::Uniform,
         SweepMethod::UniformAdaptive,
         SweepMethod::Discontinuity,
         SweepMethod::DiscontinuityAdaptive,
         SweepMethod::DiscontinuityComplete,
+        SweepMethod::DiscontinuityExtremal,
     ];
 
     pub fn name(self) -> &'static str {
@@ -57,12 +60,14 @@ impl SweepMethod {
             SweepMethod::Discontinuity => "discontinuity",
             SweepMethod::DiscontinuityAdaptive => "discontinuity+adaptive",
             SweepMethod::DiscontinuityComplete => "discontinuity-complete",
+            SweepMethod::DiscontinuityExtremal => "discontinuity-extremal",
         }
     }
 
     fn events(self) -> EventSet {
         match self {
             SweepMethod::DiscontinuityComplete => EventSet::Complete,
+            SweepMethod::DiscontinuityExtremal => EventSet::Extremal,
             _ => EventSet::default(),
         }
     }

@@ -331,7 +331,7 @@ fn adaptive_refinement_is_reported() {
             &out,
             &[
                 "--max-elements",
-                "3000",
+                "4000",
                 "--refine-tol",
                 "0.002",
                 "--refine-indirect",
@@ -806,7 +806,7 @@ fn the_memory_estimate_bounds_the_peak() {
     run_quietly(
         "boxworld-1000",
         &out,
-        &["--max-elements", "60000", "--direct-only"],
+        &["--max-elements", "80000", "--direct-only"],
     );
     let report = json(&out.join("report.json"));
     assert_eq!(report["scene"]["surfaces"], 5002);
@@ -1032,7 +1032,7 @@ fn svgs_are_written_for_the_surfaces_asked_for() {
             })
             .collect()
     };
-    let base = ["--direct-only", "--max-elements", "6000"];
+    let base = ["--direct-only", "--max-elements", "9000"];
     // 100 boxes: 502 surfaces.
     let out = dir.path().join("auto");
     run_quietly("boxworld", &out, &base);

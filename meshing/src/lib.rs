@@ -23,6 +23,7 @@ pub mod planar;
 pub mod progress;
 pub mod scene_mesh;
 pub mod uniform;
+pub mod wedges;
 
 pub use budget::{ElementBudget, FIT_TRIANGLES_PER_SURFACE, polygon_minimum};
 pub use error::MeshError;

@@ -42,6 +42,10 @@ pub struct SurfaceMesh {
 pub struct MeshQuality {
     pub triangles: usize,
     pub min_angle_deg: f64,
+    /// The smallest angle not forced by the input: among the triangle corners that lie in a
+    /// wedge between input edges (polygon edges and constraints meeting at the corner's vertex)
+    /// of at least [`FORCING_WEDGE_DEG`]. A narrower wedge leaves every corner in it narrower.
+    pub min_angle_unforced_deg: f64,
     pub aspect_ratio_median: f64,
     pub aspect_ratio_p95: f64,
     pub aspect_ratio_max: f64,
@@ -216,12 +220,30 @@ impl SurfaceMesh {
     }
 }
 
+/// Wedges between input edges narrower than this force the angles of the corners in them
+/// ([`MeshQuality::min_angle_unforced_deg`]): the angle quality refinement aims for.
+pub const FORCING_WEDGE_DEG: f64 = crate::constrained::CONSTRAINED_MIN_ANGLE_DEG;
+
 /// Quality figures over several meshes together.
 pub fn quality_of<'a>(meshes: impl IntoIterator<Item = &'a SurfaceMesh>) -> MeshQuality {
     let mut min_angle = f64::INFINITY;
+    let mut min_unforced = f64::INFINITY;
     let mut ratios = Vec::new();
     for m in meshes {
+        let wedges = crate::wedges::InputWedges::of(m);
         for tri in &m.triangles {
+            for k in 0..3 {
+                let v = tri[k] as usize;
+                let (a, b) = (
+                    m.local[tri[(k + 1) % 3] as usize],
+                    m.local[tri[(k + 2) % 3] as usize],
+                );
+                let (da, db) = ((a - m.local[v]).normalize(), (b - m.local[v]).normalize());
+                let corner = da.dot(db).clamp(-1.0, 1.0).acos().to_degrees();
+                if wedges.around(v, da, db).to_degrees() >= FORCING_WEDGE_DEG {
+                    min_unforced = min_unforced.min(corner);
+                }
+            }
             let [a, b, c] = tri.map(|i| m.local[i as usize]);
             let (la, lb, lc) = ((b - c).length(), (c - a).length(), (a - b).length());
             let angle = |opp: f64, s1: f64, s2: f64| {
@@ -247,6 +269,7 @@ pub fn quality_of<'a>(meshes: impl IntoIterator<Item = &'a SurfaceMesh>) -> Mesh
     MeshQuality {
         triangles: ratios.len(),
         min_angle_deg: min_angle,
+        min_angle_unforced_deg: min_unforced,
         aspect_ratio_median: at(0.5),
         aspect_ratio_p95: at(0.95),
         aspect_ratio_max: at(1.0),

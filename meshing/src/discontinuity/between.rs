@@ -14,7 +14,7 @@
 use std::collections::BTreeSet;
 
 use glam::DVec3;
-use penumbra_scenes::{Bounds, IndexBox, PlaneFrame, SurfaceId, Visibility};
+use penumbra_scenes::{Bounds, PlaneFrame, SurfaceId, Visibility};
 
 use super::eee::{NearBlockers, shadow_region};
 use super::topology::Topology;
@@ -33,18 +33,16 @@ pub(crate) struct BetweenSearch<'a> {
     pub emitter_polygon: &'a [DVec3],
     /// Vertices inside a straight stretch of edges: no corner, so no event.
     pub straight: &'a [bool],
-    pub surface_leaves: Option<&'a [Vec<IndexBox>]>,
     /// Heights under this are on a plane.
     pub tol: f64,
     /// How far a line may run (a few scene diagonals).
     pub reach: f64,
 }
 
-/// A wedge through blocker vertex `vertex` whose lines also pass through blocker edge `edge`.
+/// A wedge through a blocker vertex whose lines also pass through blocker edge `edge`.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct BetweenWedge {
     pub wedge: Wedge,
-    pub vertex: usize,
     pub edge: (usize, usize),
 }
 
@@ -77,7 +75,7 @@ impl BetweenSearch<'_> {
     ) -> (Vec<BetweenWedge>, BetweenCount) {
         let t = self.topology;
         let emitter = self.emitter_front();
-        let near = NearBlockers::new(t, blockers, self.surface_leaves);
+        let near = NearBlockers::indexed(t, blockers);
         let mut pairs: BTreeSet<(usize, (usize, usize))> = BTreeSet::new();
         let mut found = Vec::new();
         let in_region = |through: &[DVec3], found: &mut Vec<usize>| {
@@ -213,23 +211,24 @@ impl BetweenSearch<'_> {
                 },
                 ends,
             ) {
-                let source = [c0.lerp(c1, s0), c0.lerp(c1, s1)];
-                if source[0].distance(source[1]) <= self.tol
-                    || !t.vertex_on_outline(v, &source, self.not_pair())
-                {
-                    continue;
+                let run = [c0.lerp(c1, s0), c0.lerp(c1, s1)];
+                // The parts of the run from which the vertex is on its blocker's outline.
+                for [a, b] in t.outline_runs(v, run, self.not_pair()) {
+                    let source = [run[0].lerp(run[1], a), run[0].lerp(run[1], b)];
+                    if source[0].distance(source[1]) <= self.tol {
+                        continue;
+                    }
+                    out.push(BetweenWedge {
+                        wedge: Wedge {
+                            emitter: self.emitter,
+                            event: Event::BlockerEv,
+                            source,
+                            through: [pv, pv],
+                            order,
+                        },
+                        edge: (u, w),
+                    });
                 }
-                out.push(BetweenWedge {
-                    wedge: Wedge {
-                        emitter: self.emitter,
-                        event: Event::BlockerEv,
-                        source,
-                        through: [pv, pv],
-                        order,
-                    },
-                    vertex: v,
-                    edge: (u, w),
-                });
             }
         }
         Some(out)

@@ -162,6 +162,17 @@ impl NearBlockers {
         }
     }
 
+    /// Finds blockers near small regions through the visibility index's box query, whatever
+    /// their number: for regions that hold few of the shaft's blockers, walking the leaves of
+    /// all of them ([`NearBlockers::Leaves`]) would cost more than the query.
+    pub fn indexed(topology: &Topology, blockers: &[SurfaceId]) -> NearBlockers {
+        if blockers.len() <= FEW_BLOCKERS {
+            NearBlockers::new(topology, blockers, None)
+        } else {
+            NearBlockers::Index(blockers.iter().enumerate().map(|(b, &s)| (s, b)).collect())
+        }
+    }
+
     /// Calls `found` with each blocker near the box `region` (some maybe more than once).
     pub fn find(
         &self,

@@ -8,7 +8,7 @@
 //! (the parallel case) are merged. Blockers touching the receiver add contact (D0) lines. Every
 //! segment is classified by what lies on either side: umbra, penumbra or lit.
 
-mod between;
+pub mod between;
 pub mod contact;
 pub mod eee;
 pub mod hull;
@@ -68,17 +68,18 @@ pub struct DiscontinuitySegment {
     pub order: u8,
 }
 
-/// Which EV and VE events discontinuity finding inserts.
+/// Which vertex–edge events discontinuity finding inserts.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum EventSet {
     /// Every one: an emitter edge with each blocker vertex on the blocker's outline as seen from
-    /// the edge, and each emitter vertex with each blocker edge on the outline as seen from it.
-    /// The visible area's second derivative jumps across each.
-    Complete,
-    /// Only those whose plane is tangent to both the emitter and the blocker: the umbra and
-    /// outer penumbra boundaries.
+    /// the edge, each emitter vertex with each blocker edge on the outline as seen from it, and
+    /// each blocker vertex with an edge of another blocker in a plane that cuts the emitter
+    /// ([`between`]). The visible area's second derivative jumps across each.
     #[default]
+    Complete,
+    /// Only EV and VE events whose plane is tangent to both the emitter and the blocker: the
+    /// umbra and outer penumbra boundaries.
     Extremal,
 }
 

@@ -44,14 +44,10 @@ pub(crate) struct PairEvents {
     pub stats: DiscontinuityStats,
 }
 
-/// A wedge to follow onto the receiver. A complete EV wedge may hold the blocker vertex on the
-/// outline from only part of its emitter edge: `outline_vertex` names the vertex, checked again
-/// for each generating ray (beyond that part, the ray enters the blocker at the vertex). A wedge
-/// between two blockers also passes `grazed_edge`, which each generating ray must reach
-/// unobstructed too.
+/// A wedge to follow onto the receiver. A wedge between two blockers also passes `grazed_edge`,
+/// which each generating ray must reach unobstructed too.
 struct Candidate {
     wedge: Wedge,
-    outline_vertex: Option<usize>,
     grazed_edge: Option<(usize, usize)>,
 }
 
@@ -59,7 +55,6 @@ impl Candidate {
     fn plain(wedge: Wedge) -> Candidate {
         Candidate {
             wedge,
-            outline_vertex: None,
             grazed_edge: None,
         }
     }
@@ -305,13 +300,21 @@ impl Shaft<'_> {
                 let n = (self.point(ib) - self.point(ia)).cross(pv - self.point(ia));
                 let Some(n) = n.try_normalize() else { continue };
                 stats.wedges_considered += 1;
-                let complete = self.context.options.events == EventSet::Complete;
-                let event = if complete {
-                    topology.vertex_on_outline(v, &source, self.not_pair())
-                } else {
-                    topology.vertex_is_tangent(v, n, self.not_pair())
+                // A complete wedge keeps the parts of the edge from which the vertex is on the
+                // outline: beyond them, the ray enters the blocker at the vertex.
+                let sources: Vec<[DVec3; 2]> = match self.context.options.events {
+                    EventSet::Complete => topology
+                        .outline_runs(v, source, self.not_pair())
+                        .into_iter()
+                        .map(|[s, t]| [source[0].lerp(source[1], s), source[0].lerp(source[1], t)])
+                        .filter(|[a, b]| a.distance(*b) > tol)
+                        .collect(),
+                    EventSet::Extremal if topology.vertex_is_tangent(v, n, self.not_pair()) => {
+                        vec![source]
+                    }
+                    EventSet::Extremal => Vec::new(),
                 };
-                if !event {
+                if sources.is_empty() {
                     stats.wedges_culled += 1;
                     continue;
                 }
@@ -320,17 +323,15 @@ impl Shaft<'_> {
                 } else {
                     2
                 };
-                wedges.push(Candidate {
-                    wedge: Wedge {
+                wedges.extend(sources.into_iter().map(|source| {
+                    Candidate::plain(Wedge {
                         emitter: self.emitter,
                         event: Event::Ev,
                         source,
                         through: [pv, pv],
                         order,
-                    },
-                    outline_vertex: complete.then_some(v),
-                    grazed_edge: None,
-                });
+                    })
+                }));
             }
         }
         wedges
@@ -398,7 +399,6 @@ impl Shaft<'_> {
             receiver_frame: self.receiver_frame,
             emitter_polygon: &context.scene.surfaces[self.emitter].polygon,
             straight: &context.straight,
-            surface_leaves: context.surface_leaves.as_deref(),
             tol: context.tol,
             reach: context.reach,
         };
@@ -409,7 +409,6 @@ impl Shaft<'_> {
             .into_iter()
             .map(|b| Candidate {
                 wedge: b.wedge,
-                outline_vertex: Some(b.vertex),
                 grazed_edge: Some(b.edge),
             })
             .collect()
@@ -458,7 +457,7 @@ impl Shaft<'_> {
     }
 
     /// Where a wedge meets the receiver, clipped to its polygon and trimmed to where the wedge's
-    /// rays are unobstructed (and, for a complete EV wedge, graze its vertex from outside).
+    /// rays are unobstructed.
     fn wedge_segments(&self, candidate: &Candidate, out: &mut PairEvents) {
         let context = self.context;
         let wedge = &candidate.wedge;
@@ -468,18 +467,11 @@ impl Shaft<'_> {
         };
         let receiver_polygon = &context.scene.surfaces[self.receiver].polygon;
         let trim_tol = self.on_receiver(context.options.trim_tolerance);
-        let generates = |x: DVec3| {
-            candidate.outline_vertex.is_none_or(|v| {
-                let (_, source) = wedge.generator(x);
-                context
-                    .topology
-                    .vertex_on_outline(v, &[source, source], self.not_pair())
-            }) && match candidate.grazed_edge {
-                None => trim::generator_visible(context.visibility, wedge, x, self.receiver),
-                Some((u, w)) => {
-                    let edge = [context.topology.points[u], context.topology.points[w]];
-                    trim::generator_visible_past(context.visibility, wedge, x, self.receiver, edge)
-                }
+        let generates = |x: DVec3| match candidate.grazed_edge {
+            None => trim::generator_visible(context.visibility, wedge, x, self.receiver),
+            Some((u, w)) => {
+                let edge = [context.topology.points[u], context.topology.points[w]];
+                trim::generator_visible_past(context.visibility, wedge, x, self.receiver, edge)
             }
         };
         let mut kept = false;

@@ -138,47 +138,55 @@ impl Topology {
         true
     }
 
-    /// Whether vertex `v` is on the outline of the faces around it (those for which `include`
-    /// holds) as seen from some point of the segment `viewpoints` (a point when both ends are
-    /// one): it lies on the rim of an open sheet (an edge at `v` with one such face: every corner
-    /// of a single polygon), or some of its faces turn towards the viewpoint and some away (a
-    /// silhouette vertex of a solid). Between two viewpoints that each see all the faces from one
-    /// side, the segment meets the outline when the sides differ: the viewpoints from which all
-    /// faces turn one way form a convex cone at a convex vertex.
-    pub fn vertex_on_outline(
+    /// Where along the segment `viewpoints` vertex `v` is on the outline of the faces around it
+    /// (those for which `include` holds), as runs of parameters in `[0, 1]`: everywhere when it
+    /// lies on the rim of an open sheet (an edge at `v` with one such face: every corner of a
+    /// single polygon), else where some of its faces turn towards the viewpoint and some away (a
+    /// silhouette vertex of a solid). Each face's side changes at most once along the segment,
+    /// where it crosses the face's plane; between those crossings the answer is the same.
+    pub fn outline_runs(
         &self,
         v: usize,
-        viewpoints: &[DVec3; 2],
+        viewpoints: [DVec3; 2],
         include: impl Fn(SurfaceId) -> bool,
-    ) -> bool {
-        let faces: Vec<&Corner> = self.corners[v]
-            .iter()
-            .filter(|c| include(c.surface))
-            .collect();
+    ) -> Vec<[f64; 2]> {
+        let faces = || self.corners[v].iter().filter(|c| include(c.surface));
         let faces_on = |a: usize, b: usize| {
             self.edges
                 .get(&(a.min(b), a.max(b)))
                 .map_or(0, |f| f.iter().filter(|&&(s, _)| include(s)).count())
         };
-        if faces
-            .iter()
-            .any(|c| faces_on(v, c.prev) == 1 || faces_on(v, c.next) == 1)
-        {
-            return true;
+        if faces().any(|c| faces_on(v, c.prev) == 1 || faces_on(v, c.next) == 1) {
+            return vec![[0.0, 1.0]];
         }
         let origin = self.points[v];
-        // The one side of every face's plane that `q` is on, or `None` when the sides differ.
-        let one_side = |q: DVec3| {
-            let mut seen = 0i8;
-            faces
-                .iter()
-                .all(|c| keeps_side(&mut seen, self.side(self.normals[c.surface], origin, q)))
-                .then_some(seen)
-        };
-        match (one_side(viewpoints[0]), one_side(viewpoints[1])) {
-            (Some(a), Some(b)) => a != b && a != 0 && b != 0,
-            _ => true,
+        let mut cuts = vec![0.0, 1.0];
+        for c in faces() {
+            let n = self.normals[c.surface];
+            let (h0, h1) = (n.dot(viewpoints[0] - origin), n.dot(viewpoints[1] - origin));
+            if (h0 > 0.0) != (h1 > 0.0) {
+                cuts.push(h0 / (h0 - h1));
+            }
         }
+        cuts.sort_by(f64::total_cmp);
+        cuts.dedup();
+        // Whether the faces turn both ways as seen from `q`.
+        let straddles = |q: DVec3| {
+            let mut seen = 0i8;
+            !faces().all(|c| keeps_side(&mut seen, self.side(self.normals[c.surface], origin, q)))
+        };
+        let mut runs: Vec<[f64; 2]> = Vec::new();
+        for w in cuts.windows(2) {
+            let mid = viewpoints[0].lerp(viewpoints[1], 0.5 * (w[0] + w[1]));
+            if w[1] <= w[0] || !straddles(mid) {
+                continue;
+            }
+            match runs.last_mut() {
+                Some(r) if r[1] == w[0] => r[1] = w[1],
+                _ => runs.push([w[0], w[1]]),
+            }
+        }
+        runs
     }
 
     /// Whether every face along the edge `(a, b)` for which `include` holds lies on one side of

@@ -1,0 +1,126 @@
+//! The wedges that input edges (the polygon's edges and the constraints, each a chain of mesh
+//! edges) make around each vertex of a mesh. A triangle corner inside a wedge narrower than the
+//! angle refinement aims for cannot reach it: the input forces that corner.
+
+use std::collections::HashMap;
+use std::f64::consts::TAU;
+
+use glam::DVec2;
+
+use crate::mesh::{ON_SEGMENT_TOLERANCE, SurfaceMesh};
+
+/// Per vertex, the directions of the input edges that leave it.
+#[derive(Clone, Debug)]
+pub struct InputWedges {
+    /// Each vertex's place: copies of a vertex split along a value discontinuity share one.
+    place_of: Vec<u32>,
+    /// Per place, the angles of the input edges leaving it, sorted, in `[-pi, pi]`.
+    directions: Vec<Vec<f64>>,
+}
+
+impl InputWedges {
+    pub fn of(m: &SurfaceMesh) -> InputWedges {
+        let mut places: HashMap<(u64, u64), u32> = HashMap::new();
+        let place_of: Vec<u32> = m
+            .local
+            .iter()
+            .map(|p| {
+                let next = places.len() as u32;
+                *places.entry((p.x.to_bits(), p.y.to_bits())).or_insert(next)
+            })
+            .collect();
+        let mut at: Vec<DVec2> = vec![DVec2::ZERO; places.len()];
+        for (v, &p) in place_of.iter().enumerate() {
+            at[p as usize] = m.local[v];
+        }
+        let mut neighbours: Vec<Vec<u32>> = vec![Vec::new(); places.len()];
+        for t in &m.triangles {
+            for k in 0..3 {
+                let (a, b) = (place_of[t[k] as usize], place_of[t[(k + 1) % 3] as usize]);
+                neighbours[a as usize].push(b);
+                neighbours[b as usize].push(a);
+            }
+        }
+        for list in &mut neighbours {
+            list.sort_unstable();
+            list.dedup();
+        }
+        let mut directions: Vec<Vec<f64>> = vec![Vec::new(); places.len()];
+        let n = m.boundary.len();
+        let inputs = (0..n)
+            .map(|k| [m.boundary[k], m.boundary[(k + 1) % n]])
+            .chain(m.constraints.iter().copied());
+        for [p, q] in inputs {
+            let Some(&start) = places.get(&(p.x.to_bits(), p.y.to_bits())) else {
+                continue;
+            };
+            let chain = follow(start, p, q, &at, &neighbours);
+            for w in chain.windows(2) {
+                let (a, b) = (w[0] as usize, w[1] as usize);
+                let d = at[b] - at[a];
+                directions[a].push(d.y.atan2(d.x));
+                directions[b].push((-d.y).atan2(-d.x));
+            }
+        }
+        for list in &mut directions {
+            list.sort_by(f64::total_cmp);
+            list.dedup();
+        }
+        InputWedges {
+            place_of,
+            directions,
+        }
+    }
+
+    /// The angle (radians) of the wedge between input edges at vertex `v` that holds the corner
+    /// turning counter-clockwise from direction `from` to direction `to`; a full turn where fewer
+    /// than two input edges leave `v`.
+    pub fn around(&self, v: usize, from: DVec2, to: DVec2) -> f64 {
+        let dirs = &self.directions[self.place_of[v] as usize];
+        if dirs.len() < 2 {
+            return TAU;
+        }
+        let mid = from + to;
+        let mid = if mid.length_squared() > 0.0 {
+            mid
+        } else {
+            from.perp()
+        };
+        let phi = mid.y.atan2(mid.x);
+        // The first input direction counter-clockwise after the corner's bisector, and the one
+        // before it.
+        let after = dirs.iter().position(|&a| a > phi).unwrap_or(0);
+        let before = (after + dirs.len() - 1) % dirs.len();
+        (dirs[after] - dirs[before]).rem_euclid(TAU)
+    }
+}
+
+/// The places along the input edge `p -> q`, from `start` (at `p`), as a chain of mesh edges.
+fn follow(start: u32, p: DVec2, q: DVec2, at: &[DVec2], neighbours: &[Vec<u32>]) -> Vec<u32> {
+    let d = q - p;
+    let len2 = d.length_squared();
+    if len2 == 0.0 {
+        return Vec::new();
+    }
+    let len = len2.sqrt();
+    let along = |x: DVec2| (x - p).dot(d) / len2;
+    let on = |x: DVec2| d.perp_dot(x - p).abs() / len <= ON_SEGMENT_TOLERANCE;
+    let slack = ON_SEGMENT_TOLERANCE / len;
+    let mut chain = vec![start];
+    let mut current = start;
+    while along(at[current as usize]) < 1.0 - slack {
+        let here = along(at[current as usize]);
+        let next = neighbours[current as usize]
+            .iter()
+            .copied()
+            .filter(|&w| {
+                let x = at[w as usize];
+                on(x) && along(x) > here + slack && along(x) <= 1.0 + slack
+            })
+            .min_by(|&a, &b| along(at[a as usize]).total_cmp(&along(at[b as usize])));
+        let Some(next) = next else { break };
+        chain.push(next);
+        current = next;
+    }
+    chain
+}
