@@ -1,8 +1,11 @@
 //! An oracle for discontinuity meshes that knows nothing of events. Along seeded lines across a
 //! receiver, the exact direct light is sampled at a fine, even step; its third differences stand
 //! out from their neighbours wherever the value, the slope or the curvature jumps. Every jump
-//! found must have a discontinuity segment through it, and every segment must have a jump across
-//! it (probed along a short line at right angles to it).
+//! found must have a discontinuity segment through it (within three steps, 6e-4 of the receiver,
+//! plus the EEE chord tolerance), and every segment must have a jump across it (probed along a
+//! short line at right angles to it). Events are found from every blocker, however little it can
+//! hide (`event_tolerance` 0). Contact lines with darkness on both sides are the one exception:
+//! they bound what the reflected light reaches, not a change of the direct light.
 
 use glam::{DVec2, DVec3};
 use penumbra_meshing::discontinuity::{
@@ -27,7 +30,7 @@ const VALUE_ROUNDING: f64 = 1e-13;
 
 /// The light from one emitter over one receiver, and the receiver's flat frame.
 struct Field<'a> {
-    direct: DirectLight<'a>,
+    direct: &'a DirectLight<'a>,
     emitter: usize,
     receiver: SurfaceId,
     frame: PlaneFrame,
@@ -145,7 +148,7 @@ struct Verdict {
 }
 
 fn oracle(scene: &Scene, receiver: &str, events: EventSet, lines: usize, seed: u64) -> Verdict {
-    let vis = Visibility::build(&scene);
+    let vis = Visibility::build(scene);
     let options = DiscontinuityOptions {
         events,
         event_tolerance: 0.0,
@@ -162,7 +165,7 @@ fn oracle(scene: &Scene, receiver: &str, events: EventSet, lines: usize, seed: u
     for emitter in 0..direct.emitter_count() {
         let e = direct.emitter_surface(emitter);
         let field = Field {
-            direct: DirectLight::new(scene, &vis),
+            direct: &direct,
             emitter,
             receiver: r,
             frame,
@@ -178,7 +181,10 @@ fn oracle(scene: &Scene, receiver: &str, events: EventSet, lines: usize, seed: u
             .iter()
             .map(|s| [frame.to_2d(s.from), frame.to_2d(s.to)])
             .collect();
-        let tolerance = 3.0 * h + 1e-4 * penumbra_scenes::polygon::diameter(polygon);
+        // Jumps are placed to within a few steps; EEE curves are polylines within their chord
+        // tolerance (a 1e-4 of the receiver, `DiscontinuityOptions::eee_tolerance`).
+        let tolerance =
+            3.0 * h + options.eee_tolerance * penumbra_scenes::polygon::diameter(polygon);
         along_lines(
             &field,
             &segments,

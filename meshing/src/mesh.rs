@@ -42,9 +42,9 @@ pub struct SurfaceMesh {
 pub struct MeshQuality {
     pub triangles: usize,
     pub min_angle_deg: f64,
-    /// The smallest angle not forced by the input: among the triangle corners that lie in a
-    /// wedge between input edges (polygon edges and constraints meeting at the corner's vertex)
-    /// of at least [`FORCING_WEDGE_DEG`]. A narrower wedge leaves every corner in it narrower.
+    /// The smallest angle not forced by the input ([`crate::wedges`]): two input edges (polygon
+    /// edges and constraints) meeting at less than [`FORCING_WEDGE_DEG`] force the corners
+    /// between them at their meeting point, and the triangles between them.
     pub min_angle_unforced_deg: f64,
     pub aspect_ratio_median: f64,
     pub aspect_ratio_p95: f64,
@@ -233,15 +233,17 @@ pub fn quality_of<'a>(meshes: impl IntoIterator<Item = &'a SurfaceMesh>) -> Mesh
         let wedges = crate::wedges::InputWedges::of(m);
         for tri in &m.triangles {
             for k in 0..3 {
-                let v = tri[k] as usize;
+                let v = m.local[tri[k] as usize];
                 let (a, b) = (
                     m.local[tri[(k + 1) % 3] as usize],
                     m.local[tri[(k + 2) % 3] as usize],
                 );
-                let (da, db) = ((a - m.local[v]).normalize(), (b - m.local[v]).normalize());
-                let corner = da.dot(db).clamp(-1.0, 1.0).acos().to_degrees();
-                if wedges.around(v, da, db).to_degrees() >= FORCING_WEDGE_DEG {
-                    min_unforced = min_unforced.min(corner);
+                let corner = (a - v)
+                    .normalize()
+                    .dot((b - v).normalize())
+                    .clamp(-1.0, 1.0);
+                if !wedges.forces(&m.local, *tri, k, FORCING_WEDGE_DEG.to_radians()) {
+                    min_unforced = min_unforced.min(corner.acos().to_degrees());
                 }
             }
             let [a, b, c] = tri.map(|i| m.local[i as usize]);

@@ -1,6 +1,8 @@
 //! The wedges that input edges (the polygon's edges and the constraints, each a chain of mesh
-//! edges) make around each vertex of a mesh. A triangle corner inside a wedge narrower than the
-//! angle refinement aims for cannot reach it: the input forces that corner.
+//! edges) make around each vertex of a mesh, and the angles they force. A triangle corner inside
+//! a wedge narrower than the angle refinement aims for cannot reach it; nor can the triangles
+//! that lie between two input edges meeting at such an angle (every vertex on one of the two),
+//! which quality refinement lays out in shells around the apex: the input forces those angles.
 
 use std::collections::HashMap;
 use std::f64::consts::TAU;
@@ -9,13 +11,17 @@ use glam::DVec2;
 
 use crate::mesh::{ON_SEGMENT_TOLERANCE, SurfaceMesh};
 
-/// Per vertex, the directions of the input edges that leave it.
+/// Per vertex, the directions of the input edges that leave it and the input edges it is on.
 #[derive(Clone, Debug)]
 pub struct InputWedges {
     /// Each vertex's place: copies of a vertex split along a value discontinuity share one.
     place_of: Vec<u32>,
     /// Per place, the angles of the input edges leaving it, sorted, in `[-pi, pi]`.
     directions: Vec<Vec<f64>>,
+    /// Per place, the input edges through it (their index in `inputs`).
+    on: Vec<Vec<u32>>,
+    /// The input edges: the polygon's, then the constraints.
+    inputs: Vec<[DVec2; 2]>,
 }
 
 impl InputWedges {
@@ -47,14 +53,19 @@ impl InputWedges {
         }
         let mut directions: Vec<Vec<f64>> = vec![Vec::new(); places.len()];
         let n = m.boundary.len();
-        let inputs = (0..n)
+        let inputs: Vec<[DVec2; 2]> = (0..n)
             .map(|k| [m.boundary[k], m.boundary[(k + 1) % n]])
-            .chain(m.constraints.iter().copied());
-        for [p, q] in inputs {
+            .chain(m.constraints.iter().copied())
+            .collect();
+        let mut on: Vec<Vec<u32>> = vec![Vec::new(); places.len()];
+        for (i, &[p, q]) in inputs.iter().enumerate() {
             let Some(&start) = places.get(&(p.x.to_bits(), p.y.to_bits())) else {
                 continue;
             };
             let chain = follow(start, p, q, &at, &neighbours);
+            for &c in &chain {
+                on[c as usize].push(i as u32);
+            }
             for w in chain.windows(2) {
                 let (a, b) = (w[0] as usize, w[1] as usize);
                 let d = at[b] - at[a];
@@ -69,7 +80,38 @@ impl InputWedges {
         InputWedges {
             place_of,
             directions,
+            on,
+            inputs,
         }
+    }
+
+    /// Whether the input forces the corner of triangle `tri` at its `k`-th vertex below
+    /// `limit` (radians): the corner lies in a narrower wedge of input edges, or the triangle
+    /// lies between two input edges that meet at a narrower angle.
+    pub fn forces(&self, local: &[DVec2], tri: [u32; 3], k: usize, limit: f64) -> bool {
+        let [v, a, b] = [tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]].map(|i| i as usize);
+        let (da, db) = (
+            (local[a] - local[v]).normalize(),
+            (local[b] - local[v]).normalize(),
+        );
+        self.around(v, da, db) < limit || self.between_narrow_inputs(tri, limit)
+    }
+
+    /// Whether every vertex of `tri` is on one of two input edges that meet at an angle under
+    /// `limit`.
+    fn between_narrow_inputs(&self, tri: [u32; 3], limit: f64) -> bool {
+        let sets = tri.map(|v| &self.on[self.place_of[v as usize] as usize]);
+        if sets.iter().any(|s| s.is_empty()) {
+            return false;
+        }
+        let covers = |s: u32, t: u32| sets.iter().all(|set| set.contains(&s) || set.contains(&t));
+        sets[0].iter().any(|&s| {
+            sets.iter().flat_map(|set| set.iter()).any(|&t| {
+                t != s
+                    && covers(s, t)
+                    && meeting_angle(self.inputs[s as usize], self.inputs[t as usize]) < limit
+            })
+        })
     }
 
     /// The angle (radians) of the wedge between input edges at vertex `v` that holds the corner
@@ -93,6 +135,41 @@ impl InputWedges {
         let before = (after + dirs.len() - 1) % dirs.len();
         (dirs[after] - dirs[before]).rem_euclid(TAU)
     }
+}
+
+/// The narrowest angle (radians) between two segments where they meet; a half turn when they do
+/// not meet. Where one ends, only its direction away from the meeting point counts.
+fn meeting_angle([p, q]: [DVec2; 2], [r, s]: [DVec2; 2]) -> f64 {
+    let (d, e) = (q - p, s - r);
+    let den = d.perp_dot(e);
+    let slack = ON_SEGMENT_TOLERANCE;
+    if den.abs() <= f64::EPSILON * d.length() * e.length() {
+        return std::f64::consts::PI;
+    }
+    let t = (r - p).perp_dot(e) / den;
+    let u = (r - p).perp_dot(d) / den;
+    if !(-slack..=1.0 + slack).contains(&t) || !(-slack..=1.0 + slack).contains(&u) {
+        return std::f64::consts::PI;
+    }
+    // The directions leaving the meeting point along each segment.
+    let leaving = |t: f64, d: DVec2| -> Vec<DVec2> {
+        let d = d.normalize();
+        let mut out = Vec::with_capacity(2);
+        if t < 1.0 - slack {
+            out.push(d);
+        }
+        if t > slack {
+            out.push(-d);
+        }
+        out
+    };
+    let mut narrowest = std::f64::consts::PI;
+    for x in leaving(t, d) {
+        for y in leaving(u, e) {
+            narrowest = narrowest.min(x.dot(y).clamp(-1.0, 1.0).acos());
+        }
+    }
+    narrowest
 }
 
 /// The places along the input edge `p -> q`, from `start` (at `p`), as a chain of mesh edges.
