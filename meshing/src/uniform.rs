@@ -41,6 +41,11 @@ const SKIPPED_FACE_ROUNDS: usize = 4;
 /// refined until it reaches the target instead (see `SurfaceTriangulation::refined_capped`).
 const CAPPED_BELOW: f64 = 0.5;
 
+/// Rounds of filling a refinement that stopped short of its target (see
+/// `SurfaceTriangulation::filled`), and the share of the target that ends them.
+const FILL_ROUNDS: usize = 8;
+const FILLED_SHARE: f64 = 0.9;
+
 /// Vertices a refinement to `target` triangles may add: the target (about twice what it needs)
 /// and a few for small targets.
 fn allowance(target: usize) -> usize {
@@ -458,6 +463,7 @@ impl SurfaceTriangulation {
             let refined = self.with_cdt(refine(max_area));
             let count = refined.count();
             let ratio = count as f64 / target as f64;
+
             if count <= target && count > best_count {
                 best_count = count;
                 best = refined;
@@ -477,7 +483,46 @@ impl SurfaceTriangulation {
                 best = capped;
             }
         }
-        best
+        best.filled(target, min_angle_deg)
+    }
+
+    /// This refinement, its largest triangles split a round at a time (each round followed by
+    /// quality refinement around the splits) while the count stays within `target`: where the
+    /// area bound's count jumps past the target (a refinement cascading along close
+    /// constraints), the calibration alone stops far short of it.
+    fn filled(mut self, target: usize, min_angle_deg: f64) -> SurfaceTriangulation {
+        for _ in 0..FILL_ROUNDS {
+            let count = self.count();
+            let missing = target.saturating_sub(count);
+            if count as f64 >= FILLED_SHARE * target as f64 || missing < 8 {
+                break;
+            }
+            let mut inside: Vec<(f64, DVec2)> = self
+                .cdt
+                .inner_faces()
+                .map(|f| (f.area(), face_centroid(f)))
+                .filter(|&(_, c)| crate::planar::inside_polygon(c, &self.coords.boundary))
+                .collect();
+            inside.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.x.total_cmp(&b.1.x)));
+            // A split and the repairs around it add about four triangles, unless the repairs
+            // cascade: then fewer splits are tried.
+            let mut splits = missing / 4;
+            let mut grown = None;
+            while splits > 0 {
+                let points: Vec<DVec2> = inside.iter().take(splits).map(|&(_, c)| c).collect();
+                let mut next = self.clone();
+                if next.split_triangles_at(&points, min_angle_deg) > 0 && next.count() <= target {
+                    grown = Some(next);
+                    break;
+                }
+                splits /= 2;
+            }
+            match grown {
+                Some(next) => self = next,
+                None => break,
+            }
+        }
+        self
     }
 
     /// A refinement stopped before it can exceed `target` triangles. Refining a sliver splits
