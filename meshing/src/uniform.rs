@@ -303,10 +303,8 @@ impl SurfaceTriangulation {
                 if points.is_empty() || cdt.num_vertices() > 2 * target + 64 {
                     break;
                 }
-                for p in points {
-                    // Only positions spade cannot represent fail; skipping one costs a split.
-                    let _ = cdt.insert(Point2::new(p.x, p.y));
-                }
+                // Only positions spade cannot represent fail; skipping one costs a split.
+                insert_in_order(&mut cdt, points);
                 self.refine_cdt(&mut cdt, min_angle_deg, None, smallest, allowed);
             }
             cdt
@@ -319,7 +317,7 @@ impl SurfaceTriangulation {
     pub fn split_triangles_at(&mut self, points: &[DVec2], min_angle_deg: f64) -> usize {
         let before = self.cdt.num_vertices();
         let mut faces = std::collections::HashSet::new();
-        for p in points {
+        for p in in_walking_order(points.to_vec()) {
             if let spade::PositionInTriangulation::OnFace(f) =
                 self.cdt.locate(Point2::new(p.x, p.y))
             {
@@ -334,10 +332,8 @@ impl SurfaceTriangulation {
             .map(|&f| self.cdt.face(f).area())
             .fold(f64::INFINITY, f64::min);
         let splits = split_points(&self.cdt, |face| faces.contains(&face.fix()));
-        for p in splits {
-            // Only positions spade cannot represent fail; skipping one costs a split.
-            let _ = self.cdt.insert(Point2::new(p.x, p.y));
-        }
+        // Only positions spade cannot represent fail; skipping one costs a split.
+        insert_in_order(&mut self.cdt, splits);
         let mut cdt = std::mem::take(&mut self.cdt);
         // Quality is restored around the splits only: a triangulation whose first refinement was
         // stopped at its target (see `refined_capped`) would otherwise be refined all over.
@@ -422,10 +418,8 @@ impl SurfaceTriangulation {
             if skipped.is_empty() {
                 break;
             }
-            for p in skipped {
-                // Only positions spade cannot represent fail; the next round tries again.
-                let _ = cdt.insert(Point2::new(p.x, p.y));
-            }
+            // Only positions spade cannot represent fail; the next round tries again.
+            insert_in_order(cdt, skipped);
             complete = cdt.refine(parameters(cdt)).refinement_complete;
         }
     }
@@ -443,7 +437,7 @@ impl SurfaceTriangulation {
     }
 
     /// The best of a few refinements made by `refine(max_area)` with the area bound calibrated so
-    /// that the count comes to 90-100 % of `target`; if none comes to [`CAPPED_BELOW`] of it, a
+    /// that the count comes to 90-100 % of `target` ([`FILLED_SHARE`]); if none comes to [`CAPPED_BELOW`] of it, a
     /// refinement (to angles of `min_angle_deg`) stopped at the target.
     fn calibrated(
         &self,
@@ -453,24 +447,28 @@ impl SurfaceTriangulation {
     ) -> SurfaceTriangulation {
         let mut best = self.clone();
         let base_count = self.count();
-        if target <= base_count {
+        // The least mesh already comes to the share of the target a calibration would accept.
+        if base_count as f64 >= FILLED_SHARE * target as f64 {
             return best;
         }
         let mut best_count = base_count;
         // Calibrate the area bound from the counts of a few trial runs.
         let mut max_area = self.area_for(target);
+        let mut last_count = None;
         for _ in 0..8 {
             let refined = self.with_cdt(refine(max_area));
             let count = refined.count();
             let ratio = count as f64 / target as f64;
-
             if count <= target && count > best_count {
                 best_count = count;
                 best = refined;
             }
-            if (0.9..=1.0).contains(&ratio) {
+            // A count that a larger area bound leaves as it was is the angles' alone: no bound
+            // brings it down.
+            if (FILLED_SHARE..=1.0).contains(&ratio) || (ratio > 1.0 && last_count == Some(count)) {
                 break;
             }
+            last_count = Some(count);
             max_area *= if ratio > 1.0 {
                 ratio * 1.04
             } else {
@@ -560,6 +558,47 @@ type Face<'a> = spade::handles::FaceHandle<'a, InnerTag, Point2<f64>, (), spade:
 fn face_centroid(face: Face<'_>) -> DVec2 {
     let [a, b, c] = face.positions().map(|p| DVec2::new(p.x, p.y));
     (a + b + c) / 3.0
+}
+
+/// `points` sorted along a Z-order curve over their box, so that each is found by a short walk
+/// from the one before: spade locates a point by walking from the last vertex it touched, and
+/// points in the order of the faces they come from are scattered over the whole polygon (on a
+/// floor of 600,000 triangles, the walks took most of the meshing time).
+fn in_walking_order(mut points: Vec<DVec2>) -> Vec<DVec2> {
+    let (lo, hi) = points
+        .iter()
+        .fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), &p| {
+            (lo.min(p), hi.max(p))
+        });
+    let scale = (hi - lo).max_element();
+    if !(scale > 0.0) {
+        return points;
+    }
+    let cell = |x: f64| (((x / scale) * 65535.0) as u32).min(65535);
+    let spread = |mut v: u32| {
+        v = (v | (v << 8)) & 0x00FF_00FF;
+        v = (v | (v << 4)) & 0x0F0F_0F0F;
+        v = (v | (v << 2)) & 0x3333_3333;
+        (v | (v << 1)) & 0x5555_5555
+    };
+    let key = |p: &DVec2| {
+        let q = *p - lo;
+        (
+            spread(cell(q.x)) | (spread(cell(q.y)) << 1),
+            p.x.to_bits(),
+            p.y.to_bits(),
+        )
+    };
+    points.sort_by_cached_key(key);
+    points
+}
+
+/// Inserts `points` in walking order ([`in_walking_order`]); a point spade cannot represent is
+/// skipped.
+fn insert_in_order(cdt: &mut Cdt, points: Vec<DVec2>) {
+    for p in in_walking_order(points) {
+        let _ = cdt.insert(Point2::new(p.x, p.y));
+    }
 }
 
 /// Where to split each face for which `wants` holds: the midpoint of its longest edge (shared
