@@ -73,56 +73,10 @@ impl BetweenSearch<'_> {
         edges: &BTreeSet<(usize, usize)>,
         blockers: &[SurfaceId],
     ) -> (Vec<BetweenWedge>, BetweenCount) {
-        let t = self.topology;
         let emitter = self.emitter_front();
-        let near = NearBlockers::indexed(t, blockers);
-        let mut pairs: BTreeSet<(usize, (usize, usize))> = BTreeSet::new();
-        let mut found = Vec::new();
-        let in_region = |through: &[DVec3], found: &mut Vec<usize>| {
-            let region = shadow_region(
-                &self.receiver_frame,
-                self.tol,
-                self.reach,
-                &emitter,
-                through,
-            );
-            found.clear();
-            near.find(
-                self.visibility,
-                Bounds::from_points(region.iter()),
-                self.tol,
-                |b| found.push(b),
-            );
-            found.sort_unstable();
-            found.dedup();
-        };
-        let usable_vertex =
-            |v: usize| !self.straight[v] && self.in_front(t.points[v]) && !t.corners[v].is_empty();
-        // Each vertex with the edges below it.
-        for &v in vertices.iter().filter(|&&v| usable_vertex(v)) {
-            in_region(&[t.points[v]], &mut found);
-            for &b in &found {
-                for (u, w) in loop_edges(&t.loops[blockers[b]]) {
-                    if edges.contains(&(u, w)) {
-                        pairs.insert((v, (u, w)));
-                    }
-                }
-            }
-        }
-        // Each edge with the vertices below it.
-        for &(u, w) in edges {
-            in_region(&[t.points[u], t.points[w]], &mut found);
-            for &b in &found {
-                for &v in &t.loops[blockers[b]] {
-                    if vertices.contains(&v) && usable_vertex(v) {
-                        pairs.insert((v, (u, w)));
-                    }
-                }
-            }
-        }
         let mut count = BetweenCount::default();
         let mut out = Vec::new();
-        for (v, edge) in pairs {
+        for (v, edge) in self.nearby_pairs(&emitter, vertices, edges, blockers) {
             if self.share_a_face(v, edge) {
                 continue;
             }
@@ -133,6 +87,54 @@ impl BetweenSearch<'_> {
             }
         }
         (out, count)
+    }
+
+    /// The vertex–edge pairs where one lies in the region between the other and its shadow from
+    /// `emitter` (the part of the emitter in front of the receiver), in order.
+    fn nearby_pairs(
+        &self,
+        emitter: &[DVec3],
+        vertices: &BTreeSet<usize>,
+        edges: &BTreeSet<(usize, usize)>,
+        blockers: &[SurfaceId],
+    ) -> BTreeSet<(usize, (usize, usize))> {
+        let t = self.topology;
+        let near = NearBlockers::indexed(t, blockers);
+        // The blockers (by place in `blockers`) near the region below the points `through`.
+        let below = |through: &[DVec3]| {
+            let region =
+                shadow_region(&self.receiver_frame, self.tol, self.reach, emitter, through);
+            let mut found = Vec::new();
+            near.find(
+                self.visibility,
+                Bounds::from_points(region.iter()),
+                self.tol,
+                |b| found.push(b),
+            );
+            found.sort_unstable();
+            found.dedup();
+            found
+        };
+        let usable_vertex =
+            |v: usize| !self.straight[v] && self.in_front(t.points[v]) && !t.corners[v].is_empty();
+        let mut pairs = BTreeSet::new();
+        for &v in vertices.iter().filter(|&&v| usable_vertex(v)) {
+            for b in below(&[t.points[v]]) {
+                for edge in loop_edges(&t.loops[blockers[b]]).filter(|e| edges.contains(e)) {
+                    pairs.insert((v, edge));
+                }
+            }
+        }
+        for &(u, w) in edges {
+            for b in below(&[t.points[u], t.points[w]]) {
+                for &v in &t.loops[blockers[b]] {
+                    if vertices.contains(&v) && usable_vertex(v) {
+                        pairs.insert((v, (u, w)));
+                    }
+                }
+            }
+        }
+        pairs
     }
 
     /// The emitter's polygon, cut to the part in front of the receiver.
