@@ -445,14 +445,25 @@ impl EeeSearch<'_> {
         // second edge.
         let planes = planes.get_or_init(|| sample_planes(source, b1));
         let second_edge = SecondEdge::new(source, b2);
-        let states: [bool; SAMPLES] = std::array::from_fn(|k| {
+        let sampled: [bool; SAMPLES] = std::array::from_fn(|k| {
             let (first, n) = planes[k];
             n.and_then(|n| self.transversal_in(source, first, n, &second_edge))
                 .is_some_and(|x| holds(&x))
         });
-        if !states.iter().any(|&s| s) {
+        // Beside each parameter where a condition of the event can change, the event is tried
+        // too: a run shorter than the samples' spacing is found when it starts or ends there.
+        let mut probes: Vec<(f64, bool)> = params.iter().copied().zip(sampled).collect();
+        for c in critical_parameters(source, b1, b2, faces[1]) {
+            for u in [c - CRITICAL_STEP, c + CRITICAL_STEP] {
+                if (0.0..=1.0).contains(&u) {
+                    probes.push((u, event(u).is_some()));
+                }
+            }
+        }
+        if !probes.iter().any(|&(_, s)| s) {
             return Vec::new();
         }
+        probes.sort_by(|a, b| a.0.total_cmp(&b.0));
         // Where the event starts or stops between a parameter where it holds and one where it
         // does not.
         let edge_of = |mut inside: f64, mut outside: f64| {
@@ -468,31 +479,33 @@ impl EeeSearch<'_> {
         };
         let mut runs = Vec::new();
         let mut start = None;
-        for k in 0..SAMPLES {
-            match (states[k], start) {
+        for k in 0..probes.len() {
+            let (u, holds_here) = probes[k];
+            match (holds_here, start) {
                 (true, None) => {
                     start = Some(if k == 0 {
                         if event(0.0).is_some() {
                             0.0
                         } else {
-                            edge_of(params[0], 0.0)
+                            edge_of(u, 0.0)
                         }
                     } else {
-                        edge_of(params[k], params[k - 1])
+                        edge_of(u, probes[k - 1].0)
                     });
                 }
                 (false, Some(s)) => {
-                    runs.push((s, edge_of(params[k - 1], params[k])));
+                    runs.push((s, edge_of(probes[k - 1].0, u)));
                     start = None;
                 }
                 _ => {}
             }
         }
         if let Some(s) = start {
+            let last = probes[probes.len() - 1].0;
             let end = if event(1.0).is_some() {
                 1.0
             } else {
-                edge_of(params[SAMPLES - 1], 1.0)
+                edge_of(last, 1.0)
             };
             runs.push((s, end));
         }
@@ -783,6 +796,41 @@ fn plane_through(source: [DVec3; 2], b1: [DVec3; 2], u: f64) -> (DVec3, Option<D
     let first = b1[0].lerp(b1[1], u);
     let e = source[1] - source[0];
     (first, e.cross(first - source[0]).try_normalize())
+}
+
+/// How far beside a critical parameter (a fraction of the first edge) the event is tried.
+const CRITICAL_STEP: f64 = 1e-9;
+
+/// The parameters along the first blocker edge `b1` where the transversal through the emitter
+/// edge `source` and the second edge `b2` passes an end of either (the plane through that end
+/// and the other edge cuts `b1` there), or lies in a face of `b2` (given as vectors from the edge
+/// into each face): where the event can start or stop. Those in `[0, 1]`.
+fn critical_parameters(
+    source: [DVec3; 2],
+    b1: [DVec3; 2],
+    b2: [DVec3; 2],
+    b2_faces: &[DVec3],
+) -> Vec<f64> {
+    let d1 = b1[1] - b1[0];
+    // Where `b1`'s line cuts the plane through `origin` with normal `n`.
+    let cut = |origin: DVec3, n: DVec3| {
+        let den = n.dot(d1);
+        (den != 0.0).then(|| n.dot(origin - b1[0]) / den)
+    };
+    let e = source[1] - source[0];
+    let d2 = b2[1] - b2[0];
+    let through_source_end = source
+        .into_iter()
+        .filter_map(|a| cut(a, (b2[0] - a).cross(b2[1] - a)));
+    let through_b2_end = b2
+        .into_iter()
+        .filter_map(|b| cut(source[0], e.cross(b - source[0])));
+    let in_b2_face = b2_faces.iter().filter_map(|&f| cut(b2[0], d2.cross(f)));
+    through_source_end
+        .chain(through_b2_end)
+        .chain(in_b2_face)
+        .filter(|u| (0.0..=1.0).contains(u))
+        .collect()
 }
 
 /// The sample parameters along a first blocker edge.
