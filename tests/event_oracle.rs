@@ -643,3 +643,42 @@ fn cornell_box() {
     assert_complete(&scene, "floor", 40);
     assert_complete(&scene, "back_wall", 30);
 }
+
+/// A tilted light whose own plane cuts a wall: above the cut the wall gets no light, below it the
+/// light is seen at a growing angle, and the slope jumps along the cut (a horizon line, order 1).
+#[test]
+fn a_wall_cut_by_the_lights_own_plane() {
+    let mut wall = vec![
+        DVec3::new(-2.0, 1.5, 0.0),
+        DVec3::new(2.0, 1.5, 0.0),
+        DVec3::new(2.0, 1.5, 3.0),
+        DVec3::new(-2.0, 1.5, 3.0),
+    ];
+    // Facing the light, towards -y.
+    if penumbra_scenes::polygon::newell_normal(&wall).y > 0.0 {
+        wall.reverse();
+    }
+    let scene = scene_of(
+        "tilted light and a wall",
+        vec![
+            light(regular(4, 0.5, 0.3, -0.5, DVec3::new(0.0, 0.0, 2.0), true)),
+            Surface::new(
+                "blocker",
+                regular(3, 0.3, 0.2, 0.0, DVec3::new(0.1, 0.4, 1.2), true),
+                Rgb::splat(0.5),
+            ),
+            Surface::new("wall", wall, Rgb::splat(0.5)),
+            floor(2.5),
+        ],
+    );
+    let vis = Visibility::build(&scene);
+    let found = find_discontinuities(&scene, &vis, &DiscontinuityOptions::default());
+    let wall = scene.surface_id("wall").expect("wall");
+    let horizons: Vec<_> = found.segments[wall]
+        .iter()
+        .filter(|s| s.event == Event::Horizon)
+        .collect();
+    assert_eq!(horizons.len(), 1, "{:?}", found.stats);
+    assert_eq!(horizons[0].order, 1);
+    assert_complete(&scene, "wall", 40);
+}

@@ -11,6 +11,7 @@
 pub mod between;
 pub mod contact;
 pub mod eee;
+pub mod horizon;
 pub mod hull;
 pub mod merge;
 pub mod patches;
@@ -170,6 +171,9 @@ pub struct DiscontinuityStats {
     /// of an emitter such a patch could hide: the most any dropped event changes the light by.
     pub blockers_weak: usize,
     pub weak_share_max: f64,
+    /// Receivers cut by their emitter's plane within one element of their edge, which get no
+    /// line there ([`horizon`]).
+    pub horizons_within_an_element: usize,
     /// Shafts whose EEE search was skipped for their many blocker edges ([`EEE_MAX_EDGES`]).
     pub eee_shafts_skipped: usize,
     /// Feature pairs that could form a wedge (in front of both emitter and receiver), blocker
@@ -199,6 +203,8 @@ pub struct DiscontinuityStats {
     pub eee_segments: usize,
     /// Segments of events between two blockers (complete events only).
     pub blocker_ev_segments: usize,
+    /// Segments where an emitter's own plane cuts its receiver ([`horizon`]).
+    pub horizon_segments: usize,
     pub contact_lines: usize,
     /// Of those, by order: where the value (0), the slope (1) or the curvature (2) jumps.
     pub order_0_segments: usize,
@@ -217,6 +223,7 @@ impl DiscontinuityStats {
                 Event::Ve => self.ve_segments += 1,
                 Event::Eee => self.eee_segments += 1,
                 Event::BlockerEv => self.blocker_ev_segments += 1,
+                Event::Horizon => self.horizon_segments += 1,
                 Event::Contact => self.contact_lines += 1,
             }
             match g.order {
@@ -237,6 +244,7 @@ impl DiscontinuityStats {
         self.blockers_weak += other.blockers_weak;
         self.weak_share_max = self.weak_share_max.max(other.weak_share_max);
         self.eee_shafts_skipped += other.eee_shafts_skipped;
+        self.horizons_within_an_element += other.horizons_within_an_element;
         self.wedges_considered += other.wedges_considered;
         self.wedges_culled += other.wedges_culled;
         self.wedges_kept += other.wedges_kept;
@@ -503,7 +511,7 @@ impl EmitterProbe {
 }
 
 /// Points spread over a polygon: its vertices pulled slightly inward and a few interior points.
-fn emitter_samples(polygon: &[DVec3]) -> Vec<DVec3> {
+pub(crate) fn emitter_samples(polygon: &[DVec3]) -> Vec<DVec3> {
     let c = penumbra_scenes::polygon::centroid(polygon);
     let mut out = vec![c];
     for &p in polygon {

@@ -13,7 +13,8 @@ use super::topology::Topology;
 use super::wedge::{Event, Wedge};
 use super::{
     Boundary, DiscontinuityOptions, DiscontinuitySegment, DiscontinuityStats, EEE_MAX_EDGES,
-    EventSet, MIN_RECEIVER_ELEMENTS, between, clip_by_height, clip_to_polygon, eee, hull, trim,
+    EventSet, MIN_RECEIVER_ELEMENTS, between, clip_by_height, clip_to_polygon, eee, horizon, hull,
+    trim,
 };
 
 /// What the whole search shares: the scene, its welded topology and every surface's frame.
@@ -132,6 +133,8 @@ impl<'a> SearchContext<'a> {
             out.stats.receivers_too_small = 1;
             return out;
         }
+        out.segments
+            .extend(self.horizon_segments(e, r, &mut out.stats));
         let Some(shaft) = self.shaft(e, r, &mut out.stats) else {
             out.stats.pairs_without_blockers = 1;
             return out;
@@ -157,6 +160,61 @@ impl<'a> SearchContext<'a> {
             shaft.wedge_segments(&candidate, &mut out);
         }
         out
+    }
+
+    /// Where the emitter's plane cuts the receiver ([`horizon`]), of order 1; none where the
+    /// part of the receiver behind that plane is narrower than an element of the mesh to come
+    /// (the walls of a box whose light hangs just under the ceiling): the line would cut a strip
+    /// of slivers off the receiver's edge.
+    fn horizon_segments(
+        &self,
+        e: SurfaceId,
+        r: SurfaceId,
+        stats: &mut DiscontinuityStats,
+    ) -> Vec<DiscontinuitySegment> {
+        let (Some(ef), Some(rf)) = (self.frames[e], self.frames[r]) else {
+            return Vec::new();
+        };
+        let receiver_polygon = &self.scene.surfaces[r].polygon;
+        if let Some(area) = self.options.element_area {
+            // How far the receiver reaches behind the plane, measured in the receiver's plane.
+            let sine = ef.normal.cross(rf.normal).length();
+            let behind = receiver_polygon
+                .iter()
+                .map(|&p| -ef.height(p))
+                .fold(0.0, f64::max);
+            if sine > 0.0 && behind > self.tol && behind / sine < area.sqrt() {
+                stats.horizons_within_an_element += 1;
+                return Vec::new();
+            }
+        }
+        let horizon = horizon::Horizon {
+            visibility: self.visibility,
+            emitter: e,
+            emitter_polygon: &self.scene.surfaces[e].polygon,
+            emitter_frame: ef,
+            receiver: r,
+            receiver_polygon,
+            receiver_frame: rf,
+            tol: self.tol,
+            reach: self.reach,
+            trim_samples: self.options.trim_samples,
+            trim_tolerance: self.options.trim_tolerance
+                * penumbra_scenes::polygon::diameter(receiver_polygon),
+        };
+        horizon
+            .segments()
+            .into_iter()
+            .map(|[from, to]| DiscontinuitySegment {
+                surface: r,
+                emitter: e,
+                from,
+                to,
+                event: Event::Horizon,
+                boundary: Boundary::Umbra,
+                order: 1,
+            })
+            .collect()
     }
 
     /// The pair's shaft (the convex hull of emitter and receiver) with the blockers in it strong

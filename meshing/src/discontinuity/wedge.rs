@@ -20,6 +20,8 @@ pub enum Event {
     Contact,
     /// A blocker vertex and an edge of another blocker, in a plane that cuts the emitter.
     BlockerEv,
+    /// The emitter's own plane, cutting the receiver.
+    Horizon,
 }
 
 impl Event {
@@ -30,6 +32,7 @@ impl Event {
             Event::Eee => "EEE",
             Event::Contact => "contact",
             Event::BlockerEv => "blocker-EV",
+            Event::Horizon => "horizon",
         }
     }
 }
