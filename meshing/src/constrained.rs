@@ -31,6 +31,30 @@ const FRAME_MARGIN: f64 = 0.05;
 /// angle, and 20 degrees keeps Ruppert's refinement from cascading around them.
 pub const CONSTRAINED_MIN_ANGLE_DEG: f64 = 20.0;
 
+thread_local! {
+    /// Set while a panic would be caught and turned into an error ([`quietly`]).
+    static CATCHING: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// Runs `f`, turning a panic into `Err` without the panic message the process would print
+/// otherwise: the caller reports the failure as an error (or tries again another way). Other
+/// panics print as before.
+fn quietly<T>(f: impl FnOnce() -> T) -> std::thread::Result<T> {
+    static HOOK: std::sync::Once = std::sync::Once::new();
+    HOOK.call_once(|| {
+        let previous = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| {
+            if !CATCHING.with(std::cell::Cell::get) {
+                previous(info);
+            }
+        }));
+    });
+    CATCHING.with(|c| c.set(true));
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(f));
+    CATCHING.with(|c| c.set(false));
+    result
+}
+
 /// A segment to be a chain of mesh edges, in the surface's plane-frame coordinates.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Constraint {
@@ -121,9 +145,9 @@ impl ConstrainedSurface {
         let (segments, boundary_splits) = snap_t_junctions(&coords.boundary, segments, merge);
 
         let mut cdt = Cdt::new();
-        // spade panicked on some near-collinear input in the past; a panic here must become an
-        // error, not a crash.
-        let inserted = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        // spade panics on some near-collinear input (two constraints from one point in nearly
+        // one direction); a panic here must become an error, not a crash.
+        let inserted = quietly(|| {
             let n = coords.boundary.len();
             for k in 0..n {
                 let mut chain = vec![coords.boundary[k]];
@@ -161,7 +185,7 @@ impl ConstrainedSurface {
                 }
             }
             Ok(())
-        }));
+        });
         match inserted {
             Ok(result) => result?,
             Err(_) => {

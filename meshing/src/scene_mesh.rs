@@ -220,7 +220,11 @@ pub fn mesh_scene_discontinuity_on(
                     .collect(),
                 None => Vec::new(),
             };
-            ConstrainedSurface::joining(id, s, &constraints, join).map(Some)
+            // Joined ends can leave two lines of nearly one direction from one point, which
+            // spade's constraint insertion does not survive; those surfaces keep the ends apart.
+            ConstrainedSurface::joining(id, s, &constraints, join)
+                .or_else(|_| ConstrainedSurface::new(id, s, &constraints))
+                .map(Some)
         })
         .collect::<Result<Vec<_>, _>>()?;
     let areas: Vec<f64> = scene

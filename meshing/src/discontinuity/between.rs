@@ -74,9 +74,19 @@ impl BetweenSearch<'_> {
         blockers: &[SurfaceId],
     ) -> (Vec<BetweenWedge>, BetweenCount) {
         let emitter = self.emitter_front();
+        let edges: BTreeSet<(usize, usize)> = edges
+            .iter()
+            .copied()
+            .filter(|&e| self.may_be_on_outline(e, &emitter))
+            .collect();
+        let vertices: BTreeSet<usize> = vertices
+            .iter()
+            .copied()
+            .filter(|&v| self.vertex_may_be_on_outline(v, &emitter))
+            .collect();
         let mut count = BetweenCount::default();
         let mut out = Vec::new();
-        for (v, edge) in self.nearby_pairs(&emitter, vertices, edges, blockers) {
+        for (v, edge) in self.nearby_pairs(&emitter, &vertices, &edges, blockers) {
             if self.share_a_face(v, edge) {
                 continue;
             }
@@ -135,6 +145,57 @@ impl BetweenSearch<'_> {
             }
         }
         pairs
+    }
+
+    /// Whether edge `(u, w)` is on its faces' outline as seen from some point of the polygon
+    /// `emitter`: its faces on one side of the plane through that point and the edge. For two
+    /// faces, the side of each is linear in the point, so it is not only when at every corner of
+    /// the emitter the two sides differ the same way.
+    fn may_be_on_outline(&self, (u, w): (usize, usize), emitter: &[DVec3]) -> bool {
+        let t = self.topology;
+        let faces = t.edge_faces(u, w, self.not_pair());
+        let [f1, f2] = faces.as_slice() else {
+            return true;
+        };
+        let (a, d) = (t.points[u], t.points[w] - t.points[u]);
+        let (n1, n2) = (f1.cross(d), f2.cross(d));
+        let sides = |p: DVec3| ((p - a).dot(n1), (p - a).dot(n2));
+        let splits = |first: bool| {
+            emitter.iter().all(|&p| {
+                let (g1, g2) = sides(p);
+                if first {
+                    g1 > 0.0 && g2 < 0.0
+                } else {
+                    g1 < 0.0 && g2 > 0.0
+                }
+            })
+        };
+        !splits(true) && !splits(false)
+    }
+
+    /// Whether vertex `v` is on its faces' outline as seen from some point of the polygon
+    /// `emitter`. The points from which all its faces turn towards them, and those from which all
+    /// turn away, are two convex cones; a polygon avoids the outline only inside one of them.
+    fn vertex_may_be_on_outline(&self, v: usize, emitter: &[DVec3]) -> bool {
+        let runs = |p: DVec3| {
+            !self
+                .topology
+                .outline_runs(v, [p, p], self.not_pair())
+                .is_empty()
+        };
+        if emitter.iter().any(|&p| runs(p)) {
+            return true;
+        }
+        let t = self.topology;
+        let origin = t.points[v];
+        let all_facing = |p: DVec3, sign: f64| {
+            t.corners[v]
+                .iter()
+                .filter(|c| (self.not_pair())(c.surface))
+                .all(|c| sign * t.normals[c.surface].dot(p - origin) > 0.0)
+        };
+        !(emitter.iter().all(|&p| all_facing(p, 1.0))
+            || emitter.iter().all(|&p| all_facing(p, -1.0)))
     }
 
     /// The emitter's polygon, cut to the part in front of the receiver.

@@ -135,6 +135,9 @@ pub const MIN_RECEIVER_ELEMENTS: f64 = 2.0;
 /// Shafts with more blocker edges than this skip the EEE search (tessellated blockers, whose
 /// EEE events are many and weak); they are counted.
 pub const EEE_MAX_EDGES: usize = 2048;
+/// Shafts with more blocker edges than this skip the events between two blockers, for the same
+/// reason (a cathedral's shafts paired 200 million vertices and edges); they are counted.
+pub const BETWEEN_MAX_EDGES: usize = 512;
 
 impl Default for DiscontinuityOptions {
     fn default() -> Self {
@@ -176,6 +179,8 @@ pub struct DiscontinuityStats {
     pub horizons_within_an_element: usize,
     /// Shafts whose EEE search was skipped for their many blocker edges ([`EEE_MAX_EDGES`]).
     pub eee_shafts_skipped: usize,
+    /// Shafts whose events between blockers were skipped for the same ([`BETWEEN_MAX_EDGES`]).
+    pub between_shafts_skipped: usize,
     /// Feature pairs that could form a wedge (in front of both emitter and receiver), blocker
     /// vertex–blocker edge pairs included.
     pub wedges_considered: usize,
@@ -244,6 +249,7 @@ impl DiscontinuityStats {
         self.blockers_weak += other.blockers_weak;
         self.weak_share_max = self.weak_share_max.max(other.weak_share_max);
         self.eee_shafts_skipped += other.eee_shafts_skipped;
+        self.between_shafts_skipped += other.between_shafts_skipped;
         self.horizons_within_an_element += other.horizons_within_an_element;
         self.wedges_considered += other.wedges_considered;
         self.wedges_culled += other.wedges_culled;

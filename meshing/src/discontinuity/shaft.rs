@@ -12,9 +12,9 @@ use super::strength::Pair;
 use super::topology::Topology;
 use super::wedge::{Event, Wedge};
 use super::{
-    Boundary, DiscontinuityOptions, DiscontinuitySegment, DiscontinuityStats, EEE_MAX_EDGES,
-    EventSet, MIN_RECEIVER_ELEMENTS, between, clip_by_height, clip_to_polygon, eee, horizon, hull,
-    trim,
+    BETWEEN_MAX_EDGES, Boundary, DiscontinuityOptions, DiscontinuitySegment, DiscontinuityStats,
+    EEE_MAX_EDGES, EventSet, MIN_RECEIVER_ELEMENTS, between, clip_by_height, clip_to_polygon, eee,
+    horizon, hull, trim,
 };
 
 /// What the whole search shares: the scene, its welded topology and every surface's frame.
@@ -147,7 +147,11 @@ impl<'a> SearchContext<'a> {
                 .map(Candidate::plain),
         );
         if self.options.events == EventSet::Complete {
-            wedges.extend(shaft.between_wedges(&mut out.stats));
+            if shaft.edges.len() > BETWEEN_MAX_EDGES {
+                out.stats.between_shafts_skipped += 1;
+            } else {
+                wedges.extend(shaft.between_wedges(&mut out.stats));
+            }
         }
         if self.options.eee {
             if shaft.edges.len() > EEE_MAX_EDGES {
