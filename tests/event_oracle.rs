@@ -308,7 +308,7 @@ fn across_segments(
                     .any(|(o, &s)| o != k && touches(p, s) && carries_on(s))
             })
             .collect();
-        let spot = [0.5, 0.3, 0.7, 0.15, 0.85]
+        let spot = [0.5, 0.3, 0.7, 0.15, 0.85, 0.4, 0.6, 0.2, 0.8, 0.1, 0.9]
             .into_iter()
             .map(|u| a.lerp(b, u))
             .find(|&m| {
@@ -357,7 +357,7 @@ fn regular(n: usize, radius: f64, turn: f64, tilt: f64, centre: DVec3, down: boo
 }
 
 fn floor(half: f64) -> Surface {
-    Surface::new(
+    grey(
         "floor",
         vec![
             DVec3::new(-half, -half, 0.0),
@@ -365,8 +365,12 @@ fn floor(half: f64) -> Surface {
             DVec3::new(half, half, 0.0),
             DVec3::new(-half, half, 0.0),
         ],
-        Rgb::splat(0.5),
     )
+}
+
+/// A surface of reflectance 0.5 that does not emit.
+fn grey(name: impl Into<String>, polygon: Vec<DVec3>) -> Surface {
+    Surface::new(name, polygon, Rgb::splat(0.5))
 }
 
 fn light(polygon: Vec<DVec3>) -> Surface {
@@ -400,7 +404,7 @@ fn solid(name: &str, corners: &[DVec3], faces: &[&[usize]]) -> Vec<Surface> {
             if n.dot(p[0] - centre) < 0.0 {
                 p.reverse();
             }
-            Surface::new(format!("{name}{i}"), p, Rgb::splat(0.5))
+            grey(format!("{name}{i}"), p)
         })
         .collect()
 }
@@ -526,15 +530,13 @@ fn boxes_tetrahedra_and_overlapping_blockers() {
             true,
         ))],
         vec![
-            Surface::new(
+            grey(
                 "low",
                 regular(4, 0.45, 0.3, 0.15, DVec3::new(-0.15, 0.0, 1.0), true),
-                Rgb::splat(0.5),
             ),
-            Surface::new(
+            grey(
                 "high",
                 regular(5, 0.4, 1.1, -0.2, DVec3::new(0.2, 0.1, 1.6), true),
-                Rgb::splat(0.5),
             ),
         ],
         vec![floor(2.5)],
@@ -618,10 +620,9 @@ fn single_faces_parallel_and_tilted() {
                     DVec3::new(0.0, 0.0, 3.0),
                     true,
                 )),
-                Surface::new(
+                grey(
                     "blocker",
                     regular(k, 0.45, 3.0 * rng.next_f64(), bt, centre, true),
-                    Rgb::splat(0.5),
                 ),
                 floor(2.5),
             ],
@@ -662,12 +663,11 @@ fn a_wall_cut_by_the_lights_own_plane() {
         "tilted light and a wall",
         vec![
             light(regular(4, 0.5, 0.3, -0.5, DVec3::new(0.0, 0.0, 2.0), true)),
-            Surface::new(
+            grey(
                 "blocker",
                 regular(3, 0.3, 0.2, 0.0, DVec3::new(0.1, 0.4, 1.2), true),
-                Rgb::splat(0.5),
             ),
-            Surface::new("wall", wall, Rgb::splat(0.5)),
+            grey("wall", wall),
             floor(2.5),
         ],
     );

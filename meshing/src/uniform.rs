@@ -303,8 +303,10 @@ impl SurfaceTriangulation {
                 if points.is_empty() || cdt.num_vertices() > 2 * target + 64 {
                     break;
                 }
-                // Only positions spade cannot represent fail; skipping one costs a split.
-                insert_in_order(&mut cdt, points);
+                for p in points {
+                    // Only positions spade cannot represent fail; skipping one costs a split.
+                    let _ = cdt.insert(Point2::new(p.x, p.y));
+                }
                 self.refine_cdt(&mut cdt, min_angle_deg, None, smallest, allowed);
             }
             cdt
@@ -317,7 +319,7 @@ impl SurfaceTriangulation {
     pub fn split_triangles_at(&mut self, points: &[DVec2], min_angle_deg: f64) -> usize {
         let before = self.cdt.num_vertices();
         let mut faces = std::collections::HashSet::new();
-        for p in in_walking_order(points.to_vec()) {
+        for p in points {
             if let spade::PositionInTriangulation::OnFace(f) =
                 self.cdt.locate(Point2::new(p.x, p.y))
             {
@@ -332,8 +334,10 @@ impl SurfaceTriangulation {
             .map(|&f| self.cdt.face(f).area())
             .fold(f64::INFINITY, f64::min);
         let splits = split_points(&self.cdt, |face| faces.contains(&face.fix()));
-        // Only positions spade cannot represent fail; skipping one costs a split.
-        insert_in_order(&mut self.cdt, splits);
+        for p in splits {
+            // Only positions spade cannot represent fail; skipping one costs a split.
+            let _ = self.cdt.insert(Point2::new(p.x, p.y));
+        }
         let mut cdt = std::mem::take(&mut self.cdt);
         // Quality is restored around the splits only: a triangulation whose first refinement was
         // stopped at its target (see `refined_capped`) would otherwise be refined all over.
@@ -418,8 +422,10 @@ impl SurfaceTriangulation {
             if skipped.is_empty() {
                 break;
             }
-            // Only positions spade cannot represent fail; the next round tries again.
-            insert_in_order(cdt, skipped);
+            for p in skipped {
+                // Only positions spade cannot represent fail; the next round tries again.
+                let _ = cdt.insert(Point2::new(p.x, p.y));
+            }
             complete = cdt.refine(parameters(cdt)).refinement_complete;
         }
     }
@@ -558,47 +564,6 @@ type Face<'a> = spade::handles::FaceHandle<'a, InnerTag, Point2<f64>, (), spade:
 fn face_centroid(face: Face<'_>) -> DVec2 {
     let [a, b, c] = face.positions().map(|p| DVec2::new(p.x, p.y));
     (a + b + c) / 3.0
-}
-
-/// `points` sorted along a Z-order curve over their box, so that each is found by a short walk
-/// from the one before: spade locates a point by walking from the last vertex it touched, and
-/// points in the order of the faces they come from are scattered over the whole polygon (on a
-/// floor of 600,000 triangles, the walks took most of the meshing time).
-fn in_walking_order(mut points: Vec<DVec2>) -> Vec<DVec2> {
-    let (lo, hi) = points
-        .iter()
-        .fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), &p| {
-            (lo.min(p), hi.max(p))
-        });
-    let scale = (hi - lo).max_element();
-    if !(scale > 0.0) {
-        return points;
-    }
-    let cell = |x: f64| (((x / scale) * 65535.0) as u32).min(65535);
-    let spread = |mut v: u32| {
-        v = (v | (v << 8)) & 0x00FF_00FF;
-        v = (v | (v << 4)) & 0x0F0F_0F0F;
-        v = (v | (v << 2)) & 0x3333_3333;
-        (v | (v << 1)) & 0x5555_5555
-    };
-    let key = |p: &DVec2| {
-        let q = *p - lo;
-        (
-            spread(cell(q.x)) | (spread(cell(q.y)) << 1),
-            p.x.to_bits(),
-            p.y.to_bits(),
-        )
-    };
-    points.sort_by_cached_key(key);
-    points
-}
-
-/// Inserts `points` in walking order ([`in_walking_order`]); a point spade cannot represent is
-/// skipped.
-fn insert_in_order(cdt: &mut Cdt, points: Vec<DVec2>) {
-    for p in in_walking_order(points) {
-        let _ = cdt.insert(Point2::new(p.x, p.y));
-    }
 }
 
 /// Where to split each face for which `wants` holds: the midpoint of its longest edge (shared

@@ -14,29 +14,20 @@
 use std::collections::BTreeSet;
 
 use glam::DVec3;
-use penumbra_scenes::{Bounds, PlaneFrame, SurfaceId, Visibility};
+use penumbra_scenes::{Bounds, SurfaceId};
 
 use super::eee::{NearBlockers, shadow_region};
-use super::topology::Topology;
+use super::pair::PairGeometry;
 use super::wedge::{Event, Wedge};
 use super::{clip_by_height, clip_to_polygon};
 
 /// One emitter–receiver pair: the geometry every vertex–edge pair of it shares.
 pub(crate) struct BetweenSearch<'a> {
-    pub topology: &'a Topology,
-    pub visibility: &'a Visibility,
-    pub emitter: SurfaceId,
-    pub receiver: SurfaceId,
-    pub emitter_frame: PlaneFrame,
-    pub receiver_frame: PlaneFrame,
+    pub pair: PairGeometry<'a>,
     /// The emitter's polygon.
     pub emitter_polygon: &'a [DVec3],
     /// Vertices inside a straight stretch of edges: no corner, so no event.
     pub straight: &'a [bool],
-    /// Heights under this are on a plane.
-    pub tol: f64,
-    /// How far a line may run (a few scene diagonals).
-    pub reach: f64,
 }
 
 /// A wedge through a blocker vertex whose lines also pass through blocker edge `edge`.
@@ -56,15 +47,6 @@ pub(crate) struct BetweenCount {
 }
 
 impl BetweenSearch<'_> {
-    fn in_front(&self, p: DVec3) -> bool {
-        self.emitter_frame.height(p) > self.tol && self.receiver_frame.height(p) > self.tol
-    }
-
-    fn not_pair(&self) -> impl Fn(SurfaceId) -> bool + use<> {
-        let (e, r) = (self.emitter, self.receiver);
-        move |s| s != e && s != r
-    }
-
     /// The wedges of the blocker vertices `vertices` with the blocker edges `edges` of the
     /// surfaces `blockers`.
     pub fn wedges(
@@ -108,25 +90,31 @@ impl BetweenSearch<'_> {
         edges: &BTreeSet<(usize, usize)>,
         blockers: &[SurfaceId],
     ) -> BTreeSet<(usize, (usize, usize))> {
-        let t = self.topology;
+        let t = self.pair.topology;
         let near = NearBlockers::indexed(t, blockers);
         // The blockers (by place in `blockers`) near the region below the points `through`.
         let below = |through: &[DVec3]| {
-            let region =
-                shadow_region(&self.receiver_frame, self.tol, self.reach, emitter, through);
+            let region = shadow_region(
+                &self.pair.receiver_frame,
+                self.pair.tol,
+                self.pair.reach,
+                emitter,
+                through,
+            );
             let mut found = Vec::new();
             near.find(
-                self.visibility,
+                self.pair.visibility,
                 Bounds::from_points(region.iter()),
-                self.tol,
+                self.pair.tol,
                 |b| found.push(b),
             );
             found.sort_unstable();
             found.dedup();
             found
         };
-        let usable_vertex =
-            |v: usize| !self.straight[v] && self.in_front(t.points[v]) && !t.corners[v].is_empty();
+        let usable_vertex = |v: usize| {
+            !self.straight[v] && self.pair.in_front(t.points[v]) && !t.corners[v].is_empty()
+        };
         let mut pairs = BTreeSet::new();
         for &v in vertices.iter().filter(|&&v| usable_vertex(v)) {
             for b in below(&[t.points[v]]) {
@@ -152,8 +140,8 @@ impl BetweenSearch<'_> {
     /// faces, the side of each is linear in the point, so it is not only when at every corner of
     /// the emitter the two sides differ the same way.
     fn may_be_on_outline(&self, (u, w): (usize, usize), emitter: &[DVec3]) -> bool {
-        let t = self.topology;
-        let faces = t.edge_faces(u, w, self.not_pair());
+        let t = self.pair.topology;
+        let faces = t.edge_faces(u, w, self.pair.not_pair());
         let [f1, f2] = faces.as_slice() else {
             return true;
         };
@@ -177,21 +165,16 @@ impl BetweenSearch<'_> {
     /// `emitter`. The points from which all its faces turn towards them, and those from which all
     /// turn away, are two convex cones; a polygon avoids the outline only inside one of them.
     fn vertex_may_be_on_outline(&self, v: usize, emitter: &[DVec3]) -> bool {
-        let runs = |p: DVec3| {
-            !self
-                .topology
-                .outline_runs(v, [p, p], self.not_pair())
-                .is_empty()
-        };
-        if emitter.iter().any(|&p| runs(p)) {
+        let t = self.pair.topology;
+        let include = self.pair.not_pair();
+        if t.on_rim(v, &include) {
             return true;
         }
-        let t = self.topology;
         let origin = t.points[v];
         let all_facing = |p: DVec3, sign: f64| {
             t.corners[v]
                 .iter()
-                .filter(|c| (self.not_pair())(c.surface))
+                .filter(|c| include(c.surface))
                 .all(|c| sign * t.normals[c.surface].dot(p - origin) > 0.0)
         };
         !(emitter.iter().all(|&p| all_facing(p, 1.0))
@@ -200,12 +183,12 @@ impl BetweenSearch<'_> {
 
     /// The emitter's polygon, cut to the part in front of the receiver.
     fn emitter_front(&self) -> Vec<DVec3> {
-        let rf = &self.receiver_frame;
+        let rf = &self.pair.receiver_frame;
         let p = self.emitter_polygon;
         let mut out = Vec::with_capacity(p.len() + 1);
         for i in 0..p.len() {
             let (a, b) = (p[i], p[(i + 1) % p.len()]);
-            let (ha, hb) = (rf.height(a) - self.tol, rf.height(b) - self.tol);
+            let (ha, hb) = (rf.height(a) - self.pair.tol, rf.height(b) - self.pair.tol);
             if ha >= 0.0 {
                 out.push(a);
             }
@@ -218,7 +201,7 @@ impl BetweenSearch<'_> {
 
     /// Whether some face holds both vertex `v` and the edge: their plane is the face's.
     fn share_a_face(&self, v: usize, (u, w): (usize, usize)) -> bool {
-        let t = self.topology;
+        let t = self.pair.topology;
         if v == u || v == w {
             return true;
         }
@@ -238,23 +221,27 @@ impl BetweenSearch<'_> {
         v: usize,
         (u, w): (usize, usize),
     ) -> Option<Vec<BetweenWedge>> {
-        let t = self.topology;
+        let t = self.pair.topology;
         let pv = t.points[v];
         let ends = clip_by_height(t.points[u], t.points[w], |p| {
-            (self.emitter_frame.height(p) - self.tol).min(self.receiver_frame.height(p) - self.tol)
+            (self.pair.emitter_frame.height(p) - self.pair.tol)
+                .min(self.pair.receiver_frame.height(p) - self.pair.tol)
         })?;
         let n = (ends[0] - pv).cross(ends[1] - pv).try_normalize()?;
-        if !t.edge_is_tangent(u, w, n, self.not_pair()) {
+        if !t.edge_is_tangent(u, w, n, self.pair.not_pair()) {
             return None;
         }
-        let ef = &self.emitter_frame;
+        let ef = &self.pair.emitter_frame;
         // The line where the plane meets the emitter's: its direction, and its point nearest
         // the vertex.
         let along = n.cross(ef.normal).try_normalize()?;
         let down = n.cross(along);
         let start = pv + down * (-ef.height(pv) / down.dot(ef.normal));
-        let chord = [start - along * self.reach, start + along * self.reach];
-        let order = if t.plane_holds_an_edge_at(v, n, self.not_pair()) {
+        let chord = [
+            start - along * self.pair.reach,
+            start + along * self.pair.reach,
+        ];
+        let order = if t.plane_holds_an_edge_at(v, n, self.pair.not_pair()) {
             1
         } else {
             2
@@ -276,14 +263,14 @@ impl BetweenSearch<'_> {
             ) {
                 let run = [c0.lerp(c1, s0), c0.lerp(c1, s1)];
                 // The parts of the run from which the vertex is on its blocker's outline.
-                for [a, b] in t.outline_runs(v, run, self.not_pair()) {
+                for [a, b] in t.outline_runs(v, run, self.pair.not_pair()) {
                     let source = [run[0].lerp(run[1], a), run[0].lerp(run[1], b)];
-                    if source[0].distance(source[1]) <= self.tol {
+                    if source[0].distance(source[1]) <= self.pair.tol {
                         continue;
                     }
                     out.push(BetweenWedge {
                         wedge: Wedge {
-                            emitter: self.emitter,
+                            emitter: self.pair.emitter,
                             event: Event::BlockerEv,
                             source,
                             through: [pv, pv],

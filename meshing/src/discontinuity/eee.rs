@@ -19,6 +19,7 @@ use std::collections::{BTreeSet, HashMap};
 use glam::DVec3;
 use penumbra_scenes::{Bounds, IndexBox, PlaneFrame, SurfaceId, Visibility};
 
+use super::pair::PairGeometry;
 use super::topology::Topology;
 
 /// Samples along the first blocker edge.
@@ -49,16 +50,7 @@ pub struct EeeCount {
 
 /// One emitter–receiver pair: the geometry every triple of it shares.
 pub(crate) struct EeeSearch<'a> {
-    pub topology: &'a Topology,
-    pub visibility: &'a Visibility,
-    pub emitter: SurfaceId,
-    pub receiver: SurfaceId,
-    pub emitter_frame: PlaneFrame,
-    pub receiver_frame: PlaneFrame,
-    /// Heights under this are on a plane.
-    pub tol: f64,
-    /// How far a line may run (a few scene diagonals).
-    pub reach: f64,
+    pub pair: PairGeometry<'a>,
     /// Greatest distance of a chord from its arc.
     pub chord_tolerance: f64,
     pub receiver_polygon: &'a [DVec3],
@@ -221,7 +213,7 @@ impl EeeSearch<'_> {
     ) -> (Vec<EeeCurve>, EeeCount) {
         let mut count = EeeCount::default();
         let mut curves = Vec::new();
-        let t = self.topology;
+        let t = self.pair.topology;
         // Blocker edges by index, at each vertex (for the pairs that share one) and along each
         // surface (for the pairs found by region).
         let list: Vec<(usize, usize)> = edges.iter().copied().collect();
@@ -249,10 +241,10 @@ impl EeeSearch<'_> {
             .iter()
             .map(|&s| t.loops[s].iter().map(|&v| t.points[v]).collect())
             .collect();
-        let not_pair = |s: SurfaceId| s != self.emitter && s != self.receiver;
+        let not_pair = self.pair.not_pair();
         let faces: Vec<Vec<DVec3>> = list
             .iter()
-            .map(|&(u, w)| t.edge_faces(u, w, not_pair))
+            .map(|&(u, w)| t.edge_faces(u, w, &not_pair))
             .collect();
         let near_finder = NearBlockers::new(t, blockers, self.surface_leaves);
         let mut near: Vec<usize> = Vec::new();
@@ -270,7 +262,9 @@ impl EeeSearch<'_> {
                 .iter()
                 .map(|&(u, w)| {
                     let b = [t.points[u], t.points[w]];
-                    if !(b.iter().any(|&p| self.receiver_frame.height(p) > self.tol)
+                    if !(b
+                        .iter()
+                        .any(|&p| self.pair.receiver_frame.height(p) > self.pair.tol)
                         && self.can_be_silhouette(u, w, source))
                     {
                         return None;
@@ -285,9 +279,9 @@ impl EeeSearch<'_> {
                 };
                 round += 1;
                 let b1 = [t.points[first.0], t.points[first.1]];
-                let hull = super::hull::hull_planes(&corners, self.tol);
+                let hull = super::hull::hull_planes(&corners, self.pair.tol);
                 let outside =
-                    |points: &[DVec3]| super::hull::beyond_a_face(&hull, points, self.tol);
+                    |points: &[DVec3]| super::hull::beyond_a_face(&hull, points, self.pair.tol);
                 partners.clear();
                 let mut take = |i: usize, partners: &mut Vec<usize>| {
                     if edge_stamp[i] != round && i != i1 && regions[i].is_some() {
@@ -302,9 +296,9 @@ impl EeeSearch<'_> {
                 }
                 near.clear();
                 near_finder.find(
-                    self.visibility,
+                    self.pair.visibility,
                     Bounds::from_points(corners.iter()),
-                    self.tol,
+                    self.pair.tol,
                     |b| {
                         if blocker_stamp[b] != round {
                             blocker_stamp[b] = round;
@@ -348,14 +342,14 @@ impl EeeSearch<'_> {
     /// the emitter edge `source`: one face turned towards that point and another away, or a face
     /// seen edge-on (each face's side is linear along the edge, so the ends and the roots tell).
     fn can_be_silhouette(&self, u: usize, w: usize, source: [DVec3; 2]) -> bool {
-        let t = self.topology;
+        let t = self.pair.topology;
         let Some(faces) = t.edges.get(&(u, w)) else {
             return true;
         };
         let faces: Vec<SurfaceId> = faces
             .iter()
             .map(|&(s, _)| s)
-            .filter(|&s| s != self.emitter && s != self.receiver)
+            .filter(|&s| s != self.pair.emitter && s != self.pair.receiver)
             .collect();
         if faces.len() < 2 {
             return true;
@@ -381,7 +375,7 @@ impl EeeSearch<'_> {
     /// Whether the box, in the receiver's plane, of the shadow corners `shadow` overlaps the
     /// receiver polygon's.
     fn shadow_meets_receiver(&self, shadow: &[DVec3]) -> bool {
-        let rf = &self.receiver_frame;
+        let rf = &self.pair.receiver_frame;
         let box_of = |points: &mut dyn Iterator<Item = DVec3>| {
             points.fold(
                 (glam::DVec2::INFINITY, glam::DVec2::NEG_INFINITY),
@@ -393,7 +387,7 @@ impl EeeSearch<'_> {
         };
         let (slo, shi) = box_of(&mut shadow.iter().copied());
         let (rlo, rhi) = box_of(&mut self.receiver_polygon.iter().copied());
-        let tol = glam::DVec2::splat(self.tol);
+        let tol = glam::DVec2::splat(self.pair.tol);
         slo.cmple(rhi + tol).all() && rlo.cmple(shi + tol).all()
     }
 
@@ -401,7 +395,13 @@ impl EeeSearch<'_> {
     /// `source` towards the receiver's plane ([`shadow_region`]).
     fn beyond(&self, source: [DVec3; 2], first: [DVec3; 2]) -> [DVec3; 6] {
         let mut out = [first[0]; 6];
-        let region = shadow_region(&self.receiver_frame, self.tol, self.reach, &source, &first);
+        let region = shadow_region(
+            &self.pair.receiver_frame,
+            self.pair.tol,
+            self.pair.reach,
+            &source,
+            &first,
+        );
         out.copy_from_slice(&region);
         out
     }
@@ -416,7 +416,7 @@ impl EeeSearch<'_> {
         faces: [&[DVec3]; 2],
         planes: &OnceCell<SamplePlanes>,
     ) -> Vec<EeeCurve> {
-        let t = self.topology;
+        let t = self.pair.topology;
         let b1 = [t.points[first.0], t.points[first.1]];
         let b2 = [t.points[second.0], t.points[second.1]];
         let shares_vertex = first.0 == second.0
@@ -425,7 +425,7 @@ impl EeeSearch<'_> {
             || first.1 == second.1;
         let coplanar = shares_vertex
             || plane_normal(b1, b2)
-                .is_some_and(|n| b2.iter().all(|&p| n.dot(p - b1[0]).abs() <= self.tol));
+                .is_some_and(|n| b2.iter().all(|&p| n.dot(p - b1[0]).abs() <= self.pair.tol));
         if coplanar {
             return self.pencil(source, b1, b2, [first, second], faces);
         }
@@ -548,9 +548,9 @@ impl EeeSearch<'_> {
             return Vec::new();
         }
         let apex = source[0] + e * s;
-        let rf = &self.receiver_frame;
+        let rf = &self.pair.receiver_frame;
         let h_apex = rf.height(apex);
-        if h_apex <= self.tol || self.emitter_frame.height(apex).abs() > self.tol {
+        if h_apex <= self.pair.tol || self.pair.emitter_frame.height(apex).abs() > self.pair.tol {
             return Vec::new();
         }
         // The receiver's line: where the edges' plane meets the receiver's plane.
@@ -566,25 +566,25 @@ impl EeeSearch<'_> {
         let base = foot + across * (n.dot(b1[0] - foot) / den);
         let at = |c: f64| base + dir * c;
         // Cuts: the shadows of the four vertices from the apex, and the far ends.
-        let mut cuts = vec![-self.reach, self.reach];
+        let mut cuts = vec![-self.pair.reach, self.pair.reach];
         for v in [b1[0], b1[1], b2[0], b2[1]] {
             let hv = rf.height(v);
             if hv < h_apex {
                 let x = apex + (v - apex) * (h_apex / (h_apex - hv));
-                cuts.push(dir.dot(x - base).clamp(-self.reach, self.reach));
+                cuts.push(dir.dot(x - base).clamp(-self.pair.reach, self.pair.reach));
             }
         }
         cuts.sort_by(f64::total_cmp);
         cuts.dedup();
         let holds = |x: DVec3| {
-            self.emitter_frame.height(x) > self.tol
+            self.pair.emitter_frame.height(x) > self.pair.tol
                 && self
                     .pencil_line(apex, x, b1, b2)
                     .is_some_and(|l| self.grazes(&l, edges, faces))
         };
         let mut runs: Vec<(f64, f64)> = Vec::new();
         for w in cuts.windows(2) {
-            if w[1] - w[0] <= self.tol || !holds(at(0.5 * (w[0] + w[1]))) {
+            if w[1] - w[0] <= self.pair.tol || !holds(at(0.5 * (w[0] + w[1]))) {
                 continue;
             }
             match runs.last_mut() {
@@ -627,7 +627,7 @@ impl EeeSearch<'_> {
         }
         let second = b2[0].lerp(b2[1], m2);
         // The line must reach the receiver beyond the blocker, not touch it there.
-        (self.receiver_frame.height(second) > self.tol).then(|| Transversal {
+        (self.pair.receiver_frame.height(second) > self.pair.tol).then(|| Transversal {
             source: apex,
             first: b1[0].lerp(b1[1], m1),
             second,
@@ -701,7 +701,7 @@ impl EeeSearch<'_> {
         }
         let second = b2.start + d2 * s;
         let d = second - first;
-        if d.length() <= self.tol {
+        if d.length() <= self.pair.tol {
             return None;
         }
         // In that plane the line meets the emitter edge's line.
@@ -719,16 +719,16 @@ impl EeeSearch<'_> {
         if d.dot(first - from) <= 0.0 {
             return None;
         }
-        let rf = &self.receiver_frame;
+        let rf = &self.pair.receiver_frame;
         let (h, hd) = (rf.height(second), rf.normal.dot(d));
-        if !(h > self.tol && hd < 0.0) {
+        if !(h > self.pair.tol && hd < 0.0) {
             return None;
         }
         let receiver = second + d * (h / -hd);
-        let in_front = self.emitter_frame.height(receiver) > self.tol
-            && self.emitter_frame.height(first) > self.tol
-            && rf.height(from) > self.tol
-            && receiver.distance(from) <= self.reach;
+        let in_front = self.pair.emitter_frame.height(receiver) > self.pair.tol
+            && self.pair.emitter_frame.height(first) > self.pair.tol
+            && rf.height(from) > self.pair.tol
+            && receiver.distance(from) <= self.pair.reach;
         in_front.then_some(Transversal {
             source: from,
             first,
@@ -741,7 +741,7 @@ impl EeeSearch<'_> {
     /// through each edge and the line.
     /// `faces` are the edges' faces ([`Topology::edge_faces`], emitter and receiver excepted).
     fn grazes(&self, x: &Transversal, edges: [(usize, usize); 2], faces: [&[DVec3]; 2]) -> bool {
-        let t = self.topology;
+        let t = self.pair.topology;
         let d = x.receiver - x.source;
         edges.into_iter().zip(faces).all(|((a, b), faces)| {
             let along = t.points[b] - t.points[a];
@@ -754,8 +754,8 @@ impl EeeSearch<'_> {
 
     /// Whether nothing else crosses the line between the emitter and the receiver.
     fn unobstructed(&self, x: &Transversal) -> bool {
-        let v = self.visibility;
-        let (e, r) = (self.emitter, self.receiver);
+        let v = self.pair.visibility;
+        let (e, r) = (self.pair.emitter, self.pair.receiver);
         // The short piece between the blocker edges first: it is the cheapest to follow and
         // the most often blocked (on Sibenik, 64 % of the lines that graze both edges).
         !v.occluded(x.second, x.first, [r, e])
@@ -906,14 +906,16 @@ mod tests {
         let topology = Topology::new(&scene, tol);
         let frame = |s: usize| PlaneFrame::of_polygon(&scene.surfaces[s].polygon).expect("flat");
         let search = EeeSearch {
-            topology: &topology,
-            visibility: &vis,
-            emitter: 0,
-            receiver: 3,
-            emitter_frame: frame(0),
-            receiver_frame: frame(3),
-            tol,
-            reach: 4.0 * scene.diagonal(),
+            pair: PairGeometry {
+                topology: &topology,
+                visibility: &vis,
+                emitter: 0,
+                receiver: 3,
+                emitter_frame: frame(0),
+                receiver_frame: frame(3),
+                tol,
+                reach: 4.0 * scene.diagonal(),
+            },
             chord_tolerance: 1e-6 * scene.diagonal(),
             receiver_polygon: &scene.surfaces[3].polygon,
             trim_samples: 16,

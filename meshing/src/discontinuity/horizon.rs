@@ -5,32 +5,25 @@
 //! geometry.
 
 use glam::DVec3;
-use penumbra_scenes::{PlaneFrame, SurfaceId, Visibility};
 
+use super::pair::PairGeometry;
 use super::trim::runs_where;
 use super::{clip_to_polygon, emitter_samples};
 
 /// One emitter and one receiver, and how to trim what the emitter's plane leaves on it.
 pub(crate) struct Horizon<'a> {
-    pub visibility: &'a Visibility,
-    pub emitter: SurfaceId,
+    pub pair: PairGeometry<'a>,
     pub emitter_polygon: &'a [DVec3],
-    pub emitter_frame: PlaneFrame,
-    pub receiver: SurfaceId,
     pub receiver_polygon: &'a [DVec3],
-    pub receiver_frame: PlaneFrame,
-    /// Heights under this are on a plane.
-    pub tol: f64,
-    /// How far a line may run (a few scene diagonals).
-    pub reach: f64,
     pub trim_samples: usize,
-    pub trim_tolerance: f64,
+    /// Trim points are located to this fraction of the receiver's diameter.
+    pub trim_fraction: f64,
 }
 
 impl Horizon<'_> {
     /// The segments where the emitter's plane cuts the receiver and the emitter is seen.
     pub fn segments(&self) -> Vec<[DVec3; 2]> {
-        let ef = &self.emitter_frame;
+        let ef = &self.pair.emitter_frame;
         let p = self.receiver_polygon;
         let heights: Vec<f64> = p.iter().map(|&q| ef.height(q)).collect();
         let (lo, hi) = heights
@@ -38,10 +31,14 @@ impl Horizon<'_> {
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &h| {
                 (lo.min(h), hi.max(h))
             });
-        if !(lo < -self.tol && hi > self.tol) {
+        if !(lo < -self.pair.tol && hi > self.pair.tol) {
             return Vec::new();
         }
-        let Some(along) = ef.normal.cross(self.receiver_frame.normal).try_normalize() else {
+        let Some(along) = ef
+            .normal
+            .cross(self.pair.receiver_frame.normal)
+            .try_normalize()
+        else {
             return Vec::new();
         };
         // A point of both planes: where an edge of the receiver crosses the emitter's plane.
@@ -52,21 +49,24 @@ impl Horizon<'_> {
         }) else {
             return Vec::new();
         };
-        let (a, b) = (anchor - along * self.reach, anchor + along * self.reach);
+        let (a, b) = (
+            anchor - along * self.pair.reach,
+            anchor + along * self.pair.reach,
+        );
+        let trim_tolerance = self.trim_fraction * penumbra_scenes::polygon::diameter(p);
         // A point on the emitter's plane looks at the emitter edge-on.
         let samples = emitter_samples(self.emitter_polygon);
         let sees_emitter = |x: DVec3| {
             samples.iter().any(|&y| {
                 !self
+                    .pair
                     .visibility
-                    .occluded(x, y, [self.receiver, self.emitter])
+                    .occluded(x, y, [self.pair.receiver, self.pair.emitter])
             })
         };
-        clip_to_polygon(&self.receiver_frame, p, a, b)
+        clip_to_polygon(&self.pair.receiver_frame, p, a, b)
             .into_iter()
-            .flat_map(|[s, t]| {
-                runs_where(s, t, self.trim_samples, self.trim_tolerance, sees_emitter)
-            })
+            .flat_map(|[s, t]| runs_where(s, t, self.trim_samples, trim_tolerance, sees_emitter))
             .collect()
     }
 }

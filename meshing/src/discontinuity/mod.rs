@@ -14,6 +14,7 @@ pub mod eee;
 pub mod horizon;
 pub mod hull;
 pub mod merge;
+mod pair;
 pub mod patches;
 mod shaft;
 pub mod strength;

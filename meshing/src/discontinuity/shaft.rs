@@ -7,6 +7,7 @@ use std::collections::BTreeSet;
 use glam::DVec3;
 use penumbra_scenes::{Bounds, IndexBox, PlaneFrame, Scene, SurfaceId, Visibility};
 
+use super::pair::PairGeometry;
 use super::patches::Patches;
 use super::strength::Pair;
 use super::topology::Topology;
@@ -64,10 +65,7 @@ impl Candidate {
 /// One emitter–receiver pair with the blockers in the shaft between them.
 struct Shaft<'a> {
     context: &'a SearchContext<'a>,
-    emitter: SurfaceId,
-    receiver: SurfaceId,
-    emitter_frame: PlaneFrame,
-    receiver_frame: PlaneFrame,
+    pair: PairGeometry<'a>,
     blockers: Vec<SurfaceId>,
     /// The receiver polygon's diameter (quadratic in its vertex count: found once).
     receiver_diameter: f64,
@@ -133,9 +131,13 @@ impl<'a> SearchContext<'a> {
             out.stats.receivers_too_small = 1;
             return out;
         }
+        let Some(pair) = self.pair(e, r) else {
+            out.stats.pairs_without_blockers = 1;
+            return out;
+        };
         out.segments
-            .extend(self.horizon_segments(e, r, &mut out.stats));
-        let Some(shaft) = self.shaft(e, r, &mut out.stats) else {
+            .extend(self.horizon_segments(&pair, &mut out.stats));
+        let Some(shaft) = self.shaft(pair, &mut out.stats) else {
             out.stats.pairs_without_blockers = 1;
             return out;
         };
@@ -172,13 +174,11 @@ impl<'a> SearchContext<'a> {
     /// of slivers off the receiver's edge.
     fn horizon_segments(
         &self,
-        e: SurfaceId,
-        r: SurfaceId,
+        pair: &PairGeometry,
         stats: &mut DiscontinuityStats,
     ) -> Vec<DiscontinuitySegment> {
-        let (Some(ef), Some(rf)) = (self.frames[e], self.frames[r]) else {
-            return Vec::new();
-        };
+        let (e, r) = (pair.emitter, pair.receiver);
+        let (ef, rf) = (pair.emitter_frame, pair.receiver_frame);
         let receiver_polygon = &self.scene.surfaces[r].polygon;
         if let Some(area) = self.options.element_area {
             // How far the receiver reaches behind the plane, measured in the receiver's plane.
@@ -193,18 +193,11 @@ impl<'a> SearchContext<'a> {
             }
         }
         let horizon = horizon::Horizon {
-            visibility: self.visibility,
-            emitter: e,
+            pair: *pair,
             emitter_polygon: &self.scene.surfaces[e].polygon,
-            emitter_frame: ef,
-            receiver: r,
             receiver_polygon,
-            receiver_frame: rf,
-            tol: self.tol,
-            reach: self.reach,
             trim_samples: self.options.trim_samples,
-            trim_tolerance: self.options.trim_tolerance
-                * penumbra_scenes::polygon::diameter(receiver_polygon),
+            trim_fraction: self.options.trim_tolerance,
         };
         horizon
             .segments()
@@ -221,16 +214,30 @@ impl<'a> SearchContext<'a> {
             .collect()
     }
 
+    /// The pair `(e, r)` as its searches see it; `None` for a degenerate polygon.
+    fn pair(&'a self, e: SurfaceId, r: SurfaceId) -> Option<PairGeometry<'a>> {
+        Some(PairGeometry {
+            topology: &self.topology,
+            visibility: self.visibility,
+            emitter: e,
+            receiver: r,
+            emitter_frame: self.frames[e]?,
+            receiver_frame: self.frames[r]?,
+            tol: self.tol,
+            reach: self.reach,
+        })
+    }
+
     /// The pair's shaft (the convex hull of emitter and receiver) with the blockers in it strong
     /// enough for events, or `None` when nothing blocks.
     fn shaft(
         &'a self,
-        e: SurfaceId,
-        r: SurfaceId,
+        pair: PairGeometry<'a>,
         stats: &mut DiscontinuityStats,
     ) -> Option<Shaft<'a>> {
+        let (e, r) = (pair.emitter, pair.receiver);
         let (emitter, receiver) = (&self.scene.surfaces[e], &self.scene.surfaces[r]);
-        let (ef, rf) = (self.frames[e]?, self.frames[r]?);
+        let (ef, rf) = (pair.emitter_frame, pair.receiver_frame);
         let tol = self.tol;
         let mut ends = emitter.polygon.clone();
         ends.extend(&receiver.polygon);
@@ -269,10 +276,7 @@ impl<'a> SearchContext<'a> {
         }
         Some(Shaft {
             context: self,
-            emitter: e,
-            receiver: r,
-            emitter_frame: ef,
-            receiver_frame: rf,
+            pair,
             receiver_diameter: penumbra_scenes::polygon::diameter(&receiver.polygon),
             blockers,
             vertices,
@@ -327,17 +331,7 @@ impl Shaft<'_> {
     }
 
     fn emitter_loop(&self) -> &[usize] {
-        &self.context.topology.loops[self.emitter]
-    }
-
-    fn in_front(&self, p: DVec3) -> bool {
-        let tol = self.context.tol;
-        self.emitter_frame.height(p) > tol && self.receiver_frame.height(p) > tol
-    }
-
-    fn not_pair(&self) -> impl Fn(SurfaceId) -> bool + use<> {
-        let (e, r) = (self.emitter, self.receiver);
-        move |s| s != e && s != r
+        &self.context.topology.loops[self.pair.emitter]
     }
 
     /// EV: each emitter edge (the part in front of the receiver) with each blocker vertex on the
@@ -350,13 +344,13 @@ impl Shaft<'_> {
         for k in 0..e_loop.len() {
             let (ia, ib) = (e_loop[k], e_loop[(k + 1) % e_loop.len()]);
             let Some(source) = clip_by_height(self.point(ia), self.point(ib), |p| {
-                self.receiver_frame.height(p) - tol
+                self.pair.receiver_frame.height(p) - tol
             }) else {
                 continue;
             };
             for &v in &self.vertices {
                 let pv = self.point(v);
-                if !self.in_front(pv) || e_loop.contains(&v) || self.context.straight[v] {
+                if !self.pair.in_front(pv) || e_loop.contains(&v) || self.context.straight[v] {
                     continue;
                 }
                 let n = (self.point(ib) - self.point(ia)).cross(pv - self.point(ia));
@@ -366,12 +360,14 @@ impl Shaft<'_> {
                 // outline: beyond them, the ray enters the blocker at the vertex.
                 let sources: Vec<[DVec3; 2]> = match self.context.options.events {
                     EventSet::Complete => topology
-                        .outline_runs(v, source, self.not_pair())
+                        .outline_runs(v, source, self.pair.not_pair())
                         .into_iter()
                         .map(|[s, t]| [source[0].lerp(source[1], s), source[0].lerp(source[1], t)])
                         .filter(|[a, b]| a.distance(*b) > tol)
                         .collect(),
-                    EventSet::Extremal if topology.vertex_is_tangent(v, n, self.not_pair()) => {
+                    EventSet::Extremal
+                        if topology.vertex_is_tangent(v, n, self.pair.not_pair()) =>
+                    {
                         vec![source]
                     }
                     EventSet::Extremal => Vec::new(),
@@ -380,14 +376,14 @@ impl Shaft<'_> {
                     stats.wedges_culled += 1;
                     continue;
                 }
-                let order = if topology.plane_holds_an_edge_at(v, n, self.not_pair()) {
+                let order = if topology.plane_holds_an_edge_at(v, n, self.pair.not_pair()) {
                     1
                 } else {
                     2
                 };
                 wedges.extend(sources.into_iter().map(|source| {
                     Candidate::plain(Wedge {
-                        emitter: self.emitter,
+                        emitter: self.pair.emitter,
                         event: Event::Ev,
                         source,
                         through: [pv, pv],
@@ -404,16 +400,17 @@ impl Shaft<'_> {
     fn ve_wedges(&self, stats: &mut DiscontinuityStats) -> Vec<Wedge> {
         let topology = &self.context.topology;
         let tol = self.context.tol;
-        let e = self.emitter;
+        let e = self.pair.emitter;
         let mut wedges = Vec::new();
         for &ia in self.emitter_loop() {
             let pa = self.point(ia);
-            if self.receiver_frame.height(pa) <= tol {
+            if self.pair.receiver_frame.height(pa) <= tol {
                 continue;
             }
             for &(u, w) in &self.edges {
                 let Some(through) = clip_by_height(self.point(u), self.point(w), |p| {
-                    (self.emitter_frame.height(p) - tol).min(self.receiver_frame.height(p) - tol)
+                    (self.pair.emitter_frame.height(p) - tol)
+                        .min(self.pair.receiver_frame.height(p) - tol)
                 }) else {
                     continue;
                 };
@@ -426,7 +423,7 @@ impl Shaft<'_> {
                 stats.wedges_considered += 1;
                 let extremal = self.context.options.events == EventSet::Extremal;
                 if (extremal && !topology.vertex_is_tangent(ia, n, |s| s == e))
-                    || !topology.edge_is_tangent(u, w, n, self.not_pair())
+                    || !topology.edge_is_tangent(u, w, n, self.pair.not_pair())
                 {
                     stats.wedges_culled += 1;
                     continue;
@@ -453,16 +450,9 @@ impl Shaft<'_> {
     fn between_wedges(&self, stats: &mut DiscontinuityStats) -> Vec<Candidate> {
         let context = self.context;
         let search = between::BetweenSearch {
-            topology: &context.topology,
-            visibility: context.visibility,
-            emitter: self.emitter,
-            receiver: self.receiver,
-            emitter_frame: self.emitter_frame,
-            receiver_frame: self.receiver_frame,
-            emitter_polygon: &context.scene.surfaces[self.emitter].polygon,
+            pair: self.pair,
+            emitter_polygon: &context.scene.surfaces[self.pair.emitter].polygon,
             straight: &context.straight,
-            tol: context.tol,
-            reach: context.reach,
         };
         let (found, count) = search.wedges(&self.vertices, &self.edges, &self.blockers);
         stats.wedges_considered += count.considered;
@@ -484,16 +474,9 @@ impl Shaft<'_> {
     /// EEE: each emitter edge with two blocker edges, as polylines on the receiver.
     fn eee_segments(&self, out: &mut PairEvents) {
         let context = self.context;
-        let receiver_polygon = &context.scene.surfaces[self.receiver].polygon;
+        let receiver_polygon = &context.scene.surfaces[self.pair.receiver].polygon;
         let search = eee::EeeSearch {
-            topology: &context.topology,
-            visibility: context.visibility,
-            emitter: self.emitter,
-            receiver: self.receiver,
-            emitter_frame: self.emitter_frame,
-            receiver_frame: self.receiver_frame,
-            tol: context.tol,
-            reach: context.reach,
+            pair: self.pair,
             chord_tolerance: self.on_receiver(context.options.eee_tolerance),
             receiver_polygon,
             surface_leaves: context.surface_leaves.as_deref(),
@@ -510,7 +493,9 @@ impl Shaft<'_> {
         out.stats.eee_events += count.events;
         for curve in curves {
             for w in curve.points.windows(2) {
-                for [a, b] in clip_to_polygon(&self.receiver_frame, receiver_polygon, w[0], w[1]) {
+                for [a, b] in
+                    clip_to_polygon(&self.pair.receiver_frame, receiver_polygon, w[0], w[1])
+                {
                     out.segments
                         .push(self.segment(a, b, Event::Eee, curve.order));
                 }
@@ -523,17 +508,17 @@ impl Shaft<'_> {
     fn wedge_segments(&self, candidate: &Candidate, out: &mut PairEvents) {
         let context = self.context;
         let wedge = &candidate.wedge;
-        let rf = &self.receiver_frame;
+        let rf = &self.pair.receiver_frame;
         let Some([p, q]) = wedge.meet_plane(rf.origin, rf.normal, context.reach) else {
             return;
         };
-        let receiver_polygon = &context.scene.surfaces[self.receiver].polygon;
+        let receiver_polygon = &context.scene.surfaces[self.pair.receiver].polygon;
         let trim_tol = self.on_receiver(context.options.trim_tolerance);
         let generates = |x: DVec3| match candidate.grazed_edge {
-            None => trim::generator_visible(context.visibility, wedge, x, self.receiver),
+            None => trim::generator_visible(context.visibility, wedge, x, self.pair.receiver),
             Some((u, w)) => {
                 let edge = [context.topology.points[u], context.topology.points[w]];
-                trim::generator_visible_past(context.visibility, wedge, x, self.receiver, edge)
+                trim::generator_visible_past(context.visibility, wedge, x, self.pair.receiver, edge)
             }
         };
         let mut kept = false;
@@ -555,8 +540,8 @@ impl Shaft<'_> {
 
     fn segment(&self, from: DVec3, to: DVec3, event: Event, order: u8) -> DiscontinuitySegment {
         DiscontinuitySegment {
-            surface: self.receiver,
-            emitter: self.emitter,
+            surface: self.pair.receiver,
+            emitter: self.pair.emitter,
             from,
             to,
             event,

@@ -138,6 +138,21 @@ impl Topology {
         true
     }
 
+    /// Whether vertex `v` lies on the rim of an open sheet of the faces for which `include`
+    /// holds: an edge at `v` with one such face (every corner of a single polygon). Such a
+    /// vertex is on the outline from everywhere.
+    pub fn on_rim(&self, v: usize, include: impl Fn(SurfaceId) -> bool) -> bool {
+        let faces_on = |a: usize, b: usize| {
+            self.edges
+                .get(&(a.min(b), a.max(b)))
+                .map_or(0, |f| f.iter().filter(|&&(s, _)| include(s)).count())
+        };
+        self.corners[v]
+            .iter()
+            .filter(|c| include(c.surface))
+            .any(|c| faces_on(v, c.prev) == 1 || faces_on(v, c.next) == 1)
+    }
+
     /// Where along the segment `viewpoints` vertex `v` is on the outline of the faces around it
     /// (those for which `include` holds), as runs of parameters in `[0, 1]`: everywhere when it
     /// lies on the rim of an open sheet (an edge at `v` with one such face: every corner of a
@@ -150,15 +165,10 @@ impl Topology {
         viewpoints: [DVec3; 2],
         include: impl Fn(SurfaceId) -> bool,
     ) -> Vec<[f64; 2]> {
-        let faces = || self.corners[v].iter().filter(|c| include(c.surface));
-        let faces_on = |a: usize, b: usize| {
-            self.edges
-                .get(&(a.min(b), a.max(b)))
-                .map_or(0, |f| f.iter().filter(|&&(s, _)| include(s)).count())
-        };
-        if faces().any(|c| faces_on(v, c.prev) == 1 || faces_on(v, c.next) == 1) {
+        if self.on_rim(v, &include) {
             return vec![[0.0, 1.0]];
         }
+        let faces = || self.corners[v].iter().filter(|c| include(c.surface));
         let origin = self.points[v];
         let mut cuts = vec![0.0, 1.0];
         for c in faces() {
