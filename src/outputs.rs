@@ -224,6 +224,29 @@ pub fn estimated_direct_warning(stats: &SolveStats) -> Option<String> {
     })
 }
 
+/// A warning when triangles have angles under the aim of quality refinement that the input
+/// does not force: the budget could not hold some surface's least mesh at that angle, or
+/// adaptive splits (which restore smaller angles only) made them.
+pub fn mesh_quality_warning(quality: &MeshQuality, adaptive: bool) -> Option<String> {
+    let below = quality.triangles_below_min_angle;
+    (below > 0).then(|| {
+        let cause = if adaptive {
+            format!(
+                "adaptive splits restore angles of {} degrees only",
+                penumbra_meshing::constrained::SPLIT_MIN_ANGLE_DEG
+            )
+        } else {
+            "the element budget cannot hold the least mesh at that angle of every surface".into()
+        };
+        format!(
+            "{below} of {} triangles have an angle under {} degrees that the input does not \
+             force (mesh_quality.triangles_below_min_angle): {cause}",
+            quality.triangles,
+            penumbra_meshing::mesh::FORCING_WEDGE_DEG
+        )
+    })
+}
+
 /// `report.json`, for a run whose SVGs are chosen by `svgs`.
 pub fn report_json(result: &RunResult, svgs: &SvgSelection) -> String {
     let scene = &result.loaded.scene;
@@ -233,6 +256,11 @@ pub fn report_json(result: &RunResult, svgs: &SvgSelection) -> String {
     let mut warnings = result.loaded.warnings.clone();
     warnings.extend(energy.warning());
     warnings.extend(estimated_direct_warning(stats));
+    let mesh_quality = result.mesh.quality();
+    warnings.extend(mesh_quality_warning(
+        &mesh_quality,
+        result.refinement.is_some(),
+    ));
     let report = Report {
         format: REPORT_FORMAT,
         partial: matches!(stats.stop, StopReason::Interrupted | StopReason::TimeBudget)
@@ -286,7 +314,7 @@ pub fn report_json(result: &RunResult, svgs: &SvgSelection) -> String {
         memory: &result.memory,
         solver: stats,
         energy,
-        mesh_quality: result.mesh.quality(),
+        mesh_quality,
         render: RenderSummary {
             width: result.render.image.width(),
             height: result.render.image.height(),

@@ -39,7 +39,7 @@ thread_local! {
 /// Runs `f`, turning a panic into `Err` without the panic message the process would print
 /// otherwise: the caller reports the failure as an error (or tries again another way). Other
 /// panics print as before.
-fn quietly<T>(f: impl FnOnce() -> T) -> std::thread::Result<T> {
+pub(crate) fn quietly<T>(f: impl FnOnce() -> T) -> std::thread::Result<T> {
     static HOOK: std::sync::Once = std::sync::Once::new();
     HOOK.call_once(|| {
         let previous = std::panic::take_hook();
@@ -71,7 +71,14 @@ pub struct ConstrainedSurface {
     triangulation: SurfaceTriangulation,
     /// The constraints as inserted, in mesh coordinates.
     segments: Vec<([DVec2; 2], bool)>,
+    /// The least quality mesh, once looked for ([`Self::quality_triangles`]): `Some(None)` when
+    /// it takes more triangles than were allowed.
+    quality: Option<Option<SurfaceTriangulation>>,
 }
+
+/// Vertices beyond a target's triangle count that the search for a quality mesh may add: Ruppert's
+/// refinement also refines the frame around the polygon, and small targets need some room.
+const QUALITY_SPARE_VERTICES: usize = 64;
 
 impl std::fmt::Debug for ConstrainedSurface {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -200,12 +207,30 @@ impl ConstrainedSurface {
             id,
             triangulation: SurfaceTriangulation::new(coords, cdt, boundary_only),
             segments,
+            quality: None,
         })
     }
 
     /// Triangles before refinement: the least this surface can have.
     pub fn minimum_triangles(&self) -> usize {
         self.triangulation.count()
+    }
+
+    /// Triangles of the least mesh whose angles are all at least
+    /// [`CONSTRAINED_MIN_ANGLE_DEG`] where the input does not force them, if it can be had with
+    /// at most `target` triangles; meshes of this surface with at least as many then keep
+    /// those angles ([`Self::into_refinable`]).
+    pub fn quality_triangles(&mut self, target: usize) -> Option<usize> {
+        if self.quality.is_none() {
+            self.quality = Some(
+                self.triangulation
+                    .quality_least(CONSTRAINED_MIN_ANGLE_DEG, target + QUALITY_SPARE_VERTICES)
+                    .filter(|q| q.count() <= target),
+            );
+        }
+        self.quality
+            .as_ref()
+            .and_then(|q| q.as_ref().map(SurfaceTriangulation::count))
     }
 
     /// Refines to about `target` triangles and makes the mesh, with separate vertices on the two
@@ -229,19 +254,25 @@ impl ConstrainedSurface {
 
     /// The refined triangulation, graded as in [`Self::into_graded_mesh`], kept so that
     /// triangles can be split later.
+    /// Refinement starts from the least quality mesh when that fits `target`
+    /// ([`Self::quality_triangles`]), so that the angles the input does not force stay at
+    /// [`CONSTRAINED_MIN_ANGLE_DEG`] or more.
     pub fn into_refinable(
-        self,
+        mut self,
         target: usize,
         penumbra_density: f64,
         varies: &(dyn Fn(&[DVec3]) -> bool + Sync),
     ) -> RefinableSurface {
+        self.quality_triangles(target);
+        let base = match self.quality {
+            Some(Some(q)) if q.count() <= target => q,
+            _ => self.triangulation,
+        };
         let triangulation = if self.segments.is_empty() || penumbra_density <= 1.0 {
-            self.triangulation
-                .refined(target, CONSTRAINED_MIN_ANGLE_DEG)
+            base.refined(target, CONSTRAINED_MIN_ANGLE_DEG)
         } else {
-            let density = Density::probe(&self.triangulation, target, penumbra_density, varies);
-            self.triangulation
-                .refined_graded(target, CONSTRAINED_MIN_ANGLE_DEG, &density)
+            let density = Density::probe(&base, target, penumbra_density, varies);
+            base.refined_graded(target, CONSTRAINED_MIN_ANGLE_DEG, &density)
         };
         RefinableSurface {
             id: self.id,

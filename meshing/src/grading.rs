@@ -61,11 +61,13 @@ impl Density {
         let pilot_area = triangulation.area_for(pilot_target);
         // Refined once to its share's size: quality refinement around the constraints may take
         // it over that share, which is fine for a probe.
-        let pilot = triangulation.refined_to_area(
-            pilot_area,
-            crate::constrained::CONSTRAINED_MIN_ANGLE_DEG,
-            pilot_target,
-        );
+        let pilot = triangulation
+            .refined_to_area(
+                pilot_area,
+                crate::constrained::CONSTRAINED_MIN_ANGLE_DEG,
+                pilot_target,
+            )
+            .0;
         let coords = &triangulation.coords;
         let mut factors = vec![1.0; pilot.num_all_faces()];
         let factor = factor.max(1.0);

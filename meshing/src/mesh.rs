@@ -44,8 +44,12 @@ pub struct MeshQuality {
     pub min_angle_deg: f64,
     /// The smallest angle not forced by the input ([`crate::wedges`]): two input edges (polygon
     /// edges and constraints) meeting at less than [`FORCING_WEDGE_DEG`] force the corners
-    /// between them at their meeting point, and the triangles between them.
+    /// between them at their meeting point, and those meeting at less than
+    /// [`crate::wedges::SHELL_ANGLE_DEG`] the triangles between them.
     pub min_angle_unforced_deg: f64,
+    /// Triangles with an angle under [`FORCING_WEDGE_DEG`] that the input does not force: none
+    /// when the budget holds each surface's least mesh at that angle.
+    pub triangles_below_min_angle: usize,
     pub aspect_ratio_median: f64,
     pub aspect_ratio_p95: f64,
     pub aspect_ratio_max: f64,
@@ -228,10 +232,12 @@ pub const FORCING_WEDGE_DEG: f64 = crate::constrained::CONSTRAINED_MIN_ANGLE_DEG
 pub fn quality_of<'a>(meshes: impl IntoIterator<Item = &'a SurfaceMesh>) -> MeshQuality {
     let mut min_angle = f64::INFINITY;
     let mut min_unforced = f64::INFINITY;
+    let mut triangles_below = 0;
     let mut ratios = Vec::new();
     for m in meshes {
         let wedges = crate::wedges::InputWedges::of(m);
         for tri in &m.triangles {
+            let mut below = false;
             for k in 0..3 {
                 let v = m.local[tri[k] as usize];
                 let (a, b) = (
@@ -243,9 +249,12 @@ pub fn quality_of<'a>(meshes: impl IntoIterator<Item = &'a SurfaceMesh>) -> Mesh
                     .dot((b - v).normalize())
                     .clamp(-1.0, 1.0);
                 if !wedges.forces(&m.local, *tri, k, FORCING_WEDGE_DEG.to_radians()) {
-                    min_unforced = min_unforced.min(corner.acos().to_degrees());
+                    let angle = corner.acos().to_degrees();
+                    min_unforced = min_unforced.min(angle);
+                    below |= angle < FORCING_WEDGE_DEG;
                 }
             }
+            triangles_below += usize::from(below);
             let [a, b, c] = tri.map(|i| m.local[i as usize]);
             let (la, lb, lc) = ((b - c).length(), (c - a).length(), (a - b).length());
             let angle = |opp: f64, s1: f64, s2: f64| {
@@ -272,6 +281,7 @@ pub fn quality_of<'a>(meshes: impl IntoIterator<Item = &'a SurfaceMesh>) -> Mesh
         triangles: ratios.len(),
         min_angle_deg: min_angle,
         min_angle_unforced_deg: min_unforced,
+        triangles_below_min_angle: triangles_below,
         aspect_ratio_median: at(0.5),
         aspect_ratio_p95: at(0.95),
         aspect_ratio_max: at(1.0),

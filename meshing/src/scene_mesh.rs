@@ -200,7 +200,7 @@ pub fn mesh_scene_discontinuity_on(
     let meshed: Vec<bool> = (0..scene.surfaces.len())
         .map(|id| alone.is_none() || on.is_none_or(|on| on.get(id).copied().unwrap_or(false)))
         .collect();
-    let constrained = scene
+    let mut constrained = scene
         .surfaces
         .par_iter()
         .enumerate()
@@ -238,7 +238,17 @@ pub fn mesh_scene_discontinuity_on(
         .collect();
     let (budget, targets) = match alone {
         Some(extra) => share_alone(&areas, &minimum, &meshed, extra),
-        None => spread_by_area(&areas, &minimum, budget, true)?,
+        None => {
+            let (budget, shares) = spread_by_area(&areas, &minimum, budget, true)?;
+            let room = (QUALITY_EXTRA_SHARE * budget as f64) as usize;
+            let quality: Vec<Option<usize>> = constrained
+                .par_iter_mut()
+                .zip(&shares)
+                .map(|(c, &t)| c.as_mut().and_then(|c| c.quality_triangles(t + room)))
+                .collect();
+            let minima = quality_minima(&minimum, &shares, &quality, budget);
+            spread_by_area(&areas, &minima, budget, true)?
+        }
     };
     let minimum_triangles = minimum.iter().sum();
     let refinable: Vec<Option<RefinableSurface>> = constrained
@@ -307,6 +317,47 @@ pub fn mesh_scene_discontinuity_on(
     })
 }
 
+/// At most this share of a budget goes to surfaces beyond their share by area, so that their
+/// least meshes at the quality refinement's angle fit: a small face crossed by lines at a small
+/// angle (a block's side in the Cornell box) needs a few hundred triangles for that.
+pub const QUALITY_EXTRA_SHARE: f64 = 0.125;
+
+/// The least meshes to spread a budget over: each surface's least quality mesh (`quality[s]`)
+/// instead of its least mesh (`minimum[s]`) where that is within its share `targets[s]`, and
+/// for as many others as [`QUALITY_EXTRA_SHARE`] of `budget` holds (and the least meshes
+/// together fit it), those that need the fewest triangles beyond their share first.
+pub fn quality_minima(
+    minimum: &[usize],
+    targets: &[usize],
+    quality: &[Option<usize>],
+    budget: usize,
+) -> Vec<usize> {
+    let mut minima = minimum.to_vec();
+    let mut beyond: Vec<(usize, usize)> = Vec::new();
+    for (s, q) in quality.iter().enumerate() {
+        match *q {
+            Some(q) if q <= targets[s] => minima[s] = q,
+            Some(q) => beyond.push((q - targets[s], s)),
+            None => {}
+        }
+    }
+    beyond.sort_unstable();
+    let mut room = (QUALITY_EXTRA_SHARE * budget as f64) as usize;
+    let mut total: usize = minima.iter().sum();
+    for (extra, s) in beyond {
+        let q = quality[s].unwrap_or(minimum[s]);
+        // The least meshes must still fit the budget together.
+        let grown = total + (q - minima[s]);
+        if extra > room || grown > budget {
+            break;
+        }
+        room -= extra;
+        total = grown;
+        minima[s] = q;
+    }
+    minima
+}
+
 /// Each surface's least mesh (`minimum[s]`) and its share of `extra` triangles by area: a
 /// target that depends on the surface alone, and targets that sum to the least mesh and at most
 /// `extra`. Surfaces not `meshed` get none. Returns the targets' sum and the targets.
@@ -364,6 +415,63 @@ mod tests {
         let (sum, t) = share_alone(&areas, &[5, 900, 40], &[true, false, true], 80);
         assert_eq!(t, [15, 0, 80]);
         assert_eq!(sum, 95);
+    }
+
+    /// Least quality meshes within a surface's share are taken; beyond it, the cheapest first
+    /// while an eighth of the budget lasts.
+    #[test]
+    fn quality_minima_fit_the_cheapest_first() {
+        let minimum = [10, 10, 10, 10];
+        let targets = [400, 100, 100, 100];
+        let quality = [Some(300), Some(150), Some(200), None];
+        // 87 triangles beyond the shares: the 50 of surface 1, not the 100 of surface 2.
+        assert_eq!(
+            quality_minima(&minimum, &targets, &quality, 700),
+            [300, 150, 10, 10]
+        );
+        // 187: both.
+        assert_eq!(
+            quality_minima(&minimum, &targets, &quality, 1500),
+            [300, 150, 200, 10]
+        );
+        // The least meshes together must fit the budget: 55 + 55 would not.
+        assert_eq!(
+            quality_minima(&[10, 10], &[50, 50], &[Some(55), Some(55)], 100),
+            [55, 10]
+        );
+    }
+
+    /// The Cornell box at the default budget: each surface's least mesh at 20 degrees fits (the
+    /// short block's side, crossed by two lines at a small angle, needs about three times its
+    /// share by area), so no angle the input does not force is under 20 degrees.
+    #[test]
+    fn cornell_keeps_unforced_angles_at_the_default_budget() {
+        use crate::discontinuity::{DiscontinuityOptions, find_discontinuities};
+        let scene = builtin::cornell();
+        let vis = Visibility::build(&scene);
+        let budget = 10_000;
+        let options = DiscontinuityOptions {
+            element_area: Some(scene.total_area() / budget as f64),
+            ..DiscontinuityOptions::default()
+        };
+        let found = find_discontinuities(&scene, &vis, &options);
+        let mesh = mesh_scene_discontinuity(
+            &scene,
+            &vis,
+            found,
+            budget,
+            crate::grading::DEFAULT_PENUMBRA_DENSITY,
+        )
+        .expect("meshes");
+        mesh.sanity_check().expect("sane");
+        let q = mesh.quality();
+        assert!(q.triangles <= budget, "{q:?}");
+        assert_eq!(q.triangles_below_min_angle, 0, "{q:?}");
+        assert!(q.min_angle_unforced_deg >= 20.0 - 1e-6, "{q:?}");
+        assert!(
+            q.min_angle_deg < 20.0,
+            "the input forces smaller angles: {q:?}"
+        );
     }
 
     #[test]

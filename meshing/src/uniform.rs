@@ -28,6 +28,12 @@ pub const SNAP_BITS: i32 = 36;
 pub const MARK_QUANTUM: f64 = 1.0 / (1u64 << 24) as f64;
 /// Smallest angle the refinement aims for.
 pub const MIN_ANGLE_DEG: f64 = 25.0;
+/// Triangles smaller than this (mesh units, where the polygon's extent is 1: about (6e-8)^2)
+/// are left as they are by the refinement of a quality mesh: features closer than 2^-24 of the
+/// polygon are below the precision to which discontinuities are placed, and the circumcenters of
+/// smaller triangles lose the precision to be inserted.
+pub const QUALITY_FLOOR_AREA: f64 = 1.0 / (1u64 << 48) as f64;
+
 /// Rounds of graded refinement: each halves the triangles still too large, so a density of
 /// 2^8 is reached.
 const GRADING_ROUNDS: usize = 8;
@@ -234,6 +240,9 @@ pub(crate) struct SurfaceTriangulation {
     /// outside by the parity of constraint edges crossed from the hull, which constraints inside
     /// the polygon would upset; then faces are classified by their centroids instead.
     pub boundary_only: bool,
+    /// Every angle the input does not force is at least the refinement's angle
+    /// ([`Self::quality_least`]): refinements of it that cannot keep that are not taken.
+    pub quality: bool,
 }
 
 impl SurfaceTriangulation {
@@ -252,6 +261,7 @@ impl SurfaceTriangulation {
             cdt,
             outside: Vec::new(),
             boundary_only,
+            quality: false,
         };
         t.find_outside();
         t
@@ -269,6 +279,29 @@ impl SurfaceTriangulation {
     /// Triangles inside the polygon.
     pub fn count(&self) -> usize {
         self.cdt.num_inner_faces() - self.outside.len()
+    }
+
+    /// The least refinement in which every angle the input does not force is at least
+    /// `min_angle_deg` (Ruppert's refinement with no area bound), if it takes at most
+    /// `most_added` more vertices; refinements of it to a budget keep those angles.
+    pub fn quality_least(
+        &self,
+        min_angle_deg: f64,
+        most_added: usize,
+    ) -> Option<SurfaceTriangulation> {
+        let mut cdt = self.cdt.clone();
+        let parameters = RefinementParameters::<f64>::new()
+            .exclude_outer_faces(self.boundary_only)
+            .with_angle_limit(AngleLimit::from_deg(min_angle_deg))
+            .with_min_required_area(QUALITY_FLOOR_AREA)
+            .with_max_additional_vertices(most_added);
+        // spade asserts that a circumcenter can be inserted; a panic leaves the mesh as it was.
+        let complete =
+            crate::constrained::quietly(|| cdt.refine(parameters).refinement_complete).ok()?;
+        complete.then(|| SurfaceTriangulation {
+            quality: true,
+            ..self.with_cdt(cdt)
+        })
     }
 
     /// A refinement with about `target` triangles (never more, unless the triangulation already
@@ -293,7 +326,8 @@ impl SurfaceTriangulation {
             let mut cdt = self.cdt.clone();
             let smallest = max_area / density.max_factor();
             let allowed = allowance(target);
-            self.refine_cdt(&mut cdt, min_angle_deg, Some(max_area), max_area, allowed);
+            let mut complete =
+                self.refine_cdt(&mut cdt, min_angle_deg, Some(max_area), max_area, allowed);
             for _ in 0..GRADING_ROUNDS {
                 let points = split_points(&cdt, |face| {
                     let centroid = face_centroid(face);
@@ -307,9 +341,9 @@ impl SurfaceTriangulation {
                     // Only positions spade cannot represent fail; skipping one costs a split.
                     let _ = cdt.insert(Point2::new(p.x, p.y));
                 }
-                self.refine_cdt(&mut cdt, min_angle_deg, None, smallest, allowed);
+                complete = self.refine_cdt(&mut cdt, min_angle_deg, None, smallest, allowed);
             }
-            cdt
+            (cdt, complete)
         })
     }
 
@@ -317,6 +351,12 @@ impl SurfaceTriangulation {
     /// (angles of at least `min_angle_deg`, nothing refined below a thousandth of the smallest
     /// split triangle). Returns how many vertices were added.
     pub fn split_triangles_at(&mut self, points: &[DVec2], min_angle_deg: f64) -> usize {
+        self.split_and_repair(points, min_angle_deg).0
+    }
+
+    /// [`Self::split_triangles_at`], also telling whether the quality refinement around the
+    /// splits completed (ran out of neither vertices nor triangles to fix).
+    fn split_and_repair(&mut self, points: &[DVec2], min_angle_deg: f64) -> (usize, bool) {
         let before = self.cdt.num_vertices();
         let mut faces = std::collections::HashSet::new();
         for p in points {
@@ -327,7 +367,7 @@ impl SurfaceTriangulation {
             }
         }
         if faces.is_empty() {
-            return 0;
+            return (0, true);
         }
         let smallest = faces
             .iter()
@@ -342,10 +382,10 @@ impl SurfaceTriangulation {
         // Quality is restored around the splits only: a triangulation whose first refinement was
         // stopped at its target (see `refined_capped`) would otherwise be refined all over.
         let room = SPLIT_VERTICES_PER_FACE * faces.len();
-        self.refine_cdt(&mut cdt, min_angle_deg, None, smallest, allowance(room));
+        let complete = self.refine_cdt(&mut cdt, min_angle_deg, None, smallest, allowance(room));
         self.cdt = cdt;
         self.find_outside();
-        self.cdt.num_vertices() - before
+        (self.cdt.num_vertices() - before, complete)
     }
 
     /// The area bound that leaves about `target` triangles in a refinement of the polygon.
@@ -355,22 +395,28 @@ impl SurfaceTriangulation {
     }
 
     /// One refinement with triangles no larger than `max_area` (and at most about `target`
-    /// more vertices than there are).
-    pub(crate) fn refined_to_area(&self, max_area: f64, min_angle_deg: f64, target: usize) -> Cdt {
+    /// more vertices than there are), and whether it completed.
+    pub(crate) fn refined_to_area(
+        &self,
+        max_area: f64,
+        min_angle_deg: f64,
+        target: usize,
+    ) -> (Cdt, bool) {
         let mut cdt = self.cdt.clone();
-        self.refine_cdt(
+        let complete = self.refine_cdt(
             &mut cdt,
             min_angle_deg,
             Some(max_area),
             max_area,
             allowance(target),
         );
-        cdt
+        (cdt, complete)
     }
 
     /// Runs spade's refinement: angles of at least `min_angle_deg`, triangles no larger than
-    /// `max_area` (when given), none refined below a thousandth of `base_area`, at most
-    /// `added` more vertices.
+    /// `max_area` (when given), none refined below a thousandth of `base_area` (below
+    /// [`QUALITY_FLOOR_AREA`] for a quality mesh), at most `added` more vertices. Returns whether
+    /// the refinement completed.
     ///
     /// spade skips a face whose circumcenter it locates outside the convex hull, and does not
     /// come back to it. While no hull edge is encroached (no vertex strictly inside its diametral
@@ -389,13 +435,17 @@ impl SurfaceTriangulation {
         max_area: Option<f64>,
         base_area: f64,
         added: usize,
-    ) {
+    ) -> bool {
         let most_vertices = cdt.num_vertices() + added;
+        let floor = match self.quality {
+            true => QUALITY_FLOOR_AREA,
+            false => 1e-3 * base_area,
+        };
         let parameters = |cdt: &Cdt| {
             let mut parameters = RefinementParameters::<f64>::new()
                 .exclude_outer_faces(self.boundary_only)
                 .with_angle_limit(AngleLimit::from_deg(min_angle_deg))
-                .with_min_required_area(1e-3 * base_area)
+                .with_min_required_area(floor)
                 .with_max_additional_vertices(most_vertices.saturating_sub(cdt.num_vertices()));
             if let Some(max_area) = max_area {
                 parameters = parameters.with_max_allowed_area(max_area);
@@ -404,7 +454,7 @@ impl SurfaceTriangulation {
         };
         let mut complete = cdt.refine(parameters(cdt)).refinement_complete;
         let Some(max_area) = max_area else {
-            return;
+            return complete;
         };
         for _ in 0..SKIPPED_FACE_ROUNDS {
             // An incomplete refinement ran out of vertices: the faces left large are the budget's.
@@ -428,6 +478,7 @@ impl SurfaceTriangulation {
             }
             complete = cdt.refine(parameters(cdt)).refinement_complete;
         }
+        complete
     }
 
     /// This triangulation's polygon with another triangulation of it.
@@ -437,6 +488,7 @@ impl SurfaceTriangulation {
             cdt,
             outside: Vec::new(),
             boundary_only: self.boundary_only,
+            quality: self.quality,
         };
         t.find_outside();
         t
@@ -444,12 +496,13 @@ impl SurfaceTriangulation {
 
     /// The best of a few refinements made by `refine(max_area)` with the area bound calibrated so
     /// that the count comes to 90-100 % of `target` ([`FILLED_SHARE`]); if none comes to [`CAPPED_BELOW`] of it, a
-    /// refinement (to angles of `min_angle_deg`) stopped at the target.
+    /// refinement (to angles of `min_angle_deg`) stopped at the target. A quality mesh takes
+    /// only refinements that completed, which keep its angles.
     fn calibrated(
         &self,
         target: usize,
         min_angle_deg: f64,
-        refine: impl Fn(f64) -> Cdt,
+        refine: impl Fn(f64) -> (Cdt, bool),
     ) -> SurfaceTriangulation {
         let mut best = self.clone();
         let base_count = self.count();
@@ -462,10 +515,11 @@ impl SurfaceTriangulation {
         let mut max_area = self.area_for(target);
         let mut last_count = None;
         for _ in 0..8 {
-            let refined = self.with_cdt(refine(max_area));
+            let (cdt, complete) = refine(max_area);
+            let refined = self.with_cdt(cdt);
             let count = refined.count();
             let ratio = count as f64 / target as f64;
-            if count <= target && count > best_count {
+            if count <= target && count > best_count && (complete || !self.quality) {
                 best_count = count;
                 best = refined;
             }
@@ -481,7 +535,7 @@ impl SurfaceTriangulation {
                 ratio * 0.98
             };
         }
-        if (best_count as f64) < CAPPED_BELOW * target as f64 {
+        if !self.quality && (best_count as f64) < CAPPED_BELOW * target as f64 {
             let capped = self.refined_capped(target, min_angle_deg);
             if capped.count() <= target && capped.count() > best_count {
                 best = capped;
@@ -515,7 +569,8 @@ impl SurfaceTriangulation {
             while splits > 0 {
                 let points: Vec<DVec2> = inside.iter().take(splits).map(|&(_, c)| c).collect();
                 let mut next = self.clone();
-                if next.split_triangles_at(&points, min_angle_deg) > 0 && next.count() <= target {
+                let (added, complete) = next.split_and_repair(&points, min_angle_deg);
+                if added > 0 && next.count() <= target && (complete || !self.quality) {
                     grown = Some(next);
                     break;
                 }

@@ -11,6 +11,13 @@ use glam::DVec2;
 
 use crate::mesh::{ON_SEGMENT_TOLERANCE, SurfaceMesh};
 
+/// Two input edges that meet at less than this leave triangles between them (every vertex on
+/// one of the two) that Delaunay refinement cannot improve without splitting the edges without
+/// end: it lays them out in shells around the meeting point and leaves them (Shewchuk 2002,
+/// "Delaunay refinement algorithms for triangular mesh generation", section 4: small input
+/// angles spoil the angle guarantee near them, where they are under 60 degrees).
+pub const SHELL_ANGLE_DEG: f64 = 60.0;
+
 /// Per vertex, the directions of the input edges that leave it and the input edges it is on.
 #[derive(Clone, Debug)]
 pub struct InputWedges {
@@ -87,14 +94,15 @@ impl InputWedges {
 
     /// Whether the input forces the corner of triangle `tri` at its `k`-th vertex below
     /// `limit` (radians): the corner lies in a narrower wedge of input edges, or the triangle
-    /// lies between two input edges that meet at a narrower angle.
+    /// lies between two input edges that meet at less than [`SHELL_ANGLE_DEG`].
     pub fn forces(&self, local: &[DVec2], tri: [u32; 3], k: usize, limit: f64) -> bool {
         let [v, a, b] = [tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]].map(|i| i as usize);
         let (da, db) = (
             (local[a] - local[v]).normalize(),
             (local[b] - local[v]).normalize(),
         );
-        self.around(v, da, db) < limit || self.between_narrow_inputs(tri, limit)
+        self.around(v, da, db) < limit
+            || self.between_narrow_inputs(tri, SHELL_ANGLE_DEG.to_radians())
     }
 
     /// Whether every vertex of `tri` is on one of two input edges that meet at an angle under

@@ -211,3 +211,43 @@ fn angles_forced_by_constraints_are_told_apart() {
         "{plain:?}"
     );
 }
+
+/// Two lines that cross at 6 degrees and run on to the square's edges cut thin lenses off each
+/// other. The least mesh at 20 degrees (Ruppert's refinement with no area bound) is the least
+/// one that keeps every angle the input does not force at 20 or more: with a target that holds
+/// it, the mesh keeps them so; with one that does not, the target still holds and the quality
+/// figures count the triangles below.
+#[test]
+fn lines_crossing_at_a_small_angle_keep_unforced_angles_when_the_budget_holds_them() {
+    let surface = square(1.0);
+    let turn = 6f64.to_radians();
+    let centre = DVec2::new(0.45, 0.55);
+    let along = |a: f64| DVec2::new(a.cos(), a.sin());
+    let segments = [0.3, 0.3 + turn].map(|a| Constraint {
+        from: centre - 0.4 * along(a),
+        to: centre + 0.6 * along(a),
+        splits: false,
+    });
+    let mut constrained = ConstrainedSurface::new(0, &surface, &segments).expect("inserts");
+    let least = constrained.minimum_triangles();
+    let quality = constrained
+        .quality_triangles(100_000)
+        .expect("a quality mesh exists");
+    assert!(quality > 2 * least, "{least} {quality}");
+    for target in [quality, 2 * quality, 20 * quality] {
+        let mesh = constrained.clone().into_mesh(&surface, target);
+        mesh.sanity_check().expect("sane");
+        let q = mesh.quality();
+        assert!(q.triangles <= target, "{} > {target}", q.triangles);
+        assert!(q.min_angle_deg < 6.0 + 1e-9, "{q:?}");
+        assert!(q.min_angle_unforced_deg >= 20.0 - 1e-6, "{target}: {q:?}");
+        assert_eq!(q.triangles_below_min_angle, 0, "{target}: {q:?}");
+    }
+    // Half the least quality mesh: the budget holds, and the figures say what it cost.
+    let mut tight = ConstrainedSurface::new(0, &surface, &segments).expect("inserts");
+    assert_eq!(tight.quality_triangles(quality / 2), None);
+    let q = tight.into_mesh(&surface, quality / 2).quality();
+    assert!(q.triangles <= quality / 2, "{q:?}");
+    assert!(q.triangles_below_min_angle > 0, "{q:?}");
+    assert!(q.min_angle_unforced_deg < 20.0, "{q:?}");
+}
