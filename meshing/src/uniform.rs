@@ -414,9 +414,14 @@ impl SurfaceTriangulation {
     }
 
     /// Runs spade's refinement: angles of at least `min_angle_deg`, triangles no larger than
-    /// `max_area` (when given), none refined below a thousandth of `base_area` (below
-    /// [`QUALITY_FLOOR_AREA`] for a quality mesh), at most `added` more vertices. Returns whether
-    /// the refinement completed.
+    /// `max_area` (when given), none refined below a thousandth of `base_area`, at most `added`
+    /// more vertices. Returns whether the refinement completed.
+    ///
+    /// The floor matters for a quality mesh too: a later refinement does not know which split
+    /// points on two constraints came from one small input angle, so it refines the shells
+    /// around that angle again, and without the floor it would go on down to
+    /// [`QUALITY_FLOOR_AREA`] (the extremal boxworld floor's least quality mesh of 36,281
+    /// triangles then came to at least 53,590 under any area bound).
     ///
     /// spade skips a face whose circumcenter it locates outside the convex hull, and does not
     /// come back to it. While no hull edge is encroached (no vertex strictly inside its diametral
@@ -437,15 +442,11 @@ impl SurfaceTriangulation {
         added: usize,
     ) -> bool {
         let most_vertices = cdt.num_vertices() + added;
-        let floor = match self.quality {
-            true => QUALITY_FLOOR_AREA,
-            false => 1e-3 * base_area,
-        };
         let parameters = |cdt: &Cdt| {
             let mut parameters = RefinementParameters::<f64>::new()
                 .exclude_outer_faces(self.boundary_only)
                 .with_angle_limit(AngleLimit::from_deg(min_angle_deg))
-                .with_min_required_area(floor)
+                .with_min_required_area(1e-3 * base_area)
                 .with_max_additional_vertices(most_vertices.saturating_sub(cdt.num_vertices()));
             if let Some(max_area) = max_area {
                 parameters = parameters.with_max_allowed_area(max_area);
