@@ -228,7 +228,15 @@ pub fn estimated_direct_warning(stats: &SolveStats) -> Option<String> {
 /// does not force: the budget could not hold some surface's least mesh at that angle, or
 /// adaptive splits (which restore smaller angles only) made them.
 pub fn mesh_quality_warning(quality: &MeshQuality, adaptive: bool) -> Option<String> {
-    let below = quality.triangles_below_min_angle;
+    quality_warning(
+        quality.triangles_below_min_angle,
+        quality.triangles,
+        adaptive,
+    )
+}
+
+/// [`mesh_quality_warning`] from the two counts: `below` of `triangles`.
+pub fn quality_warning(below: usize, triangles: usize, adaptive: bool) -> Option<String> {
     (below > 0).then(|| {
         let cause = if adaptive {
             format!(
@@ -241,7 +249,7 @@ pub fn mesh_quality_warning(quality: &MeshQuality, adaptive: bool) -> Option<Str
         format!(
             "{below} of {} triangles have an angle under {} degrees that the input does not \
              force (mesh_quality.triangles_below_min_angle): {cause}",
-            quality.triangles,
+            triangles,
             penumbra_meshing::mesh::FORCING_WEDGE_DEG
         )
     })

@@ -642,6 +642,13 @@ pub fn merge(
                 serde_json::to_value(quality).unwrap_or_default(),
             );
         }
+        // The joined meshes' quality, or the first shard's whole-scene mesh's.
+        let quality_count = |key: &str| r["mesh_quality"][key].as_u64().unwrap_or(0) as usize;
+        all_warnings.extend(crate::outputs::quality_warning(
+            quality_count("triangles_below_min_angle"),
+            quality_count("triangles"),
+            false,
+        ));
         r.insert("warnings".to_owned(), all_warnings.into());
         r.insert(
             "energy".to_owned(),
