@@ -224,18 +224,9 @@ pub fn estimated_direct_warning(stats: &SolveStats) -> Option<String> {
     })
 }
 
-/// A warning when triangles have angles under the aim of quality refinement that the input
-/// does not force: the budget could not hold some surface's least mesh at that angle, or
-/// adaptive splits (which restore smaller angles only) made them.
-pub fn mesh_quality_warning(quality: &MeshQuality, adaptive: bool) -> Option<String> {
-    quality_warning(
-        quality.triangles_below_min_angle,
-        quality.triangles,
-        adaptive,
-    )
-}
-
-/// [`mesh_quality_warning`] from the two counts: `below` of `triangles`.
+/// A warning when `below` of the mesh's `triangles` have angles under the aim of quality
+/// refinement that the input does not force: the budget could not hold some surface's least
+/// mesh at that angle, or adaptive splits (which restore smaller angles only) made them.
 pub fn quality_warning(below: usize, triangles: usize, adaptive: bool) -> Option<String> {
     (below > 0).then(|| {
         let cause = if adaptive {
@@ -265,8 +256,9 @@ pub fn report_json(result: &RunResult, svgs: &SvgSelection) -> String {
     warnings.extend(energy.warning());
     warnings.extend(estimated_direct_warning(stats));
     let mesh_quality = result.mesh.quality();
-    warnings.extend(mesh_quality_warning(
-        &mesh_quality,
+    warnings.extend(quality_warning(
+        mesh_quality.triangles_below_min_angle,
+        mesh_quality.triangles,
         result.refinement.is_some(),
     ));
     let report = Report {

@@ -643,7 +643,12 @@ pub fn merge(
             );
         }
         // The joined meshes' quality, or the first shard's whole-scene mesh's.
-        let quality_count = |key: &str| r["mesh_quality"][key].as_u64().unwrap_or(0) as usize;
+        let quality_count = |key: &str| {
+            r.get("mesh_quality")
+                .and_then(|q| q.get(key))
+                .and_then(serde_json::Value::as_u64)
+                .unwrap_or(0) as usize
+        };
         all_warnings.extend(crate::outputs::quality_warning(
             quality_count("triangles_below_min_angle"),
             quality_count("triangles"),

@@ -254,6 +254,7 @@ impl ConstrainedSurface {
 
     /// The refined triangulation, graded as in [`Self::into_graded_mesh`], kept so that
     /// triangles can be split later.
+    ///
     /// Refinement starts from the least quality mesh when that fits `target`
     /// ([`Self::quality_triangles`]), so that the angles the input does not force stay at
     /// [`CONSTRAINED_MIN_ANGLE_DEG`] or more.

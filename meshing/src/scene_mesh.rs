@@ -333,19 +333,19 @@ pub fn quality_minima(
     budget: usize,
 ) -> Vec<usize> {
     let mut minima = minimum.to_vec();
-    let mut beyond: Vec<(usize, usize)> = Vec::new();
+    // (triangles beyond the share, surface, least quality mesh)
+    let mut beyond: Vec<(usize, usize, usize)> = Vec::new();
     for (s, q) in quality.iter().enumerate() {
         match *q {
             Some(q) if q <= targets[s] => minima[s] = q,
-            Some(q) => beyond.push((q - targets[s], s)),
+            Some(q) => beyond.push((q - targets[s], s, q)),
             None => {}
         }
     }
     beyond.sort_unstable();
     let mut room = (QUALITY_EXTRA_SHARE * budget as f64) as usize;
     let mut total: usize = minima.iter().sum();
-    for (extra, s) in beyond {
-        let q = quality[s].unwrap_or(minimum[s]);
+    for (extra, s, q) in beyond {
         // The least meshes must still fit the budget together.
         let grown = total + (q - minima[s]);
         if extra > room || grown > budget {

@@ -13,9 +13,9 @@ use crate::mesh::{ON_SEGMENT_TOLERANCE, SurfaceMesh};
 
 /// Two input edges that meet at less than this leave triangles between them (every vertex on
 /// one of the two) that Delaunay refinement cannot improve without splitting the edges without
-/// end: it lays them out in shells around the meeting point and leaves them (Shewchuk 2002,
-/// "Delaunay refinement algorithms for triangular mesh generation", section 4: small input
-/// angles spoil the angle guarantee near them, where they are under 60 degrees).
+/// end: it lays them out in shells around the meeting point and leaves them (Ruppert 1995;
+/// Shewchuk 2000, "Mesh generation for domains with small angles": the angle guarantee holds
+/// only away from input angles under 60 degrees).
 pub const SHELL_ANGLE_DEG: f64 = 60.0;
 
 /// Per vertex, the directions of the input edges that leave it and the input edges it is on.
