@@ -29,10 +29,10 @@ pub const MARK_QUANTUM: f64 = 1.0 / (1u64 << 24) as f64;
 /// Smallest angle the refinement aims for.
 pub const MIN_ANGLE_DEG: f64 = 25.0;
 /// Triangles smaller than this (mesh units, where the polygon's extent is 1: (2^-24)^2, about
-/// (6e-8)^2) are left as they are by the search for the least quality mesh
-/// (the least mesh at the angle, with no area bound): far below any feature the discontinuities keep
-/// apart (constraint ends within [`crate::constrained::MERGE_DISTANCE`] are one), it keeps the
-/// refinement from chasing rounding.
+/// (6e-8)^2) are left as they are by the search for the least quality mesh (the least mesh at
+/// the angle, with no area bound). Only features a few hundred merge distances apart
+/// ([`crate::constrained::MERGE_DISTANCE`], 2^-30) make triangles that small; the floor keeps the
+/// refinement from chasing them down to rounding.
 pub const QUALITY_FLOOR_AREA: f64 = 1.0 / (1u64 << 48) as f64;
 
 /// Rounds of graded refinement: each halves the triangles still too large, so a density of
