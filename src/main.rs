@@ -92,6 +92,7 @@ enum SolverArg {
     Jacobi,
     GaussSeidel,
     Direct,
+    Hierarchical,
 }
 
 impl From<SolverArg> for penumbra_solver::SolverMethod {
@@ -101,6 +102,7 @@ impl From<SolverArg> for penumbra_solver::SolverMethod {
             SolverArg::Jacobi => Self::Jacobi,
             SolverArg::GaussSeidel => Self::GaussSeidel,
             SolverArg::Direct => Self::Direct,
+            SolverArg::Hierarchical => Self::Hierarchical,
         }
     }
 }
@@ -166,10 +168,15 @@ struct RunArgs {
     refine_rounds: usize,
     /// How the radiosity system is solved: progressive refinement (shooting), Jacobi or
     /// Gauss–Seidel gathering over the patch form-factor matrix, or its dense direct solve (the
-    /// discrete system's exact answer). Gathering and direct solves stop at a relative residual
-    /// of --epsilon, or after --max-shots sweeps.
+    /// discrete system's exact answer), or hierarchical radiosity with clustering (links refined
+    /// to --link-tol, then a final gather at every vertex). Gathering, direct and hierarchical
+    /// solves stop at a relative residual of --epsilon, or after --max-shots sweeps.
     #[arg(long, value_enum, default_value_t = SolverArg::Progressive)]
     solver: SolverArg,
+    /// With --solver hierarchical: the light a link may carry wrongly, as a fraction of the
+    /// emitted power; smaller is finer and slower.
+    #[arg(long, default_value_t = penumbra_solver::hierarchical::DEFAULT_LINK_TOL)]
+    link_tol: f64,
     /// How vertex-to-patch form factors are computed: Lambert's formula times a ray-sampled
     /// visibility fraction, Monte Carlo over each patch (--ff-samples points, each with a ray),
     /// or a hemicube z-buffer at each vertex (--hemicube-resolution; not with --refine-tol).
@@ -977,6 +984,7 @@ fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
             epsilon: args.epsilon,
             max_shots: args.max_shots,
             visibility_rays: args.rays,
+            link_tol: args.link_tol,
             form_factors: match args.form_factors {
                 FormFactorArg::Analytic => penumbra_solver::coupling::FormFactorMethod::Analytic,
                 FormFactorArg::MonteCarlo => {

@@ -15,7 +15,7 @@ use penumbra_meshing::{
 use penumbra_scenes::{LoadedScene, Rgb, Visibility};
 use penumbra_solver::{
     Progress, Solution, SolveError, SolverMethod, SolverOptions, solve_direct_on, solve_gathering,
-    solve_progressive,
+    solve_hierarchical, solve_progressive,
 };
 use penumbra_viz::{Render, RenderOptions, VizError};
 use serde::Serialize;
@@ -426,6 +426,10 @@ pub fn run(
         None if solver.direct_only || options.method == SolverMethod::Progressive => (
             None,
             solve_progressive(scene, &mesh, &visibility, &solver, progress)?,
+        ),
+        None if options.method == SolverMethod::Hierarchical => (
+            None,
+            solve_hierarchical(scene, &mesh, &visibility, &solver, progress)?,
         ),
         None => (
             None,

@@ -41,6 +41,8 @@ pub enum SolverMethod {
     GaussSeidel,
     /// Gaussian elimination of the dense patch system: the discrete system's exact answer.
     Direct,
+    /// Hierarchical radiosity with clustering, and a final gather at the vertices.
+    Hierarchical,
 }
 
 impl SolverMethod {
@@ -51,6 +53,7 @@ impl SolverMethod {
             SolverMethod::Jacobi => "jacobi",
             SolverMethod::GaussSeidel => "gauss-seidel",
             SolverMethod::Direct => "direct",
+            SolverMethod::Hierarchical => "hierarchical",
         }
     }
 }
@@ -362,6 +365,7 @@ pub fn solve_gathering(
         remeshes: 0,
         gathered: 0,
         gather_seconds: 0.0,
+        hierarchy: None,
     };
     Ok((
         Solution {

@@ -25,6 +25,7 @@ pub mod error;
 pub mod estimate;
 pub mod gathering;
 pub mod hemicube;
+pub mod hierarchical;
 pub mod lambert;
 pub mod measure;
 mod occluder_tree;
@@ -38,6 +39,7 @@ pub use direct::DirectLight;
 pub use elements::Discretization;
 pub use error::SolveError;
 pub use gathering::{SolverMethod, solve_gathering};
+pub use hierarchical::solve_hierarchical;
 pub use lambert::{ReceivingPoint, form_factor};
 pub use progress::{NoProgress, Progress};
 pub use progressive::{

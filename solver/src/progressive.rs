@@ -59,6 +59,9 @@ pub struct SolverOptions {
     pub interrupt: Option<Interrupt>,
     /// How vertex-to-patch form factors are computed.
     pub form_factors: FormFactorMethod,
+    /// The hierarchical solver's link tolerance: the light a link may carry wrongly, as a
+    /// fraction of the emitted power.
+    pub link_tol: f64,
 }
 
 pub const DEFAULT_EPSILON: f64 = 1e-3;
@@ -76,6 +79,7 @@ impl Default for SolverOptions {
             deadline: None,
             interrupt: None,
             form_factors: FormFactorMethod::Analytic,
+            link_tol: crate::hierarchical::DEFAULT_LINK_TOL,
         }
     }
 }
@@ -98,6 +102,9 @@ impl SolverOptions {
         };
         if !(self.epsilon > 0.0 && self.epsilon < 1.0) {
             return bad("epsilon", "must be in (0, 1)");
+        }
+        if !(self.link_tol > 0.0 && self.link_tol < 1.0) {
+            return bad("link tolerance", "must be in (0, 1)");
         }
         if self.visibility_rays == 0 {
             return bad("visibility rays", "must be at least 1");
@@ -168,6 +175,9 @@ pub struct SolveStats {
     pub remeshes: usize,
     pub gathered: usize,
     pub gather_seconds: f64,
+    /// The hierarchical solver's own figures.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub hierarchy: Option<crate::hierarchical::HierarchyStats>,
 }
 
 /// One step of a solver: its residual relative to the light put in (for progressive refinement
@@ -961,6 +971,7 @@ impl<'a> ProgressiveSolver<'a> {
             remeshes: self.remeshes,
             gathered: self.gathered,
             gather_seconds: self.gather_seconds,
+            hierarchy: None,
         };
         Solution {
             radiosity: self.radiosity(),
@@ -983,7 +994,7 @@ fn unshot_magnitude(patch_power: &[Rgb]) -> f64 {
     patch_power.iter().map(|&p| magnitude(p)).sum()
 }
 
-fn check_mesh(scene: &Scene, mesh: &SceneMesh) -> Result<(), SolveError> {
+pub(crate) fn check_mesh(scene: &Scene, mesh: &SceneMesh) -> Result<(), SolveError> {
     if mesh.surfaces.len() != scene.surfaces.len()
         || mesh
             .surfaces

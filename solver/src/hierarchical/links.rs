@@ -1,0 +1,397 @@
+//! Links and the oracle that refines them (Hanrahan, Salzman & Aupperle 1991, with clusters as
+//! in Smits, Arvo & Greenberg 1994).
+//!
+//! A link carries light from a source node to a receiver node. Linking starts from the root
+//! cluster's link to itself; a link is kept when the light it would carry wrongly is below the
+//! tolerance, and otherwise replaced by the links of the larger node's children. What a link
+//! carries wrongly (BF refinement) is the receiver's reflectance times its area times:
+//! - between elements, the source's radiosity times the spread of the form factor over the
+//!   receiver's quadrature points (plus the disc approximation's own error where the source is
+//!   large for its distance), and the form factor times the spread of the source's radiosity
+//!   over its children;
+//! - from or to a cluster, all the light the link carries (a cluster's light is only
+//!   approximately directional, see [`super::transfer`]).
+//!
+//! Visibility comes from shaft culling ([`super::shaft`]); only partial links cast rays, a
+//! stratified, seeded set between the two nodes.
+
+use glam::DVec3;
+use penumbra_scenes::rng::SplitMix64;
+use penumbra_scenes::{Rgb, Visibility};
+use rayon::prelude::*;
+
+use super::shaft::{Shafts, Sight};
+use super::transfer::{Axes, cluster_intensity, disc_factor, element_intensity};
+use super::tree::{Hierarchy, Node};
+use crate::lambert::{ReceivingPoint, form_factor};
+
+/// How light goes along a link.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Transfer {
+    /// Element to element: the receiver's mean irradiance is `factor` times the source's
+    /// radiosity; `spread` is the form factor's range over the receiver (unoccluded).
+    Factor { factor: f64, spread: f64 },
+    /// From or to a cluster: the source's intensity along unit `direction` (source to receiver),
+    /// over the squared `distance`, times the fraction `visible` of open segments.
+    Far {
+        direction: DVec3,
+        distance2: f64,
+        visible: f64,
+    },
+}
+
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Link {
+    pub receiver: u32,
+    pub source: u32,
+    pub transfer: Transfer,
+    /// Whether shaft culling left some blocker: the final gather casts rays for such links.
+    pub partial: bool,
+}
+
+/// The solution the oracle judges links by: every element's mean reflected radiosity, and every
+/// cluster's power per axis direction.
+pub(crate) struct Radiosities<'s> {
+    pub b: &'s [Rgb],
+    pub q: &'s [Axes],
+    /// Each node's slot in `q` (clusters only).
+    pub slot: &'s [u32],
+}
+
+impl Radiosities<'_> {
+    /// The power the source sends (W).
+    pub fn power(&self, node: &Node, id: u32) -> Rgb {
+        if node.is_cluster() {
+            self.q[self.slot[id as usize] as usize]
+                .iter()
+                .copied()
+                .sum()
+        } else {
+            self.b[id as usize] * node.area
+        }
+    }
+
+    /// The source's intensity toward unit `d` (W/sr).
+    pub fn intensity(&self, node: &Node, id: u32, d: DVec3) -> Rgb {
+        if node.is_cluster() {
+            cluster_intensity(&self.q[self.slot[id as usize] as usize], d)
+        } else {
+            self.b[id as usize] * element_intensity(node, d)
+        }
+    }
+}
+
+/// What refinement counted.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct RefineCounts {
+    /// Pairs of nodes found hidden from each other by one polygon, and not linked.
+    pub hidden: u64,
+    pub rays: u64,
+}
+
+impl RefineCounts {
+    pub fn add(&mut self, other: RefineCounts) {
+        self.hidden += other.hidden;
+        self.rays += other.rays;
+    }
+}
+
+/// Below this sum of the two nodes' depths, a link's children are refined in parallel.
+const PARALLEL_DEPTH: u16 = 10;
+
+/// Everything refinement needs, borrowed.
+pub(crate) struct Refiner<'a> {
+    pub hierarchy: &'a Hierarchy,
+    pub shafts: &'a Shafts<'a>,
+    /// Light a link may carry wrongly (W, channel mean).
+    pub tolerance: f64,
+    pub rays: usize,
+    pub seed: u64,
+    /// Distance under which a point counts as lying on a plane.
+    pub tol: f64,
+}
+
+impl Refiner<'_> {
+    fn visibility(&self) -> &Visibility {
+        self.shafts.visibility
+    }
+
+    /// The links that replace the link from `s` to `r` (itself, if it holds), appended to `out`.
+    /// `candidates` are the blockers of a shaft that holds this pair's.
+    pub fn refine(
+        &self,
+        r: u32,
+        s: u32,
+        candidates: Option<&[u32]>,
+        state: &Radiosities,
+        out: &mut Vec<Link>,
+        counts: &mut RefineCounts,
+    ) {
+        let h = self.hierarchy;
+        let (rn, sn) = (h.node(r), h.node(s));
+        if r == s {
+            // A cluster's light among its own parts; an element cannot see itself.
+            if let Some([a, b]) = rn.children.filter(|_| rn.is_cluster()) {
+                let pairs = [(a, a), (a, b), (b, a), (b, b)];
+                self.refine_all(&pairs, candidates, 2 * rn.depth, state, out, counts);
+            }
+            return;
+        }
+        if rn.surface.is_some() && rn.surface == sn.surface {
+            return;
+        }
+        if behind(sn, rn, self.tol) || behind(rn, sn, self.tol) {
+            return;
+        }
+        let sight = self.shafts.classify(rn, sn, candidates);
+        if sight == Sight::Hidden {
+            counts.hidden += 1;
+            return;
+        }
+        let (transfer, error) = self.estimate(r, s, state);
+        let split = if error <= self.tolerance {
+            None
+        } else {
+            match (rn.children, sn.children) {
+                (None, None) => None,
+                (Some(c), None) => Some((c, true)),
+                (None, Some(c)) => Some((c, false)),
+                (Some(rc), Some(sc)) => Some(if rn.radius >= sn.radius {
+                    (rc, true)
+                } else {
+                    (sc, false)
+                }),
+            }
+        };
+        let blockers: &[u32] = match &sight {
+            Sight::Partial(list) => list,
+            _ => &[],
+        };
+        match split {
+            Some((children, receiver_side)) => {
+                let pairs = children.map(|c| if receiver_side { (c, s) } else { (r, c) });
+                let depth = rn.depth + sn.depth;
+                self.refine_all(&pairs, Some(blockers), depth, state, out, counts);
+            }
+            None => {
+                let partial = !blockers.is_empty();
+                let transfer = if partial {
+                    self.occlude(r, s, transfer, counts)
+                } else {
+                    transfer
+                };
+                out.push(Link {
+                    receiver: r,
+                    source: s,
+                    transfer,
+                    partial,
+                });
+            }
+        }
+    }
+
+    /// [`Self::refine`] for each pair, in parallel for shallow pairs, collected in order.
+    fn refine_all(
+        &self,
+        pairs: &[(u32, u32)],
+        candidates: Option<&[u32]>,
+        depth: u16,
+        state: &Radiosities,
+        out: &mut Vec<Link>,
+        counts: &mut RefineCounts,
+    ) {
+        if depth >= PARALLEL_DEPTH {
+            for &(x, y) in pairs {
+                self.refine(x, y, candidates, state, out, counts);
+            }
+            return;
+        }
+        let parts: Vec<(Vec<Link>, RefineCounts)> = pairs
+            .par_iter()
+            .map(|&(x, y)| {
+                let (mut links, mut c) = (Vec::new(), RefineCounts::default());
+                self.refine(x, y, candidates, state, &mut links, &mut c);
+                (links, c)
+            })
+            .collect();
+        for (links, c) in parts {
+            out.extend(links);
+            counts.add(c);
+        }
+    }
+
+    /// The link's unoccluded transfer, and the light it would carry wrongly (W). Nodes nearer
+    /// than their radii allow no estimate but a bound: the receiver reflects at most all the
+    /// light the source sends, and at most its own area times the source's radiosity.
+    fn estimate(&self, r: u32, s: u32, state: &Radiosities) -> (Transfer, f64) {
+        let h = self.hierarchy;
+        let (rn, sn) = (h.node(r), h.node(s));
+        let touching = rn.centroid.distance(sn.centroid) <= rn.radius + sn.radius;
+        let bound = || {
+            let power = state.power(sn, s);
+            let limit = if sn.is_cluster() || rn.is_cluster() {
+                power
+            } else {
+                let b = state.b[s as usize];
+                Rgb::new(
+                    power.r.min(b.r * rn.area),
+                    power.g.min(b.g * rn.area),
+                    power.b.min(b.b * rn.area),
+                )
+            };
+            rn.reflectance.mul_rgb(limit).mean()
+        };
+        if rn.is_cluster() || sn.is_cluster() {
+            let offset = rn.centroid - sn.centroid;
+            let distance2 = offset.length_squared().max(f64::MIN_POSITIVE);
+            let direction = offset / distance2.sqrt();
+            let transfer = Transfer::Far {
+                direction,
+                distance2,
+                visible: 1.0,
+            };
+            if touching {
+                return (transfer, bound());
+            }
+            let facing = if rn.is_cluster() {
+                1.0
+            } else {
+                rn.normal.dot(-direction).max(0.0)
+            };
+            let irradiance = state.intensity(sn, s, direction) * (facing / distance2);
+            return (
+                transfer,
+                rn.reflectance.mul_rgb(irradiance).mean() * rn.area,
+            );
+        }
+        let points = h.quadrature(r);
+        let factors: smallvec::SmallVec<[f64; 4]> = points
+            .iter()
+            .map(|&(p, _)| {
+                let x = ReceivingPoint::interior(p, rn.normal);
+                match sn.children {
+                    None => form_factor(&x, &h.triangles[sn.first as usize].points, self.tol),
+                    Some(_) => disc_factor(p, rn.normal, sn.centroid, sn.normal, sn.area),
+                }
+            })
+            .collect();
+        let factor: f64 = factors.iter().zip(&points).map(|(f, (_, w))| f * w).sum();
+        let (lo, hi) = factors
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &f| {
+                (lo.min(f), hi.max(f))
+            });
+        let spread = (hi - lo).max(0.0);
+        let transfer = Transfer::Factor { factor, spread };
+        let error = if touching && (rn.children.is_some() || sn.children.is_some()) {
+            bound()
+        } else {
+            self.factor_error(r, s, factor, spread, state)
+        };
+        (transfer, error)
+    }
+
+    /// The light an element-to-element link with form factor `factor` (spread `spread` over
+    /// the receiver) carries wrongly.
+    fn factor_error(&self, r: u32, s: u32, factor: f64, spread: f64, state: &Radiosities) -> f64 {
+        let h = self.hierarchy;
+        let (rn, sn) = (h.node(r), h.node(s));
+        let b = state.b[s as usize];
+        // The disc stands for a source of some size: off by about (radius / distance)².
+        let size = match sn.children {
+            None => 0.0,
+            Some(_) => {
+                let d2 = rn
+                    .centroid
+                    .distance_squared(sn.centroid)
+                    .max(f64::MIN_POSITIVE);
+                factor * sn.radius * sn.radius / d2
+            }
+        };
+        let variation = match sn.children {
+            None => Rgb::ZERO,
+            Some(children) => children
+                .iter()
+                .map(|&c| (state.b[c as usize] - b).map(f64::abs))
+                .fold(Rgb::ZERO, |m, d| {
+                    Rgb::new(m.r.max(d.r), m.g.max(d.g), m.b.max(d.b))
+                }),
+        };
+        let wrong = b * (spread + size) + variation * factor;
+        rn.reflectance.mul_rgb(wrong).mean() * rn.area
+    }
+
+    /// The error a kept link still carries, with the radiosities as they are now: links over
+    /// `tolerance` are refined again.
+    pub fn error_of(&self, link: &Link, state: &Radiosities) -> f64 {
+        match link.transfer {
+            Transfer::Factor { factor, spread } => {
+                let (rn, sn) = (
+                    self.hierarchy.node(link.receiver),
+                    self.hierarchy.node(link.source),
+                );
+                let touching = rn.centroid.distance(sn.centroid) <= rn.radius + sn.radius;
+                if touching && (rn.children.is_some() || sn.children.is_some()) {
+                    self.estimate(link.receiver, link.source, state).1
+                } else {
+                    self.factor_error(link.receiver, link.source, factor, spread, state)
+                }
+            }
+            Transfer::Far { .. } => self.estimate(link.receiver, link.source, state).1,
+        }
+    }
+
+    /// The transfer times the fraction of stratified segments between the two nodes that
+    /// nothing blocks (weighted by the form-factor kernel between elements).
+    fn occlude(&self, r: u32, s: u32, transfer: Transfer, counts: &mut RefineCounts) -> Transfer {
+        let h = self.hierarchy;
+        let mut rng = SplitMix64::keyed(self.seed, &[r as u64, s as u64]);
+        let vis = self.visibility();
+        let offset = vis.junction_offset();
+        let (mut seen, mut weight) = (0.0, 0.0);
+        for k in 0..self.rays {
+            let (x, xt) = h.sample(r, k, self.rays, &mut rng);
+            let (y, yt) = h.sample(s, (k * 7 + 3) % self.rays, self.rays, &mut rng);
+            let (xs, ys) = (xt.surface, yt.surface);
+            let d = y - x;
+            let w = (xt.normal.dot(d) * -yt.normal.dot(d)).max(0.0) / d.length_squared().powi(2);
+            if !(w > 0.0) {
+                continue;
+            }
+            weight += w;
+            counts.rays += 1;
+            // Each end moves off its surface a little, so that no segment runs along a surface
+            // it starts on.
+            let from = x + d.normalize_or_zero() * offset;
+            let to = y - d.normalize_or_zero() * offset;
+            if !vis.occluded(from, to, [xs, ys]) {
+                seen += w;
+            }
+        }
+        let visible = if weight > 0.0 { seen / weight } else { 1.0 };
+        match transfer {
+            Transfer::Factor { factor, spread } => Transfer::Factor {
+                factor: factor * visible,
+                spread,
+            },
+            Transfer::Far {
+                direction,
+                distance2,
+                ..
+            } => Transfer::Far {
+                direction,
+                distance2,
+                visible,
+            },
+        }
+    }
+}
+
+/// Whether element `a` lies wholly behind (or in) the plane of element `b` (so `b` cannot send
+/// it light, nor receive light from it); never for clusters.
+fn behind(a: &Node, b: &Node, tol: f64) -> bool {
+    if b.is_cluster() {
+        return false;
+    }
+    a.hull.iter().all(|&p| b.normal.dot(p - b.centroid) <= tol)
+}

@@ -1,0 +1,423 @@
+//! Hierarchical radiosity with clustering on the discontinuity mesh (Hanrahan, Salzman &
+//! Aupperle 1991; Smits, Arvo & Greenberg 1994; Sillion 1995; combined with discontinuity
+//! meshing as in Lischinski, Tampieri & Greenberg 1993).
+//!
+//! 1. Every vertex of the display mesh gets the exact direct light, as in the other solvers; each
+//!    triangle reflects its mean, exactly (the integral of the linear interpolant).
+//! 2. The hierarchy ([`tree`]) is built over the mesh's triangles and the surfaces, and linked
+//!    from the root cluster down, each link as coarse as the oracle allows ([`links`]), with
+//!    visibility from shaft culling ([`shaft`]) and rays only where a shaft holds blockers.
+//! 3. Jacobi sweeps with push–pull ([`iterate`]) carry the reflected light until the relative
+//!    residual is below `epsilon`; the links are then judged again with the new radiosities,
+//!    those carrying too much light wrongly are refined, and the sweeps go on, until no link
+//!    changes.
+//! 4. Every display vertex gathers the reflected light along the links of its leaf and the
+//!    leaf's ancestors ([`final_gather`]).
+//!
+//! The light a link may carry wrongly is `link_tol` of the emitted power: a larger scene with the
+//! same light gets links no finer where its light is weak, so the links grow about linearly with
+//! the scene. Results do not depend on the thread count: every parallel step collects in order.
+
+mod final_gather;
+mod iterate;
+mod links;
+mod shaft;
+mod transfer;
+mod tree;
+
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Instant;
+
+use penumbra_meshing::SceneMesh;
+use penumbra_scenes::{Rgb, Scene, Visibility};
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::elements::Discretization;
+use crate::error::SolveError;
+use crate::progress::Progress;
+use crate::progressive::{
+    ConvergencePoint, Solution, SolveStats, SolverOptions, StopReason, check_mesh,
+    direct_irradiance,
+};
+use final_gather::FinalGather;
+use iterate::{Field, System};
+use links::{Link, RefineCounts, Refiner};
+use shaft::Shafts;
+use tree::{Hierarchy, NONE};
+
+/// The light a link may carry wrongly by default, as a fraction of the emitted power.
+pub const DEFAULT_LINK_TOL: f64 = 1e-5;
+
+/// Refinement passes at most: link, solve, refine the links the new radiosities condemn, solve
+/// again.
+pub const MAX_PASSES: usize = 6;
+
+/// Figures of a hierarchical solve, under `solver.hierarchy` in `report.json`.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct HierarchyStats {
+    pub link_tol: f64,
+    /// Element nodes (parts of surfaces), of which leaves (the mesh's triangles).
+    pub elements: usize,
+    pub leaves: usize,
+    pub clusters: usize,
+    pub links: usize,
+    /// Links by visibility: open (no blocker in the shaft), partial (rays decide).
+    pub links_open: usize,
+    pub links_partial: usize,
+    /// Links from or to a cluster.
+    pub links_with_clusters: usize,
+    /// Links by the depth of their receiver (0: the root cluster).
+    pub links_by_depth: Vec<usize>,
+    /// Pairs of nodes found hidden by one polygon, and not linked.
+    pub hidden_pairs: u64,
+    pub refinement_passes: usize,
+    /// Rays for the links' visibility, and for the final gather's partial links.
+    pub link_rays: u64,
+    pub gather_rays: u64,
+    /// Jacobi sweeps, over all passes.
+    pub sweeps: usize,
+    pub link_seconds: f64,
+    pub sweep_seconds: f64,
+    /// Bytes held by the links.
+    pub link_bytes: u64,
+}
+
+/// Solves a meshed scene by hierarchical radiosity; the display values come from a final gather
+/// at every vertex.
+pub fn solve_hierarchical(
+    scene: &Scene,
+    mesh: &SceneMesh,
+    visibility: &Visibility,
+    options: &SolverOptions,
+    progress: &dyn Progress,
+) -> Result<Solution, SolveError> {
+    options.validate()?;
+    check_mesh(scene, mesh)?;
+    let started = Instant::now();
+    let disc = Discretization::new(scene, mesh, options.elements_per_patch);
+    let (direct, direct_beyond_cap) =
+        direct_irradiance(scene, &disc, visibility, options, progress)?;
+    let direct_seconds = started.elapsed().as_secs_f64();
+
+    let started = Instant::now();
+    let hierarchy = Hierarchy::build(&disc, |s| scene.surfaces[s].reflectance);
+    let mut leaf_direct = vec![Rgb::ZERO; hierarchy.nodes.len()];
+    for (e, &leaf) in hierarchy.leaf_of_element.iter().enumerate() {
+        if leaf != NONE {
+            let el = &disc.elements[e];
+            let mean = el.vertices.iter().map(|&v| direct[v]).sum::<Rgb>() / 3.0;
+            leaf_direct[leaf as usize] = scene.surfaces[el.surface].reflectance.mul_rgb(mean);
+        }
+    }
+    let mut system = System::new(&hierarchy, leaf_direct);
+    let shafts = Shafts::new(scene, visibility);
+    let emitted = scene.emitted_power();
+    let refiner = Refiner {
+        hierarchy: &hierarchy,
+        shafts: &shafts,
+        tolerance: options.link_tol * emitted.mean(),
+        rays: options.visibility_rays,
+        seed: options.seed,
+        tol: visibility.contact_distance(),
+    };
+    let mut stats = HierarchyStats {
+        link_tol: options.link_tol,
+        elements: hierarchy.nodes.iter().filter(|n| !n.is_cluster()).count(),
+        leaves: hierarchy.nodes.iter().filter(|n| n.is_leaf()).count(),
+        clusters: system.clusters,
+        ..HierarchyStats::default()
+    };
+    let mut field = system.initial_field();
+    let mut history = Vec::new();
+    let mut stop;
+    let mut residual = f64::INFINITY;
+    let mut link_seconds = 0.0;
+    let mut sweep_seconds = 0.0;
+    if let Some(root) = hierarchy.root {
+        let t = Instant::now();
+        progress.start("linking", 1);
+        let (links, counts) = refine_pair(&refiner, root, root, &system.radiosities(&field));
+        progress.finish();
+        add_counts(&mut stats, counts);
+        system.set_links(links);
+        link_seconds += t.elapsed().as_secs_f64();
+        'passes: loop {
+            let t = Instant::now();
+            progress.start("sweeps", 1000);
+            let goal = -options.epsilon.log10();
+            loop {
+                if let Some(reason) = options.stop_now() {
+                    stop = reason;
+                    break 'passes;
+                }
+                if stats.sweeps >= options.max_shots {
+                    stop = StopReason::ShotLimit;
+                    break 'passes;
+                }
+                let next = system.sweep(&field);
+                let (change, _) = system.change(&field, &next);
+                field = next;
+                stats.sweeps += 1;
+                residual = change;
+                history.push(ConvergencePoint {
+                    iteration: stats.sweeps,
+                    residual,
+                    seconds: direct_seconds + started.elapsed().as_secs_f64(),
+                });
+                progress
+                    .set(((-residual.max(1e-300).log10() / goal).clamp(0.0, 1.0) * 1000.0) as u64);
+                if residual < options.epsilon {
+                    stop = StopReason::Converged;
+                    break;
+                }
+            }
+            progress.finish();
+            sweep_seconds += t.elapsed().as_secs_f64();
+            stats.refinement_passes += 1;
+            if stats.refinement_passes >= MAX_PASSES {
+                break;
+            }
+            let t = Instant::now();
+            let relinked = relink(&refiner, &system, &field);
+            link_seconds += t.elapsed().as_secs_f64();
+            match relinked {
+                Some((links, counts)) => {
+                    add_counts(&mut stats, counts);
+                    system.set_links(links);
+                }
+                None => break,
+            }
+        }
+    } else {
+        stop = StopReason::Converged;
+        residual = 0.0;
+    }
+    stats.link_seconds = link_seconds;
+    stats.sweep_seconds = sweep_seconds;
+    link_figures(&mut stats, &system);
+    let solve_seconds = started.elapsed().as_secs_f64();
+
+    // The final gather, unless the run must stop: then each vertex keeps its leaf's value.
+    let t = Instant::now();
+    let vertex_leaf = vertex_leaves(&disc, &hierarchy);
+    let quick: Vec<Rgb> = vertex_leaf
+        .iter()
+        .map(|&l| {
+            if l == NONE {
+                Rgb::ZERO
+            } else {
+                field.irradiance[l as usize]
+            }
+        })
+        .collect();
+    let gather = FinalGather {
+        system: &system,
+        field: &field,
+        visibility,
+        rays: options.visibility_rays,
+        seed: options.seed,
+    };
+    let gathered = if options.stop_now().is_some() {
+        None
+    } else {
+        final_gather_all(&disc, &vertex_leaf, &gather, options, progress)
+    };
+    let reflected = match gathered {
+        Some((values, rays)) => {
+            stats.gather_rays = rays;
+            values
+        }
+        None => {
+            stop = options.stop_now().unwrap_or(stop);
+            quick
+        }
+    };
+    let gather_seconds = t.elapsed().as_secs_f64();
+
+    let irradiance: Vec<Rgb> = direct
+        .iter()
+        .zip(&reflected)
+        .map(|(&d, &r)| d + r)
+        .collect();
+    let radiosity: Vec<Rgb> = (0..disc.receiver_count())
+        .map(|v| disc.emission[v] + disc.reflectance[v].mul_rgb(irradiance[v]))
+        .collect();
+    let absorbed = disc.integrate(&irradiance, |e| {
+        Rgb::splat(1.0) - scene.surfaces[e.surface].reflectance
+    });
+    let reflected_power = disc.integrate(&irradiance, |e| scene.surfaces[e.surface].reflectance);
+    let received = disc.integrate(&irradiance, |_| Rgb::splat(1.0));
+    let sent: Rgb = hierarchy
+        .nodes
+        .iter()
+        .enumerate()
+        .filter(|(_, n)| n.is_leaf() && !n.is_cluster())
+        .map(|(i, n)| field.b[i] * n.area)
+        .sum();
+    let unshot = reflected_power - sent;
+    let solve_stats = SolveStats {
+        stop,
+        shots: 0,
+        iterations: stats.sweeps,
+        residual: if residual.is_finite() { residual } else { 1.0 },
+        patches: stats.leaves,
+        receivers: disc.receiver_count(),
+        rays_cast: stats.link_rays + stats.gather_rays,
+        emitted,
+        absorbed,
+        unshot,
+        escaped: emitted + sent - received,
+        unshot_fraction: unshot.mean().abs() / emitted.mean().max(f64::MIN_POSITIVE),
+        direct_seconds,
+        direct_estimated: direct_beyond_cap,
+        direct_beyond_cap,
+        shooting_seconds: solve_seconds,
+        remeshes: 0,
+        gathered: disc.receiver_count(),
+        gather_seconds,
+        hierarchy: Some(stats),
+    };
+    Ok(Solution {
+        radiosity: disc.per_surface(&radiosity),
+        irradiance: disc.per_surface(&irradiance),
+        ambient: Rgb::ZERO,
+        stats: solve_stats,
+        convergence: history,
+    })
+}
+
+fn add_counts(stats: &mut HierarchyStats, counts: RefineCounts) {
+    stats.hidden_pairs += counts.hidden;
+    stats.link_rays += counts.rays;
+}
+
+/// Counts of the links as they are.
+fn link_figures(stats: &mut HierarchyStats, system: &System) {
+    let h = system.hierarchy;
+    stats.links = system.links.len();
+    stats.links_partial = system.links.iter().filter(|l| l.partial).count();
+    stats.links_open = stats.links - stats.links_partial;
+    stats.links_with_clusters = system
+        .links
+        .iter()
+        .filter(|l| h.node(l.receiver).is_cluster() || h.node(l.source).is_cluster())
+        .count();
+    let mut by_depth = Vec::new();
+    for l in &system.links {
+        let d = h.node(l.receiver).depth as usize;
+        if by_depth.len() <= d {
+            by_depth.resize(d + 1, 0);
+        }
+        by_depth[d] += 1;
+    }
+    stats.links_by_depth = by_depth;
+    stats.link_bytes =
+        (system.links.capacity() * size_of::<Link>() + system.first_link.capacity() * 4) as u64;
+}
+
+/// The links that replace the link from `s` to `r`, and what finding them counted; the children
+/// of shallow pairs are refined in parallel, and collected in order.
+fn refine_pair(
+    refiner: &Refiner,
+    r: u32,
+    s: u32,
+    state: &links::Radiosities,
+) -> (Vec<Link>, RefineCounts) {
+    let mut out = Vec::new();
+    let mut counts = RefineCounts::default();
+    refiner.refine(r, s, None, state, &mut out, &mut counts);
+    (out, counts)
+}
+
+/// The links judged again with the radiosities of `field`: each link carrying more light wrongly
+/// than the tolerance is refined; `None` when none is.
+fn relink(refiner: &Refiner, system: &System, field: &Field) -> Option<(Vec<Link>, RefineCounts)> {
+    let state = system.radiosities(field);
+    let h = system.hierarchy;
+    let splittable = |l: &Link| !(h.node(l.receiver).is_leaf() && h.node(l.source).is_leaf());
+    let condemned: Vec<bool> = system
+        .links
+        .par_iter()
+        .map(|l| splittable(l) && refiner.error_of(l, &state) > refiner.tolerance)
+        .collect();
+    if !condemned.iter().any(|&c| c) {
+        return None;
+    }
+    let parts: Vec<(Vec<Link>, RefineCounts)> = system
+        .links
+        .par_iter()
+        .zip(&condemned)
+        .map(|(l, &c)| {
+            if c {
+                refine_pair(refiner, l.receiver, l.source, &state)
+            } else {
+                (vec![*l], RefineCounts::default())
+            }
+        })
+        .collect();
+    let mut links = Vec::new();
+    let mut counts = RefineCounts::default();
+    for (part, c) in parts {
+        links.extend(part);
+        counts.add(c);
+    }
+    Some((links, counts))
+}
+
+/// For each vertex, the leaf of the first element (in the discretization's order) that holds it;
+/// `NONE` on surfaces that reflect nothing.
+fn vertex_leaves(disc: &Discretization, hierarchy: &Hierarchy) -> Vec<u32> {
+    let mut leaf = vec![NONE; disc.receiver_count()];
+    for (e, el) in disc.elements.iter().enumerate() {
+        let l = hierarchy.leaf_of_element[e];
+        if l == NONE {
+            continue;
+        }
+        for &v in &el.vertices {
+            if leaf[v] == NONE {
+                leaf[v] = l;
+            }
+        }
+    }
+    leaf
+}
+
+/// The final gather at every vertex, in parallel and in order, with a progress bar, and the
+/// rays it cast; `None` if the run must stop first.
+fn final_gather_all(
+    disc: &Discretization,
+    vertex_leaf: &[u32],
+    gather: &FinalGather,
+    options: &SolverOptions,
+    progress: &dyn Progress,
+) -> Option<(Vec<Rgb>, u64)> {
+    let n = disc.receiver_count();
+    progress.start("final gather", n as u64);
+    let done = AtomicU64::new(0);
+    let values: Vec<Option<(Rgb, u64)>> = (0..n)
+        .into_par_iter()
+        .map(|v| {
+            if options.stop_now().is_some() {
+                return None;
+            }
+            let leaf = vertex_leaf[v];
+            let value = if leaf == NONE || disc.reflectance[v].max_channel() <= 0.0 {
+                (Rgb::ZERO, 0)
+            } else {
+                gather.irradiance(&disc.receivers[v], disc.receiver_surface[v], leaf, v as u64)
+            };
+            let d = done.fetch_add(1, Ordering::Relaxed);
+            if d.is_multiple_of(256) {
+                progress.set(d);
+            }
+            Some(value)
+        })
+        .collect();
+    progress.finish();
+    let values: Option<Vec<(Rgb, u64)>> = values.into_iter().collect();
+    values.map(|v| {
+        let rays = v.iter().map(|&(_, r)| r).sum();
+        (v.into_iter().map(|(h, _)| h).collect(), rays)
+    })
+}
