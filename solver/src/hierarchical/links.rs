@@ -21,7 +21,9 @@ use penumbra_scenes::{Rgb, Visibility};
 use rayon::prelude::*;
 
 use super::shaft::{Shafts, Sight};
-use super::transfer::{Axes, cluster_intensity, disc_factor, element_intensity};
+use super::transfer::{
+    Axes, cluster_intensity, element_intensity, far_factor, point_factor, triangle_mean,
+};
 use super::tree::{Hierarchy, Node};
 use crate::lambert::{ReceivingPoint, form_factor};
 
@@ -95,6 +97,14 @@ impl RefineCounts {
         self.rays += other.rays;
     }
 }
+
+/// A leaf's form factor to a source is integrated finely when it varies over the leaf by more
+/// than this fraction of its mean, in at most [`LEAF_DEPTH`] rounds of splitting in four.
+const LEAF_SPREAD: f64 = 0.05;
+const LEAF_DEPTH: u32 = 3;
+
+/// How far toward a receiver's corners its form factors are judged, from its centroid.
+const CORNER_SHRINK: f64 = 0.98;
 
 /// Below this sum of the two nodes' depths, a link's children are refined in parallel.
 const PARALLEL_DEPTH: u16 = 10;
@@ -175,6 +185,7 @@ impl Refiner<'_> {
             }
             None => {
                 let partial = !blockers.is_empty();
+                let transfer = transfer.unwrap_or_else(|| self.factor(r, s).0);
                 let transfer = if partial {
                     self.occlude(r, s, transfer, counts)
                 } else {
@@ -223,24 +234,11 @@ impl Refiner<'_> {
     /// The link's unoccluded transfer, and the light it would carry wrongly (W). Nodes nearer
     /// than their radii allow no estimate but a bound: the receiver reflects at most all the
     /// light the source sends, and at most its own area times the source's radiosity.
-    fn estimate(&self, r: u32, s: u32, state: &Radiosities) -> (Transfer, f64) {
+    fn estimate(&self, r: u32, s: u32, state: &Radiosities) -> (Option<Transfer>, f64) {
         let h = self.hierarchy;
         let (rn, sn) = (h.node(r), h.node(s));
         let touching = rn.centroid.distance(sn.centroid) <= rn.radius + sn.radius;
-        let bound = || {
-            let power = state.power(sn, s);
-            let limit = if sn.is_cluster() || rn.is_cluster() {
-                power
-            } else {
-                let b = state.b[s as usize];
-                Rgb::new(
-                    power.r.min(b.r * rn.area),
-                    power.g.min(b.g * rn.area),
-                    power.b.min(b.b * rn.area),
-                )
-            };
-            rn.reflectance.mul_rgb(limit).mean()
-        };
+        let bound = || self.bound(r, s, state);
         if rn.is_cluster() || sn.is_cluster() {
             let offset = rn.centroid - sn.centroid;
             let distance2 = offset.length_squared().max(f64::MIN_POSITIVE);
@@ -251,7 +249,7 @@ impl Refiner<'_> {
                 visible: 1.0,
             };
             if touching {
-                return (transfer, bound());
+                return (Some(transfer), bound());
             }
             let facing = if rn.is_cluster() {
                 1.0
@@ -259,36 +257,77 @@ impl Refiner<'_> {
                 rn.normal.dot(-direction).max(0.0)
             };
             let irradiance = state.intensity(sn, s, direction) * (facing / distance2);
+            if std::env::var("NOCLUSTER").is_ok() { return (Some(transfer), f64::INFINITY); }
             return (
-                transfer,
+                Some(transfer),
                 rn.reflectance.mul_rgb(irradiance).mean() * rn.area,
             );
         }
-        let points = h.quadrature(r);
-        let factors: smallvec::SmallVec<[f64; 4]> = points
-            .iter()
-            .map(|&(p, _)| {
-                let x = ReceivingPoint::interior(p, rn.normal);
-                match sn.children {
-                    None => form_factor(&x, &h.triangles[sn.first as usize].points, self.tol),
-                    Some(_) => disc_factor(p, rn.normal, sn.centroid, sn.normal, sn.area),
-                }
-            })
-            .collect();
-        let factor: f64 = factors.iter().zip(&points).map(|(f, (_, w))| f * w).sum();
-        let (lo, hi) = factors
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &f| {
-                (lo.min(f), hi.max(f))
-            });
-        let spread = (hi - lo).max(0.0);
-        let transfer = Transfer::Factor { factor, spread };
+        // Nodes whose spheres overlap allow no estimate, only the bound; otherwise a quick one
+        // decides, and a kept link gets its factor the careful way.
+        let touching = rn.centroid.distance(sn.centroid) <= rn.radius + sn.radius;
         let error = if touching && (rn.children.is_some() || sn.children.is_some()) {
-            bound()
+            self.bound(r, s, state)
         } else {
+            let (factor, spread) = self.quick_factor(r, s);
             self.factor_error(r, s, factor, spread, state)
         };
-        (transfer, error)
+        (None, error)
+    }
+
+    /// The form factor from element `r` to element `s` at `r`'s quadrature points and corners,
+    /// `s` seen from afar (or exactly, if a leaf): their weighted mean and their spread.
+    fn quick_factor(&self, r: u32, s: u32) -> (f64, f64) {
+        let h = self.hierarchy;
+        let (rn, sn) = (h.node(r), h.node(s));
+        let at = |p: DVec3| match sn.children {
+            None => form_factor(
+                &ReceivingPoint::interior(p, rn.normal),
+                &h.triangles[sn.first as usize].points,
+                self.tol,
+            ),
+            Some(_) => far_factor(p, rn.normal, sn),
+        };
+        let points = h.quadrature(r);
+        let factors: smallvec::SmallVec<[f64; 4]> = points.iter().map(|&(p, _)| at(p)).collect();
+        let factor: f64 = factors.iter().zip(&points).map(|(f, (_, w))| f * w).sum();
+        (factor, spread(&factors, rn, at))
+    }
+
+    /// What a link can carry at most: the receiver reflects at most all the light the source
+    /// sends, and at most its own area times the source's radiosity.
+    fn bound(&self, r: u32, s: u32, state: &Radiosities) -> f64 {
+        let (rn, sn) = (self.hierarchy.node(r), self.hierarchy.node(s));
+        let power = state.power(sn, s);
+        let limit = if sn.is_cluster() || rn.is_cluster() {
+            power
+        } else {
+            let b = state.b[s as usize];
+            Rgb::new(
+                power.r.min(b.r * rn.area),
+                power.g.min(b.g * rn.area),
+                power.b.min(b.b * rn.area),
+            )
+        };
+        rn.reflectance.mul_rgb(limit).mean()
+    }
+
+    /// The mean form factor from element `r` to element `s`, and its spread over `r`.
+    fn factor(&self, r: u32, s: u32) -> (Transfer, f64) {
+        let h = self.hierarchy;
+        let rn = h.node(r);
+        let points = h.quadrature(r);
+        let at = |p: DVec3| point_factor(h, &ReceivingPoint::interior(p, rn.normal), s, self.tol);
+        let factors: smallvec::SmallVec<[f64; 4]> = points.iter().map(|&(p, _)| at(p)).collect();
+        let mut factor: f64 = factors.iter().zip(&points).map(|(f, (_, w))| f * w).sum();
+        let spread = spread(&factors, rn, at);
+        // A leaf cannot be split: where the form factor varies much over it (next to a
+        // junction, where it rises toward one half), its mean is integrated more finely.
+        if rn.is_leaf() && spread > LEAF_SPREAD * factor {
+            let t = &h.triangles[rn.first as usize].points;
+            factor = triangle_mean(t, &at, LEAF_DEPTH);
+        }
+        (Transfer::Factor { factor, spread }, spread)
     }
 
     /// The light an element-to-element link with form factor `factor` (spread `spread` over
@@ -298,16 +337,6 @@ impl Refiner<'_> {
         let (rn, sn) = (h.node(r), h.node(s));
         let b = state.b[s as usize];
         // The disc stands for a source of some size: off by about (radius / distance)².
-        let size = match sn.children {
-            None => 0.0,
-            Some(_) => {
-                let d2 = rn
-                    .centroid
-                    .distance_squared(sn.centroid)
-                    .max(f64::MIN_POSITIVE);
-                factor * sn.radius * sn.radius / d2
-            }
-        };
         let variation = match sn.children {
             None => Rgb::ZERO,
             Some(children) => children
@@ -317,27 +346,25 @@ impl Refiner<'_> {
                     Rgb::new(m.r.max(d.r), m.g.max(d.g), m.b.max(d.b))
                 }),
         };
-        let wrong = b * (spread + size) + variation * factor;
+        let wrong = b * spread + variation * factor;
         rn.reflectance.mul_rgb(wrong).mean() * rn.area
     }
 
     /// The error a kept link still carries, with the radiosities as they are now: links over
     /// `tolerance` are refined again.
     pub fn error_of(&self, link: &Link, state: &Radiosities) -> f64 {
+        let (r, s) = (link.receiver, link.source);
+        let (rn, sn) = (self.hierarchy.node(r), self.hierarchy.node(s));
         match link.transfer {
             Transfer::Factor { factor, spread } => {
-                let (rn, sn) = (
-                    self.hierarchy.node(link.receiver),
-                    self.hierarchy.node(link.source),
-                );
                 let touching = rn.centroid.distance(sn.centroid) <= rn.radius + sn.radius;
                 if touching && (rn.children.is_some() || sn.children.is_some()) {
-                    self.estimate(link.receiver, link.source, state).1
+                    self.bound(r, s, state)
                 } else {
-                    self.factor_error(link.receiver, link.source, factor, spread, state)
+                    self.factor_error(r, s, factor, spread, state)
                 }
             }
-            Transfer::Far { .. } => self.estimate(link.receiver, link.source, state).1,
+            Transfer::Far { .. } => self.estimate(r, s, state).1,
         }
     }
 
@@ -385,6 +412,24 @@ impl Refiner<'_> {
             },
         }
     }
+}
+
+/// The range of `factors` and of `at` at the receiver's corners. The spread is judged at its
+/// extremes too (its hull's corners, drawn in a little off any plane they touch): next to a
+/// junction the form factor changes most at the edge, where no inner point sees it.
+fn spread(factors: &[f64], rn: &Node, at: impl Fn(DVec3) -> f64) -> f64 {
+    let corners = rn
+        .hull
+        .iter()
+        .map(|&c| at(rn.centroid + (c - rn.centroid) * CORNER_SHRINK));
+    let (lo, hi) = factors
+        .iter()
+        .copied()
+        .chain(corners)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), f| {
+            (lo.min(f), hi.max(f))
+        });
+    (hi - lo).max(0.0)
 }
 
 /// Whether element `a` lies wholly behind (or in) the plane of element `b` (so `b` cannot send

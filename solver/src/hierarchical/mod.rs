@@ -421,3 +421,120 @@ fn final_gather_all(
         (v.into_iter().map(|(h, _)| h).collect(), rays)
     })
 }
+
+#[cfg(test)]
+mod debug_tests {
+    use super::*;
+    use penumbra_meshing::mesh_scene_uniform;
+    use penumbra_scenes::builtin;
+
+    #[test]
+    fn corner_sum() {
+        let scene = builtin::furnace(1.0, 0.5);
+        let vis = Visibility::build(&scene);
+        let mesh = mesh_scene_uniform(&scene, 1200).unwrap();
+        let disc = Discretization::new(&scene, &mesh, 24);
+        let hierarchy = Hierarchy::build(&disc, |s| scene.surfaces[s].reflectance);
+        let leaf_direct = vec![Rgb::splat(0.5); hierarchy.nodes.len()];
+        let mut system = System::new(&hierarchy, leaf_direct);
+        let shafts = Shafts::new(&scene, &vis);
+        let refiner = Refiner { hierarchy: &hierarchy, shafts: &shafts, tolerance: 1e-5 * 6.0, rays: 16, seed: 1, tol: vis.contact_distance() };
+        let field = system.initial_field();
+        let root = hierarchy.root.unwrap();
+        let (links, _) = refine_pair(&refiner, root, root, &system.radiosities(&field));
+        system.set_links(links);
+        let leaves = vertex_leaves(&disc, &hierarchy);
+        let mut rows = vec![];
+        for (i, n) in hierarchy.nodes.iter().enumerate() {
+            if !n.is_leaf() { continue; }
+            let mut sum = 0.0;
+            for node in hierarchy.ancestry(i as u32) {
+                for l in system.links_of(node) {
+                    match l.transfer { links::Transfer::Factor { factor, .. } => sum += factor, _ => sum += 1000.0 }
+                }
+            }
+            rows.push((sum, n.centroid, n.surface));
+        }
+        rows.sort_by(|a, b| a.0.total_cmp(&b.0));
+        for r in rows.iter().take(4).chain(rows.iter().rev().take(6)) { eprintln!("row {:?}", r); }
+        let worst = hierarchy.nodes.iter().position(|n| n.is_leaf() && n.centroid.distance(rows.last().unwrap().1) < 1e-12).unwrap();
+        let mut per = vec![0.0; 6];
+        for node in hierarchy.ancestry(worst as u32) {
+            for l in system.links_of(node) {
+                let sn = hierarchy.node(l.source);
+                if let links::Transfer::Factor { factor, spread } = l.transfer {
+                    per[sn.surface.unwrap()] += factor;
+                    if factor > 0.01 { eprintln!("  recv depth {} src {} depth {} leaf {} c {:?} r {:.3} F {factor:.4} spread {spread:.4} partial {}", hierarchy.node(node).depth, l.source, sn.depth, sn.is_leaf(), sn.centroid, sn.radius, l.partial); }
+                }
+            }
+        }
+        eprintln!("per surface {:?}", per);
+        let mut ranges = vec![];
+        for node in hierarchy.ancestry(worst as u32) {
+            for l in system.links_of(node) {
+                let sn = hierarchy.node(l.source);
+                if sn.surface == Some(4) { ranges.push((sn.first, sn.end, sn.area, l.source)); }
+            }
+        }
+        ranges.sort_by_key(|r| (r.0, r.1));
+        let area: f64 = ranges.iter().map(|r| r.2).sum();
+        eprintln!("wall sources {} area {area}", ranges.len());
+        {
+            let tol = vis.contact_distance();
+            let rn = hierarchy.node(worst as u32);
+            let t = hierarchy.triangles[rn.first as usize].points;
+            let mut diffs = vec![];
+            for node in hierarchy.ancestry(worst as u32) {
+                for l in system.links_of(node) {
+                    if let links::Transfer::Factor { factor, .. } = l.transfer {
+                        let at = |p: glam::DVec3| transfer::point_factor(&hierarchy, &crate::lambert::ReceivingPoint::interior(p, rn.normal), l.source, tol);
+                        let own = transfer::triangle_mean(&t, &at, 4);
+                        diffs.push((factor - own, factor, own, hierarchy.node(node).depth, l.source, hierarchy.node(l.source).surface));
+                    }
+                }
+            }
+            let total: f64 = diffs.iter().map(|d| d.0).sum();
+            diffs.sort_by(|a, b| b.0.abs().total_cmp(&a.0.abs()));
+            eprintln!("total diff {total}");
+            for d in diffs.iter().take(8) { eprintln!("diff {:?}", d); }
+        }
+        let wall_root = { let mut n = ranges[0].3; while hierarchy.node(n).parent != NONE && hierarchy.node(hierarchy.node(n).parent).surface == Some(4) { n = hierarchy.node(n).parent; } n };
+        for (p, _) in hierarchy.quadrature(worst as u32) {
+            let tol = vis.contact_distance();
+            let x = crate::lambert::ReceivingPoint::interior(p, hierarchy.node(worst as u32).normal);
+            let exact = crate::lambert::form_factor(&x, &scene.surfaces[4].polygon, tol);
+            let pf = transfer::point_factor(&hierarchy, &x, wall_root, tol);
+            let links_sum: f64 = ranges.iter().map(|r| transfer::point_factor(&hierarchy, &x, r.3, tol)).sum();
+            eprintln!("point {p:?}: exact {exact} root {pf} links {links_sum}");
+        }
+        for w in ranges.windows(2) { if w[0].1 > w[1].0 { eprintln!("overlap {:?} {:?}", w[0], w[1]); } }
+        let rn = hierarchy.node(worst as u32);
+        let tol = vis.contact_distance();
+        let t = hierarchy.triangles[rn.first as usize].points;
+        eprintln!("receiver tri {:?}", t);
+        for src in [483u32, 481] {
+            eprintln!("src tri {:?}", hierarchy.triangles[hierarchy.node(src).first as usize].points);
+            let at = |p: glam::DVec3| transfer::point_factor(&hierarchy, &crate::lambert::ReceivingPoint::interior(p, rn.normal), src, tol);
+            for d in 0..7 { eprintln!("depth {d}: {}", transfer::triangle_mean(&t, &at, d)); }
+            let mut rng = penumbra_scenes::rng::SplitMix64::new(3);
+            let mut sum = 0.0; let n = 200000;
+            for _ in 0..n { let (r1, r2) = (rng.next_f64().sqrt(), rng.next_f64()); let p = t[0] * (1.0 - r1) + t[1] * (r1 * (1.0 - r2)) + t[2] * (r1 * r2); sum += at(p); }
+            eprintln!("mc {}", sum / n as f64);
+        }
+        let tol = vis.contact_distance();
+        for v in 0..disc.receiver_count() {
+            let x = &disc.receivers[v];
+            if x.point.length() > 1e-9 { continue; }
+            let mut sum = 0.0;
+            let mut per_surface = vec![0.0; 6];
+            for node in hierarchy.ancestry(leaves[v]) {
+                for l in system.links_of(node) {
+                    let f = transfer::point_factor(&hierarchy, x, l.source, tol);
+                    sum += f;
+                    per_surface[hierarchy.node(l.source).surface.unwrap()] += f;
+                }
+            }
+            eprintln!("vertex {v} surface {} inward {:?}: {sum} {:?}", disc.receiver_surface[v], x.inward, per_surface);
+        }
+    }
+}

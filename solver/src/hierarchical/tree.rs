@@ -39,6 +39,10 @@ pub(crate) struct Node {
     /// Points whose convex hull holds the node: a leaf's triangle, an element's bounding
     /// rectangle in its plane, or a cluster's box.
     pub hull: SmallVec<[DVec3; 8]>,
+    /// An element's principal half-axes in its plane, scaled so that the four points centroid
+    /// ± axis, each with a quarter of the area, have the element's second moments of area (zero
+    /// for clusters).
+    pub axes: [DVec3; 2],
     /// An element's reflectance; for a cluster, the largest of its surfaces' per channel.
     pub reflectance: Rgb,
     pub depth: u16,
@@ -89,6 +93,7 @@ impl Hierarchy {
             disc,
             reflectance: &reflectance,
             by_surface,
+            moments: Vec::new(),
             hierarchy: Hierarchy {
                 nodes: Vec::new(),
                 root: None,
@@ -192,10 +197,13 @@ struct Builder<'a, F> {
     reflectance: &'a F,
     by_surface: Vec<Vec<u32>>,
     hierarchy: Hierarchy,
+    /// Per node, an element's second moment of area about its centroid, in its plane's axes.
+    moments: Vec<Moment>,
 }
 
 impl<F: Fn(SurfaceId) -> Rgb> Builder<'_, F> {
     fn push(&mut self, node: Node) -> u32 {
+        self.moments.push(Moment::default());
         self.hierarchy.nodes.push(node);
         (self.hierarchy.nodes.len() - 1) as u32
     }
@@ -203,8 +211,8 @@ impl<F: Fn(SurfaceId) -> Rgb> Builder<'_, F> {
     /// A cluster over `surfaces` (or the surface's own tree, for one).
     fn cluster(&mut self, surfaces: &mut [SurfaceId], parent: u32, depth: u16) -> u32 {
         if let [s] = surfaces {
-            let mut elements = std::mem::take(&mut self.by_surface[*s]);
-            return self.element(&mut elements, *s, parent, depth);
+            let elements = std::mem::take(&mut self.by_surface[*s]);
+            return self.surface(elements, *s, parent, depth);
         }
         let centroid = |s: SurfaceId| -> DVec3 {
             let (sum, area) = self.by_surface[s]
@@ -277,6 +285,7 @@ impl<F: Fn(SurfaceId) -> Rgb> Builder<'_, F> {
                 normal,
             });
             let centroid = (el.points[0] + el.points[1] + el.points[2]) / 3.0;
+            let moment = Moment::of_triangle(&el.points, centroid, normal, el.area);
             let id = self.push(Node {
                 children: None,
                 parent,
@@ -293,9 +302,11 @@ impl<F: Fn(SurfaceId) -> Rgb> Builder<'_, F> {
                     .fold(0.0, f64::max),
                 bounds: Bounds::from_points(&el.points),
                 hull: SmallVec::from_slice(&el.points),
+                axes: moment.axes(normal, el.area),
                 reflectance: rho,
                 depth,
             });
+            self.moments[id as usize] = moment;
             self.hierarchy.leaf_of_element[*e as usize] = id;
             return id;
         }
@@ -331,6 +342,43 @@ impl<F: Fn(SurfaceId) -> Rgb> Builder<'_, F> {
         let (left, right) = elements.split_at_mut(mid);
         let a = self.element(left, s, id, depth + 1);
         let b = self.element(right, s, id, depth + 1);
+        self.join(id, [a, b], first, s, normal)
+    }
+
+    /// The tree of surface `s`: its connected pieces first (the two sides of a contact line
+    /// share no vertex, so the floor under a block is never averaged with the floor beside it:
+    /// the strongest discontinuities are split first), then each piece's own tree.
+    fn surface(&mut self, elements: Vec<u32>, s: SurfaceId, parent: u32, depth: u16) -> u32 {
+        let mut pieces = connected_pieces(self.disc, elements);
+        self.pieces(&mut pieces, s, parent, depth)
+    }
+
+    fn pieces(&mut self, pieces: &mut [Vec<u32>], s: SurfaceId, parent: u32, depth: u16) -> u32 {
+        if let [piece] = pieces {
+            return self.element(piece, s, parent, depth);
+        }
+        let disc = self.disc;
+        let centroid = |piece: &Vec<u32>| -> DVec3 {
+            let (sum, area) = piece.iter().fold((DVec3::ZERO, 0.0), |(p, a), &e| {
+                let e = &disc.elements[e as usize];
+                (p + (e.points[0] + e.points[1] + e.points[2]) / 3.0 * e.area, a + e.area)
+            });
+            sum / area.max(f64::MIN_POSITIVE)
+        };
+        let axis = longest_axis(pieces.iter().map(centroid));
+        pieces.sort_by(|a, b| centroid(a)[axis].total_cmp(&centroid(b)[axis]).then(a[0].cmp(&b[0])));
+        let normal = disc.receivers[disc.elements[pieces[0][0] as usize].vertices[0]].normal;
+        let id = self.push(placeholder(parent, depth));
+        let first = self.hierarchy.triangles.len() as u32;
+        let mid = pieces.len() / 2;
+        let (left, right) = pieces.split_at_mut(mid);
+        let a = self.pieces(left, s, id, depth + 1);
+        let b = self.pieces(right, s, id, depth + 1);
+        self.join(id, [a, b], first, s, normal)
+    }
+
+    /// Fills in element node `id` over its two children, whose triangles start at `first`.
+    fn join(&mut self, id: u32, [a, b]: [u32; 2], first: u32, s: SurfaceId, normal: DVec3) -> u32 {
         let end = self.hierarchy.triangles.len() as u32;
         let (na, nb) = (self.hierarchy.node(a), self.hierarchy.node(b));
         let area = na.area + nb.area;
@@ -341,7 +389,12 @@ impl<F: Fn(SurfaceId) -> Rgb> Builder<'_, F> {
             normal,
             centroid,
         );
-        self.hierarchy.nodes[id as usize] = Node {
+        let moment = self.moments[a as usize].shifted(na.centroid - centroid, normal, na.area)
+            + self.moments[b as usize].shifted(nb.centroid - centroid, normal, nb.area);
+        self.moments[id as usize] = moment;
+        let node = &mut self.hierarchy.nodes[id as usize];
+        let (parent, depth) = (node.parent, node.depth);
+        *node = Node {
             children: Some([a, b]),
             surface: Some(s),
             first,
@@ -349,17 +402,37 @@ impl<F: Fn(SurfaceId) -> Rgb> Builder<'_, F> {
             area,
             centroid,
             normal,
-            radius: hull
-                .iter()
-                .map(|p| p.distance(centroid))
-                .fold(0.0, f64::max),
+            radius: hull.iter().map(|p| p.distance(centroid)).fold(0.0, f64::max),
             bounds,
             hull,
-            reflectance: rho,
+            axes: moment.axes(normal, area),
+            reflectance: (self.reflectance)(s),
             ..placeholder(parent, depth)
         };
         id
     }
+}
+
+/// `elements` split into groups connected through shared vertices, each group in ascending
+/// order, groups ordered by their first element.
+fn connected_pieces(disc: &Discretization, elements: Vec<u32>) -> Vec<Vec<u32>> {
+    let mut sets = penumbra_scenes::union_find::UnionFind::new(elements.len());
+    let mut owner: std::collections::HashMap<usize, usize> = std::collections::HashMap::new();
+    for (k, &e) in elements.iter().enumerate() {
+        for &v in &disc.elements[e as usize].vertices {
+            match owner.get(&v) {
+                Some(&j) => sets.join(k, j),
+                None => {
+                    owner.insert(v, k);
+                }
+            }
+        }
+    }
+    let mut groups: std::collections::BTreeMap<usize, Vec<u32>> = std::collections::BTreeMap::new();
+    for (k, &e) in elements.iter().enumerate() {
+        groups.entry(sets.find(k)).or_default().push(e);
+    }
+    groups.into_values().collect()
 }
 
 fn placeholder(parent: u32, depth: u16) -> Node {
@@ -378,6 +451,7 @@ fn placeholder(parent: u32, depth: u16) -> Node {
             max: DVec3::ZERO,
         },
         hull: SmallVec::new(),
+        axes: [DVec3::ZERO; 2],
         reflectance: Rgb::ZERO,
         depth,
     }
@@ -433,4 +507,54 @@ fn plane_rectangle(triangles: &[Triangle], normal: DVec3, origin: DVec3) -> Smal
     .into_iter()
     .map(|(a, b)| origin + u * a + v * b)
     .collect()
+}
+
+/// A second moment of area [xx, xy, yy] in the axes `normal.any_orthonormal_pair()` of a plane.
+#[derive(Clone, Copy, Debug, Default)]
+struct Moment([f64; 3]);
+
+impl std::ops::Add for Moment {
+    type Output = Moment;
+    fn add(self, o: Moment) -> Moment {
+        Moment([self.0[0] + o.0[0], self.0[1] + o.0[1], self.0[2] + o.0[2]])
+    }
+}
+
+impl Moment {
+    /// ∫ x xᵀ over a triangle about its centroid: A/12 Σ v vᵀ over its corners, relative to it.
+    fn of_triangle(points: &[DVec3; 3], centroid: DVec3, normal: DVec3, area: f64) -> Moment {
+        let (u, v) = normal.any_orthonormal_pair();
+        let mut m = [0.0; 3];
+        for p in points {
+            let (x, y) = ((*p - centroid).dot(u), (*p - centroid).dot(v));
+            m[0] += x * x;
+            m[1] += x * y;
+            m[2] += y * y;
+        }
+        Moment(m.map(|c| c * area / 12.0))
+    }
+
+    /// The moment about a point `offset` away from the centroid (parallel axes).
+    fn shifted(self, offset: DVec3, normal: DVec3, area: f64) -> Moment {
+        let (u, v) = normal.any_orthonormal_pair();
+        let (x, y) = (offset.dot(u), offset.dot(v));
+        self + Moment([area * x * x, area * x * y, area * y * y])
+    }
+
+    /// The half-axes a₁, a₂ with (a₁a₁ᵀ + a₂a₂ᵀ) / 2 equal to the covariance (moment / area).
+    fn axes(self, normal: DVec3, area: f64) -> [DVec3; 2] {
+        let (u, v) = normal.any_orthonormal_pair();
+        let [p, q, r] = self.0.map(|c| c / area.max(f64::MIN_POSITIVE));
+        let mean = (p + r) / 2.0;
+        let radius = (((p - r) / 2.0).powi(2) + q * q).sqrt();
+        let (l1, l2) = (mean + radius, (mean - radius).max(0.0));
+        // The first eigenvector: of the two forms, the longer (better conditioned) one.
+        let (a, b) = ((q, l1 - p), (l1 - r, q));
+        let e = if a.0.hypot(a.1) >= b.0.hypot(b.1) { a } else { b };
+        let norm = e.0.hypot(e.1);
+        let (c, s) = if norm > 0.0 { (e.0 / norm, e.1 / norm) } else { (1.0, 0.0) };
+        let e1 = u * c + v * s;
+        let e2 = v * c - u * s;
+        [e1 * (2.0 * l1).sqrt(), e2 * (2.0 * l2).sqrt()]
+    }
 }
