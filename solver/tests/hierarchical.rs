@@ -14,7 +14,8 @@ fn furnace_gives_e_over_one_minus_rho() {
             epsilon: 1e-5,
             ..SolverOptions::default()
         };
-        let solution = solve_hierarchical(&scene, &mesh, &vis, &options, &NoProgress).expect("solves");
+        let solution =
+            solve_hierarchical(&scene, &mesh, &vis, &options, &NoProgress).expect("solves");
         assert_eq!(solution.stats.stop, StopReason::Converged);
         let expected = 1.0 / (1.0 - rho);
         let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
@@ -32,16 +33,28 @@ fn furnace_gives_e_over_one_minus_rho() {
 #[test]
 fn debug_tol() {
     for tol in [1e-4, 1e-5, 1e-6, 1e-7] {
-    let rho = 0.5;
-    let scene = builtin::furnace(1.0, rho);
-    let vis = Visibility::build(&scene);
-    let mesh = mesh_scene_uniform(&scene, 1200).expect("cube meshes");
-    let options = SolverOptions { epsilon: 1e-5, link_tol: tol, ..SolverOptions::default() };
-    let t = std::time::Instant::now();
-    let solution = solve_hierarchical(&scene, &mesh, &vis, &options, &NoProgress).expect("solves");
-    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    for b in solution.radiosity.iter().flatten() { lo = lo.min(b.r / 2.0); hi = hi.max(b.r / 2.0); }
-    eprintln!("tol {tol}: {lo:.5} .. {hi:.5} links {} {:?}", solution.stats.hierarchy.as_ref().unwrap().links, t.elapsed());
+        let rho = 0.5;
+        let scene = builtin::furnace(1.0, rho);
+        let vis = Visibility::build(&scene);
+        let mesh = mesh_scene_uniform(&scene, 1200).expect("cube meshes");
+        let options = SolverOptions {
+            epsilon: 1e-5,
+            link_tol: tol,
+            ..SolverOptions::default()
+        };
+        let t = std::time::Instant::now();
+        let solution =
+            solve_hierarchical(&scene, &mesh, &vis, &options, &NoProgress).expect("solves");
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for b in solution.radiosity.iter().flatten() {
+            lo = lo.min(b.r / 2.0);
+            hi = hi.max(b.r / 2.0);
+        }
+        eprintln!(
+            "tol {tol}: {lo:.5} .. {hi:.5} links {} {:?}",
+            solution.stats.hierarchy.as_ref().unwrap().links,
+            t.elapsed()
+        );
     }
 }
 
@@ -51,7 +64,10 @@ fn debug_furnace_worst() {
     let scene = builtin::furnace(1.0, rho);
     let vis = Visibility::build(&scene);
     let mesh = mesh_scene_uniform(&scene, 1200).expect("cube meshes");
-    let options = SolverOptions { epsilon: 1e-5, ..SolverOptions::default() };
+    let options = SolverOptions {
+        epsilon: 1e-5,
+        ..SolverOptions::default()
+    };
     let solution = solve_hierarchical(&scene, &mesh, &vis, &options, &NoProgress).expect("solves");
     let mut all = vec![];
     for (m, b) in mesh.surfaces.iter().zip(&solution.radiosity) {

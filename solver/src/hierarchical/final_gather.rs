@@ -4,56 +4,99 @@
 //! Between them those links see every source once, so a vertex's value is the hierarchy's
 //! solution seen from that point: smooth where the light is smooth, with no blocks at element
 //! boundaries. Links that shaft culling left partial get their own rays from the vertex.
+//!
+//! Leaves near the vertex are the exception. Next to a concave junction half of what a point
+//! sees is the strip of the other surface right beside it, darker than that surface's elements
+//! on average (it sees the first surface's dark strip in turn), so a leaf's mean radiosity
+//! overstates it. Near leaves are therefore gathered again with their radiosity linear over them,
+//! from their vertices' values of the gather before, a few times over: the strips on both sides
+//! converge together.
 
 use std::f64::consts::PI;
 
+use glam::DVec3;
 use penumbra_scenes::rng::SplitMix64;
 use penumbra_scenes::{Rgb, SurfaceId};
 
 use super::iterate::{Field, System};
 use super::links::Link;
-use super::transfer::point_factor;
-use crate::lambert::ReceivingPoint;
+use super::transfer::{FAR_DISTANCE, point_factor};
+use crate::elements::Element;
+use crate::lambert::{ReceivingPoint, form_factor};
 
 /// Gathers at points along the links of a solved system.
 pub(crate) struct FinalGather<'a> {
     pub system: &'a System<'a>,
     pub field: &'a Field,
     pub visibility: &'a penumbra_scenes::Visibility,
+    pub elements: &'a [Element],
     pub rays: usize,
     pub seed: u64,
 }
 
+/// What a point gathers: from near leaves, and from everything else, and the rays cast.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Gathered {
+    pub near: Rgb,
+    pub far: Rgb,
+    pub rays: u64,
+}
+
+/// Rounds of subdividing a near leaf to integrate its linear radiosity against the kernel.
+const LINEAR_DEPTH: u32 = 4;
+
 impl FinalGather<'_> {
-    /// The reflected irradiance at `x`, which lies in `leaf`, and the rays cast for it. `key`
-    /// picks the point's random streams.
+    /// The reflected irradiance at `x`, which lies in `leaf`. With `linear` (the reflected
+    /// radiosity at every vertex, from a gather before), near leaves are linear over their
+    /// triangles and only they are gathered (`far` is left zero). `key` picks the point's random
+    /// streams.
     pub fn irradiance(
         &self,
         x: &ReceivingPoint,
         surface: SurfaceId,
         leaf: u32,
         key: u64,
-    ) -> (Rgb, u64) {
+        linear: Option<&[Rgb]>,
+    ) -> Gathered {
         let h = self.system.hierarchy;
-        let mut total = Rgb::ZERO;
-        let mut rays = 0;
+        let mut out = Gathered::default();
         for node in h.ancestry(leaf) {
             for link in self.system.links_of(node) {
-                let (value, cast) = self.along(x, surface, link, key);
-                total += value;
-                rays += cast;
+                let sn = h.node(link.source);
+                let near = sn.is_leaf()
+                    && !sn.is_cluster()
+                    && x.point.distance_squared(sn.centroid)
+                        < (FAR_DISTANCE * sn.radius) * (FAR_DISTANCE * sn.radius);
+                if linear.is_some() && !near {
+                    continue;
+                }
+                let unoccluded = match linear {
+                    Some(vertex_b) => self.linear_leaf(x, link.source, vertex_b),
+                    None => self.unoccluded(x, link),
+                };
+                let value = if link.partial && unoccluded.max_channel() > 0.0 {
+                    let (visible, rays) = self.visible_fraction(x, surface, link.source, key);
+                    out.rays += rays;
+                    unoccluded * visible
+                } else {
+                    unoccluded
+                };
+                if near {
+                    out.near += value;
+                } else {
+                    out.far += value;
+                }
             }
         }
-        (total, rays)
+        out
     }
 
-    /// What `x` receives from `link`'s source.
-    fn along(&self, x: &ReceivingPoint, surface: SurfaceId, link: &Link, key: u64) -> (Rgb, u64) {
+    /// What `x` receives from `link`'s source, unoccluded, at the source's mean radiosity.
+    fn unoccluded(&self, x: &ReceivingPoint, link: &Link) -> Rgb {
         let h = self.system.hierarchy;
         let s = link.source;
         let sn = h.node(s);
-        let tol = self.visibility.contact_distance();
-        let unoccluded = if sn.is_cluster() {
+        if sn.is_cluster() {
             let offset = x.point - sn.centroid;
             let distance2 = offset.length_squared();
             let direction = offset / distance2.sqrt();
@@ -63,13 +106,32 @@ impl FinalGather<'_> {
                 .intensity(sn, s, direction)
                 * (facing / distance2)
         } else {
+            let tol = self.visibility.contact_distance();
             self.field.b[s as usize] * point_factor(h, x, s, tol)
-        };
-        if !link.partial || unoccluded.max_channel() <= 0.0 {
-            return (unoccluded, 0);
         }
-        let (visible, rays) = self.visible_fraction(x, surface, s, key);
-        (unoccluded * visible, rays)
+    }
+
+    /// What `x` receives from leaf `s` with its radiosity linear over it, from the values at its
+    /// vertices: the value at the point of `s` nearest to `x` times the exact form factor (which
+    /// takes the one-sided limit at a junction), plus the rest, which vanishes at that point,
+    /// integrated over `s`.
+    fn linear_leaf(&self, x: &ReceivingPoint, s: u32, vertex_b: &[Rgb]) -> Rgb {
+        let h = self.system.hierarchy;
+        let triangle = &h.triangles[h.node(s).first as usize];
+        let t = triangle.points;
+        let tol = self.visibility.contact_distance();
+        if !x.in_front_of(t[0], triangle.normal, tol) {
+            return Rgb::ZERO;
+        }
+        let b = self.elements[triangle.element as usize]
+            .vertices
+            .map(|v| vertex_b[v]);
+        let nearest = barycentric_nearest(x.point, &t);
+        let at = |w: [f64; 3]| b[0] * w[0] + b[1] * w[1] + b[2] * w[2];
+        let b0 = at(nearest);
+        let factor = form_factor(x, &t, tol);
+        let rest = linear_rest(x, triangle.normal, t, b, b0, LINEAR_DEPTH);
+        b0 * factor + rest
     }
 
     /// The fraction of node `s` that `x` sees, weighted by the form-factor kernel, from
@@ -88,11 +150,11 @@ impl FinalGather<'_> {
         for k in 0..self.rays {
             let (y, t) = h.sample(s, k, self.rays, &mut rng);
             let d = y - origin;
-            let w =
-                (x.normal.dot(d) * -t.normal.dot(d)).max(0.0) / (PI * d.length_squared().powi(2));
-            if !(w > 0.0) {
+            let (cx, cy) = (x.normal.dot(d), -t.normal.dot(d));
+            if !(cx > 0.0 && cy > 0.0) {
                 continue;
             }
+            let w = cx * cy / (PI * d.length_squared().powi(2));
             weight += w;
             rays += 1;
             if !self.visibility.occluded(origin, y, [surface, t.surface]) {
@@ -102,4 +164,86 @@ impl FinalGather<'_> {
         let fraction = if weight > 0.0 { seen / weight } else { 1.0 };
         (fraction, rays)
     }
+}
+
+/// ∫ over triangle `t` (unit normal `normal`, radiosity linear from `b` at its corners) of
+/// (B(y) − `b0`) cos θ cos θ' / (π r²) seen from `x`: the three-point rule on pieces split in
+/// four until they are smaller than half their distance from `x`, `depth` times at most.
+fn linear_rest(
+    x: &ReceivingPoint,
+    normal: DVec3,
+    t: [DVec3; 3],
+    b: [Rgb; 3],
+    b0: Rgb,
+    depth: u32,
+) -> Rgb {
+    let centroid = (t[0] + t[1] + t[2]) / 3.0;
+    let size = t[0]
+        .distance(t[1])
+        .max(t[1].distance(t[2]))
+        .max(t[2].distance(t[0]));
+    if depth > 0 && size > 0.5 * centroid.distance(x.point) {
+        let mid = |i: usize, j: usize| ((t[i] + t[j]) / 2.0, (b[i] + b[j]) * 0.5);
+        let ((p01, b01), (p12, b12), (p20, b20)) = (mid(0, 1), mid(1, 2), mid(2, 0));
+        return [
+            ([t[0], p01, p20], [b[0], b01, b20]),
+            ([p01, t[1], p12], [b01, b[1], b12]),
+            ([p20, p12, t[2]], [b20, b12, b[2]]),
+            ([p12, p20, p01], [b12, b20, b01]),
+        ]
+        .into_iter()
+        .map(|(pt, pb)| linear_rest(x, normal, pt, pb, b0, depth - 1))
+        .sum();
+    }
+    let area = 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length();
+    let (a, c) = (2.0 / 3.0, 1.0 / 6.0);
+    [[a, c, c], [c, a, c], [c, c, a]]
+        .iter()
+        .map(|w| {
+            let y = t[0] * w[0] + t[1] * w[1] + t[2] * w[2];
+            let d = y - x.point;
+            let r2 = d.length_squared();
+            let k = x.normal.dot(d).max(0.0) * (-normal.dot(d)).max(0.0) / (PI * r2 * r2);
+            let value = b[0] * w[0] + b[1] * w[1] + b[2] * w[2];
+            (value - b0) * (k * area / 3.0)
+        })
+        .sum()
+}
+
+/// Barycentric coordinates of the point of triangle `t` nearest to `p`.
+fn barycentric_nearest(p: DVec3, t: &[DVec3; 3]) -> [f64; 3] {
+    let (a, b, c) = (t[0], t[1], t[2]);
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return [1.0, 0.0, 0.0];
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return [0.0, 1.0, 0.0];
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        let v = d1 / (d1 - d3);
+        return [1.0 - v, v, 0.0];
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return [0.0, 0.0, 1.0];
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        let w = d2 / (d2 - d6);
+        return [1.0 - w, 0.0, w];
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return [0.0, 1.0 - w, w];
+    }
+    let denom = 1.0 / (va + vb + vc);
+    let (v, w) = (vb * denom, vc * denom);
+    [1.0 - v - w, v, w]
 }

@@ -22,7 +22,8 @@ use rayon::prelude::*;
 
 use super::shaft::{Shafts, Sight};
 use super::transfer::{
-    Axes, cluster_intensity, element_intensity, far_factor, point_factor, triangle_mean,
+    Axes, FAR_DISTANCE, cluster_intensity, element_intensity, far_factor, point_factor,
+    triangle_mean,
 };
 use super::tree::{Hierarchy, Node};
 use crate::lambert::{ReceivingPoint, form_factor};
@@ -257,7 +258,9 @@ impl Refiner<'_> {
                 rn.normal.dot(-direction).max(0.0)
             };
             let irradiance = state.intensity(sn, s, direction) * (facing / distance2);
-            if std::env::var("NOCLUSTER").is_ok() { return (Some(transfer), f64::INFINITY); }
+            if std::env::var("NOCLUSTER").is_ok() {
+                return (Some(transfer), f64::INFINITY);
+            }
             return (
                 Some(transfer),
                 rn.reflectance.mul_rgb(irradiance).mean() * rn.area,
@@ -280,13 +283,14 @@ impl Refiner<'_> {
     fn quick_factor(&self, r: u32, s: u32) -> (f64, f64) {
         let h = self.hierarchy;
         let (rn, sn) = (h.node(r), h.node(s));
+        let far = (FAR_DISTANCE * sn.radius).powi(2);
         let at = |p: DVec3| match sn.children {
-            None => form_factor(
+            None if p.distance_squared(sn.centroid) < far => form_factor(
                 &ReceivingPoint::interior(p, rn.normal),
                 &h.triangles[sn.first as usize].points,
                 self.tol,
             ),
-            Some(_) => far_factor(p, rn.normal, sn),
+            _ => far_factor(p, rn.normal, sn),
         };
         let points = h.quadrature(r);
         let factors: smallvec::SmallVec<[f64; 4]> = points.iter().map(|&(p, _)| at(p)).collect();

@@ -40,7 +40,7 @@ use crate::progressive::{
     ConvergencePoint, Solution, SolveStats, SolverOptions, StopReason, check_mesh,
     direct_irradiance,
 };
-use final_gather::FinalGather;
+use final_gather::{FinalGather, Gathered};
 use iterate::{Field, System};
 use links::{Link, RefineCounts, Refiner};
 use shaft::Shafts;
@@ -215,13 +215,14 @@ pub fn solve_hierarchical(
         system: &system,
         field: &field,
         visibility,
+        elements: &disc.elements,
         rays: options.visibility_rays,
         seed: options.seed,
     };
     let gathered = if options.stop_now().is_some() {
         None
     } else {
-        final_gather_all(&disc, &vertex_leaf, &gather, options, progress)
+        final_gather_all(&disc, &vertex_leaf, &direct, &gather, options, progress)
     };
     let reflected = match gathered {
         Some((values, rays)) => {
@@ -383,30 +384,68 @@ fn vertex_leaves(disc: &Discretization, hierarchy: &Hierarchy) -> Vec<u32> {
     leaf
 }
 
+/// Gathers of the near leaves again with linear radiosities, after the first final gather.
+pub const LINEAR_PASSES: usize = 2;
+
 /// The final gather at every vertex, in parallel and in order, with a progress bar, and the
-/// rays it cast; `None` if the run must stop first.
+/// rays it cast; `None` if the run must stop first. `direct` is the direct irradiance at every
+/// vertex.
 fn final_gather_all(
     disc: &Discretization,
     vertex_leaf: &[u32],
+    direct: &[Rgb],
     gather: &FinalGather,
     options: &SolverOptions,
     progress: &dyn Progress,
 ) -> Option<(Vec<Rgb>, u64)> {
+    let gather_at = |stage: &str, linear: Option<&[Rgb]>| {
+        each_vertex(disc, stage, options, progress, |v| {
+            let leaf = vertex_leaf[v];
+            if leaf == NONE || disc.reflectance[v].max_channel() <= 0.0 {
+                return Gathered::default();
+            }
+            let x = &disc.receivers[v];
+            gather.irradiance(x, disc.receiver_surface[v], leaf, v as u64, linear)
+        })
+    };
+    let mut values = gather_at("final gather", None)?;
+    let mut rays: u64 = values.iter().map(|g| g.rays).sum();
+    let passes = std::env::var("LP")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(LINEAR_PASSES);
+    for _ in 0..passes {
+        let vertex_b: Vec<Rgb> = (0..disc.receiver_count())
+            .map(|v| disc.reflectance[v].mul_rgb(direct[v] + values[v].near + values[v].far))
+            .collect();
+        let near = gather_at("final gather, near leaves", Some(&vertex_b))?;
+        for (g, n) in values.iter_mut().zip(near) {
+            g.near = n.near;
+            rays += n.rays;
+        }
+    }
+    Some((values.iter().map(|g| g.near + g.far).collect(), rays))
+}
+
+/// `f` at every vertex, in parallel and in order, with a progress bar; `None` if the run must
+/// stop first.
+fn each_vertex<T: Send>(
+    disc: &Discretization,
+    stage: &str,
+    options: &SolverOptions,
+    progress: &dyn Progress,
+    f: impl Fn(usize) -> T + Sync,
+) -> Option<Vec<T>> {
     let n = disc.receiver_count();
-    progress.start("final gather", n as u64);
+    progress.start(stage, n as u64);
     let done = AtomicU64::new(0);
-    let values: Vec<Option<(Rgb, u64)>> = (0..n)
+    let values: Vec<Option<T>> = (0..n)
         .into_par_iter()
         .map(|v| {
             if options.stop_now().is_some() {
                 return None;
             }
-            let leaf = vertex_leaf[v];
-            let value = if leaf == NONE || disc.reflectance[v].max_channel() <= 0.0 {
-                (Rgb::ZERO, 0)
-            } else {
-                gather.irradiance(&disc.receivers[v], disc.receiver_surface[v], leaf, v as u64)
-            };
+            let value = f(v);
             let d = done.fetch_add(1, Ordering::Relaxed);
             if d.is_multiple_of(256) {
                 progress.set(d);
@@ -415,11 +454,7 @@ fn final_gather_all(
         })
         .collect();
     progress.finish();
-    let values: Option<Vec<(Rgb, u64)>> = values.into_iter().collect();
-    values.map(|v| {
-        let rays = v.iter().map(|&(_, r)| r).sum();
-        (v.into_iter().map(|(h, _)| h).collect(), rays)
-    })
+    values.into_iter().collect()
 }
 
 #[cfg(test)]
@@ -438,7 +473,14 @@ mod debug_tests {
         let leaf_direct = vec![Rgb::splat(0.5); hierarchy.nodes.len()];
         let mut system = System::new(&hierarchy, leaf_direct);
         let shafts = Shafts::new(&scene, &vis);
-        let refiner = Refiner { hierarchy: &hierarchy, shafts: &shafts, tolerance: 1e-5 * 6.0, rays: 16, seed: 1, tol: vis.contact_distance() };
+        let refiner = Refiner {
+            hierarchy: &hierarchy,
+            shafts: &shafts,
+            tolerance: 1e-5 * 6.0,
+            rays: 16,
+            seed: 1,
+            tol: vis.contact_distance(),
+        };
         let field = system.initial_field();
         let root = hierarchy.root.unwrap();
         let (links, _) = refine_pair(&refiner, root, root, &system.radiosities(&field));
@@ -446,25 +488,47 @@ mod debug_tests {
         let leaves = vertex_leaves(&disc, &hierarchy);
         let mut rows = vec![];
         for (i, n) in hierarchy.nodes.iter().enumerate() {
-            if !n.is_leaf() { continue; }
+            if !n.is_leaf() {
+                continue;
+            }
             let mut sum = 0.0;
             for node in hierarchy.ancestry(i as u32) {
                 for l in system.links_of(node) {
-                    match l.transfer { links::Transfer::Factor { factor, .. } => sum += factor, _ => sum += 1000.0 }
+                    match l.transfer {
+                        links::Transfer::Factor { factor, .. } => sum += factor,
+                        _ => sum += 1000.0,
+                    }
                 }
             }
             rows.push((sum, n.centroid, n.surface));
         }
         rows.sort_by(|a, b| a.0.total_cmp(&b.0));
-        for r in rows.iter().take(4).chain(rows.iter().rev().take(6)) { eprintln!("row {:?}", r); }
-        let worst = hierarchy.nodes.iter().position(|n| n.is_leaf() && n.centroid.distance(rows.last().unwrap().1) < 1e-12).unwrap();
+        for r in rows.iter().take(4).chain(rows.iter().rev().take(6)) {
+            eprintln!("row {:?}", r);
+        }
+        let worst = hierarchy
+            .nodes
+            .iter()
+            .position(|n| n.is_leaf() && n.centroid.distance(rows.last().unwrap().1) < 1e-12)
+            .unwrap();
         let mut per = vec![0.0; 6];
         for node in hierarchy.ancestry(worst as u32) {
             for l in system.links_of(node) {
                 let sn = hierarchy.node(l.source);
                 if let links::Transfer::Factor { factor, spread } = l.transfer {
                     per[sn.surface.unwrap()] += factor;
-                    if factor > 0.01 { eprintln!("  recv depth {} src {} depth {} leaf {} c {:?} r {:.3} F {factor:.4} spread {spread:.4} partial {}", hierarchy.node(node).depth, l.source, sn.depth, sn.is_leaf(), sn.centroid, sn.radius, l.partial); }
+                    if factor > 0.01 {
+                        eprintln!(
+                            "  recv depth {} src {} depth {} leaf {} c {:?} r {:.3} F {factor:.4} spread {spread:.4} partial {}",
+                            hierarchy.node(node).depth,
+                            l.source,
+                            sn.depth,
+                            sn.is_leaf(),
+                            sn.centroid,
+                            sn.radius,
+                            l.partial
+                        );
+                    }
                 }
             }
         }
@@ -473,7 +537,9 @@ mod debug_tests {
         for node in hierarchy.ancestry(worst as u32) {
             for l in system.links_of(node) {
                 let sn = hierarchy.node(l.source);
-                if sn.surface == Some(4) { ranges.push((sn.first, sn.end, sn.area, l.source)); }
+                if sn.surface == Some(4) {
+                    ranges.push((sn.first, sn.end, sn.area, l.source));
+                }
             }
         }
         ranges.sort_by_key(|r| (r.0, r.1));
@@ -487,44 +553,95 @@ mod debug_tests {
             for node in hierarchy.ancestry(worst as u32) {
                 for l in system.links_of(node) {
                     if let links::Transfer::Factor { factor, .. } = l.transfer {
-                        let at = |p: glam::DVec3| transfer::point_factor(&hierarchy, &crate::lambert::ReceivingPoint::interior(p, rn.normal), l.source, tol);
+                        let at = |p: glam::DVec3| {
+                            transfer::point_factor(
+                                &hierarchy,
+                                &crate::lambert::ReceivingPoint::interior(p, rn.normal),
+                                l.source,
+                                tol,
+                            )
+                        };
                         let own = transfer::triangle_mean(&t, &at, 4);
-                        diffs.push((factor - own, factor, own, hierarchy.node(node).depth, l.source, hierarchy.node(l.source).surface));
+                        diffs.push((
+                            factor - own,
+                            factor,
+                            own,
+                            hierarchy.node(node).depth,
+                            l.source,
+                            hierarchy.node(l.source).surface,
+                        ));
                     }
                 }
             }
             let total: f64 = diffs.iter().map(|d| d.0).sum();
             diffs.sort_by(|a, b| b.0.abs().total_cmp(&a.0.abs()));
             eprintln!("total diff {total}");
-            for d in diffs.iter().take(8) { eprintln!("diff {:?}", d); }
+            for d in diffs.iter().take(8) {
+                eprintln!("diff {:?}", d);
+            }
         }
-        let wall_root = { let mut n = ranges[0].3; while hierarchy.node(n).parent != NONE && hierarchy.node(hierarchy.node(n).parent).surface == Some(4) { n = hierarchy.node(n).parent; } n };
+        let wall_root = {
+            let mut n = ranges[0].3;
+            while hierarchy.node(n).parent != NONE
+                && hierarchy.node(hierarchy.node(n).parent).surface == Some(4)
+            {
+                n = hierarchy.node(n).parent;
+            }
+            n
+        };
         for (p, _) in hierarchy.quadrature(worst as u32) {
             let tol = vis.contact_distance();
-            let x = crate::lambert::ReceivingPoint::interior(p, hierarchy.node(worst as u32).normal);
+            let x =
+                crate::lambert::ReceivingPoint::interior(p, hierarchy.node(worst as u32).normal);
             let exact = crate::lambert::form_factor(&x, &scene.surfaces[4].polygon, tol);
             let pf = transfer::point_factor(&hierarchy, &x, wall_root, tol);
-            let links_sum: f64 = ranges.iter().map(|r| transfer::point_factor(&hierarchy, &x, r.3, tol)).sum();
+            let links_sum: f64 = ranges
+                .iter()
+                .map(|r| transfer::point_factor(&hierarchy, &x, r.3, tol))
+                .sum();
             eprintln!("point {p:?}: exact {exact} root {pf} links {links_sum}");
         }
-        for w in ranges.windows(2) { if w[0].1 > w[1].0 { eprintln!("overlap {:?} {:?}", w[0], w[1]); } }
+        for w in ranges.windows(2) {
+            if w[0].1 > w[1].0 {
+                eprintln!("overlap {:?} {:?}", w[0], w[1]);
+            }
+        }
         let rn = hierarchy.node(worst as u32);
         let tol = vis.contact_distance();
         let t = hierarchy.triangles[rn.first as usize].points;
         eprintln!("receiver tri {:?}", t);
         for src in [483u32, 481] {
-            eprintln!("src tri {:?}", hierarchy.triangles[hierarchy.node(src).first as usize].points);
-            let at = |p: glam::DVec3| transfer::point_factor(&hierarchy, &crate::lambert::ReceivingPoint::interior(p, rn.normal), src, tol);
-            for d in 0..7 { eprintln!("depth {d}: {}", transfer::triangle_mean(&t, &at, d)); }
+            eprintln!(
+                "src tri {:?}",
+                hierarchy.triangles[hierarchy.node(src).first as usize].points
+            );
+            let at = |p: glam::DVec3| {
+                transfer::point_factor(
+                    &hierarchy,
+                    &crate::lambert::ReceivingPoint::interior(p, rn.normal),
+                    src,
+                    tol,
+                )
+            };
+            for d in 0..7 {
+                eprintln!("depth {d}: {}", transfer::triangle_mean(&t, &at, d));
+            }
             let mut rng = penumbra_scenes::rng::SplitMix64::new(3);
-            let mut sum = 0.0; let n = 200000;
-            for _ in 0..n { let (r1, r2) = (rng.next_f64().sqrt(), rng.next_f64()); let p = t[0] * (1.0 - r1) + t[1] * (r1 * (1.0 - r2)) + t[2] * (r1 * r2); sum += at(p); }
+            let mut sum = 0.0;
+            let n = 200000;
+            for _ in 0..n {
+                let (r1, r2) = (rng.next_f64().sqrt(), rng.next_f64());
+                let p = t[0] * (1.0 - r1) + t[1] * (r1 * (1.0 - r2)) + t[2] * (r1 * r2);
+                sum += at(p);
+            }
             eprintln!("mc {}", sum / n as f64);
         }
         let tol = vis.contact_distance();
         for v in 0..disc.receiver_count() {
             let x = &disc.receivers[v];
-            if x.point.length() > 1e-9 { continue; }
+            if x.point.length() > 1e-9 {
+                continue;
+            }
             let mut sum = 0.0;
             let mut per_surface = vec![0.0; 6];
             for node in hierarchy.ancestry(leaves[v]) {
@@ -534,7 +651,10 @@ mod debug_tests {
                     per_surface[hierarchy.node(l.source).surface.unwrap()] += f;
                 }
             }
-            eprintln!("vertex {v} surface {} inward {:?}: {sum} {:?}", disc.receiver_surface[v], x.inward, per_surface);
+            eprintln!(
+                "vertex {v} surface {} inward {:?}: {sum} {:?}",
+                disc.receiver_surface[v], x.inward, per_surface
+            );
         }
     }
 }

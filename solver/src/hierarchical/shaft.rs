@@ -84,7 +84,8 @@ impl<'a> Shafts<'a> {
                 break;
             }
             tried.push(s);
-            if std::env::var("NOHIDE").is_err() && self.convex[s] && self.hides(s, &a.hull, &b.hull) {
+            if std::env::var("NOHIDE").is_err() && self.convex[s] && self.hides(s, &a.hull, &b.hull)
+            {
                 return Sight::Hidden;
             }
         }

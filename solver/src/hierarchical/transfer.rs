@@ -87,9 +87,11 @@ pub(crate) fn far_factor(x: DVec3, normal: DVec3, node: &Node) -> f64 {
         / (4.0 * PI)
 }
 
-/// The unoccluded form factor from `x` to element `s`: exact (Lambert's formula) over leaves,
-/// [`far_factor`] for nodes at least [`FAR_DISTANCE`] radii away, and the sum over the children
-/// of nearer ones.
+/// The unoccluded form factor from `x` to element `s`: [`far_factor`] for nodes at least
+/// [`FAR_DISTANCE`] radii away, exact (Lambert's formula) over nearer leaves, and the sum over
+/// the children of nearer inner nodes. (Lambert's formula is exact everywhere, but far away, at
+/// grazing angles, its terms cancel and it must integrate instead: slower, and no better than
+/// the four-point rule there.)
 pub(crate) fn point_factor(h: &Hierarchy, x: &ReceivingPoint, s: u32, tol: f64) -> f64 {
     let node = h.node(s);
     if !x.in_front_of(node.centroid, node.normal, tol) {
@@ -98,8 +100,8 @@ pub(crate) fn point_factor(h: &Hierarchy, x: &ReceivingPoint, s: u32, tol: f64) 
     let far = x.point.distance_squared(node.centroid)
         >= (FAR_DISTANCE * node.radius) * (FAR_DISTANCE * node.radius);
     match node.children {
+        _ if far => far_factor(x.point, x.normal, node),
         None => form_factor(x, &h.triangles[node.first as usize].points, tol),
-        Some(_) if far => far_factor(x.point, x.normal, node),
         Some([a, b]) => point_factor(h, x, a, tol) + point_factor(h, x, b, tol),
     }
 }
@@ -114,7 +116,9 @@ pub(crate) fn triangle_mean(t: &[DVec3; 3], f: &impl Fn(DVec3) -> f64, depth: u3
     let mean = values.iter().sum::<f64>() / 3.0;
     let (lo, hi) = values
         .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+            (lo.min(v), hi.max(v))
+        });
     if depth == 0 || hi - lo <= 0.05 * mean.abs() {
         return mean;
     }

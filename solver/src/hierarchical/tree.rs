@@ -62,6 +62,8 @@ impl Node {
 #[derive(Clone, Debug)]
 pub(crate) struct Triangle {
     pub surface: SurfaceId,
+    /// Its index among the discretization's elements.
+    pub element: u32,
     pub points: [DVec3; 3],
     pub area: f64,
     pub normal: DVec3,
@@ -280,6 +282,7 @@ impl<F: Fn(SurfaceId) -> Rgb> Builder<'_, F> {
             let t = self.hierarchy.triangles.len() as u32;
             self.hierarchy.triangles.push(Triangle {
                 surface: s,
+                element: *e,
                 points: el.points,
                 area: el.area,
                 normal,
@@ -361,12 +364,19 @@ impl<F: Fn(SurfaceId) -> Rgb> Builder<'_, F> {
         let centroid = |piece: &Vec<u32>| -> DVec3 {
             let (sum, area) = piece.iter().fold((DVec3::ZERO, 0.0), |(p, a), &e| {
                 let e = &disc.elements[e as usize];
-                (p + (e.points[0] + e.points[1] + e.points[2]) / 3.0 * e.area, a + e.area)
+                (
+                    p + (e.points[0] + e.points[1] + e.points[2]) / 3.0 * e.area,
+                    a + e.area,
+                )
             });
             sum / area.max(f64::MIN_POSITIVE)
         };
         let axis = longest_axis(pieces.iter().map(centroid));
-        pieces.sort_by(|a, b| centroid(a)[axis].total_cmp(&centroid(b)[axis]).then(a[0].cmp(&b[0])));
+        pieces.sort_by(|a, b| {
+            centroid(a)[axis]
+                .total_cmp(&centroid(b)[axis])
+                .then(a[0].cmp(&b[0]))
+        });
         let normal = disc.receivers[disc.elements[pieces[0][0] as usize].vertices[0]].normal;
         let id = self.push(placeholder(parent, depth));
         let first = self.hierarchy.triangles.len() as u32;
@@ -402,7 +412,10 @@ impl<F: Fn(SurfaceId) -> Rgb> Builder<'_, F> {
             area,
             centroid,
             normal,
-            radius: hull.iter().map(|p| p.distance(centroid)).fold(0.0, f64::max),
+            radius: hull
+                .iter()
+                .map(|p| p.distance(centroid))
+                .fold(0.0, f64::max),
             bounds,
             hull,
             axes: moment.axes(normal, area),
@@ -550,9 +563,17 @@ impl Moment {
         let (l1, l2) = (mean + radius, (mean - radius).max(0.0));
         // The first eigenvector: of the two forms, the longer (better conditioned) one.
         let (a, b) = ((q, l1 - p), (l1 - r, q));
-        let e = if a.0.hypot(a.1) >= b.0.hypot(b.1) { a } else { b };
+        let e = if a.0.hypot(a.1) >= b.0.hypot(b.1) {
+            a
+        } else {
+            b
+        };
         let norm = e.0.hypot(e.1);
-        let (c, s) = if norm > 0.0 { (e.0 / norm, e.1 / norm) } else { (1.0, 0.0) };
+        let (c, s) = if norm > 0.0 {
+            (e.0 / norm, e.1 / norm)
+        } else {
+            (1.0, 0.0)
+        };
         let e1 = u * c + v * s;
         let e2 = v * c - u * s;
         [e1 * (2.0 * l1).sqrt(), e2 * (2.0 * l2).sqrt()]
