@@ -17,12 +17,13 @@ use std::f64::consts::PI;
 use glam::DVec3;
 use penumbra_scenes::rng::SplitMix64;
 use penumbra_scenes::{Rgb, SurfaceId};
+use smallvec::SmallVec;
 
 use super::iterate::{Field, System};
 use super::links::Link;
-use super::transfer::{FAR_DISTANCE, point_factor};
+use super::transfer::{FAR_DISTANCE, barycentric_nearest, leaf_factor, point_factor};
 use crate::elements::Element;
-use crate::lambert::{ReceivingPoint, form_factor};
+use crate::lambert::ReceivingPoint;
 
 /// Gathers at points along the links of a solved system.
 pub(crate) struct FinalGather<'a> {
@@ -35,31 +36,43 @@ pub(crate) struct FinalGather<'a> {
 }
 
 /// What a point gathers: from near leaves, and from everything else, and the rays cast.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Debug, Default)]
 pub(crate) struct Gathered {
     pub near: Rgb,
     pub far: Rgb,
     pub rays: u64,
+    /// The fraction of each partial near leaf seen, in the order of the links, for the gathers
+    /// that follow.
+    pub near_visible: SmallVec<[f32; 8]>,
 }
+
+/// A partial link that brings less than this share of the light the vertex's leaf receives in
+/// the hierarchy gets [`MINOR_RAYS`] rays, not the full count: its visibility's noise is a small
+/// part of a small part.
+const MINOR_SHARE: f64 = 0.02;
+const MINOR_RAYS: usize = 4;
 
 /// Rounds of subdividing a near leaf to integrate its linear radiosity against the kernel.
 const LINEAR_DEPTH: u32 = 4;
 
 impl FinalGather<'_> {
     /// The reflected irradiance at `x`, which lies in `leaf`. With `linear` (the reflected
-    /// radiosity at every vertex, from a gather before), near leaves are linear over their
-    /// triangles and only they are gathered (`far` is left zero). `key` picks the point's random
-    /// streams.
+    /// radiosity at every vertex, and what the first gather at `x` found of it), near leaves
+    /// are linear over their triangles and only they are gathered (`far` is left zero). `key`
+    /// picks the point's random streams.
     pub fn irradiance(
         &self,
         x: &ReceivingPoint,
         surface: SurfaceId,
         leaf: u32,
         key: u64,
-        linear: Option<&[Rgb]>,
+        linear: Option<(&[Rgb], &Gathered)>,
     ) -> Gathered {
         let h = self.system.hierarchy;
         let mut out = Gathered::default();
+        let mut seen = linear.map(|(_, first)| first.near_visible.iter());
+        // Links that bring little of the light get fewer rays.
+        let minor = MINOR_SHARE * self.field.irradiance[leaf as usize].mean();
         for node in h.ancestry(leaf) {
             for link in self.system.links_of(node) {
                 let sn = h.node(link.source);
@@ -71,15 +84,30 @@ impl FinalGather<'_> {
                     continue;
                 }
                 let unoccluded = match linear {
-                    Some(vertex_b) => self.linear_leaf(x, link.source, vertex_b),
+                    Some((vertex_b, _)) => self.linear_leaf(x, link.source, vertex_b),
                     None => self.unoccluded(x, link),
                 };
-                let value = if link.partial && unoccluded.max_channel() > 0.0 {
-                    let (visible, rays) = self.visible_fraction(x, surface, link.source, key);
-                    out.rays += rays;
-                    unoccluded * visible
-                } else {
-                    unoccluded
+                let known = match (&mut seen, link.partial && near) {
+                    (Some(list), true) => list.next().map(|&f| f as f64),
+                    _ => None,
+                };
+                let value = match known {
+                    Some(visible) => unoccluded * visible,
+                    None if link.partial && (near || unoccluded.max_channel() > 0.0) => {
+                        let rays = if unoccluded.mean() < minor {
+                            MINOR_RAYS.min(self.rays)
+                        } else {
+                            self.rays
+                        };
+                        let (visible, rays) =
+                            self.visible_fraction(x, surface, link.source, key, rays);
+                        out.rays += rays;
+                        if near {
+                            out.near_visible.push(visible as f32);
+                        }
+                        unoccluded * visible
+                    }
+                    None => unoccluded,
                 };
                 if near {
                     out.near += value;
@@ -129,26 +157,27 @@ impl FinalGather<'_> {
         let nearest = barycentric_nearest(x.point, &t);
         let at = |w: [f64; 3]| b[0] * w[0] + b[1] * w[1] + b[2] * w[2];
         let b0 = at(nearest);
-        let factor = form_factor(x, &t, tol);
+        let factor = leaf_factor(x, &t, triangle.normal, tol);
         let rest = linear_rest(x, triangle.normal, t, b, b0, LINEAR_DEPTH);
         b0 * factor + rest
     }
 
     /// The fraction of node `s` that `x` sees, weighted by the form-factor kernel, from
-    /// stratified rays.
+    /// `strata` stratified rays.
     fn visible_fraction(
         &self,
         x: &ReceivingPoint,
         surface: SurfaceId,
         s: u32,
         key: u64,
+        strata: usize,
     ) -> (f64, u64) {
         let h = self.system.hierarchy;
         let mut rng = SplitMix64::keyed(self.seed, &[key, s as u64]);
         let origin = x.point + x.inward * self.visibility.junction_offset();
         let (mut seen, mut weight, mut rays) = (0.0, 0.0, 0);
-        for k in 0..self.rays {
-            let (y, t) = h.sample(s, k, self.rays, &mut rng);
+        for k in 0..strata {
+            let (y, t) = h.sample(s, k, strata, &mut rng);
             let d = y - origin;
             let (cx, cy) = (x.normal.dot(d), -t.normal.dot(d));
             if !(cx > 0.0 && cy > 0.0) {
@@ -208,42 +237,4 @@ fn linear_rest(
             (value - b0) * (k * area / 3.0)
         })
         .sum()
-}
-
-/// Barycentric coordinates of the point of triangle `t` nearest to `p`.
-fn barycentric_nearest(p: DVec3, t: &[DVec3; 3]) -> [f64; 3] {
-    let (a, b, c) = (t[0], t[1], t[2]);
-    let (ab, ac, ap) = (b - a, c - a, p - a);
-    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return [1.0, 0.0, 0.0];
-    }
-    let bp = p - b;
-    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return [0.0, 1.0, 0.0];
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        let v = d1 / (d1 - d3);
-        return [1.0 - v, v, 0.0];
-    }
-    let cp = p - c;
-    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return [0.0, 0.0, 1.0];
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        let w = d2 / (d2 - d6);
-        return [1.0 - w, 0.0, w];
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        return [0.0, 1.0 - w, w];
-    }
-    let denom = 1.0 / (va + vb + vc);
-    let (v, w) = (vb * denom, vc * denom);
-    [1.0 - v - w, v, w]
 }

@@ -22,11 +22,11 @@ use rayon::prelude::*;
 
 use super::shaft::{Shafts, Sight};
 use super::transfer::{
-    Axes, FAR_DISTANCE, cluster_intensity, element_intensity, far_factor, point_factor,
-    triangle_mean,
+    Axes, FAR_DISTANCE, cluster_intensity, element_intensity, far_factor, leaf_factor,
+    point_factor, triangle_mean,
 };
 use super::tree::{Hierarchy, Node};
-use crate::lambert::{ReceivingPoint, form_factor};
+use crate::lambert::ReceivingPoint;
 
 /// How light goes along a link.
 #[derive(Clone, Copy, Debug)]
@@ -102,7 +102,7 @@ impl RefineCounts {
 /// A leaf's form factor to a source is integrated finely when it varies over the leaf by more
 /// than this fraction of its mean, in at most [`LEAF_DEPTH`] rounds of splitting in four.
 const LEAF_SPREAD: f64 = 0.05;
-const LEAF_DEPTH: u32 = 3;
+const LEAF_DEPTH: u32 = 2;
 
 /// How far toward a receiver's corners its form factors are judged, from its centroid.
 const CORNER_SHRINK: f64 = 0.98;
@@ -186,7 +186,11 @@ impl Refiner<'_> {
             }
             None => {
                 let partial = !blockers.is_empty();
-                let transfer = transfer.unwrap_or_else(|| self.factor(r, s).0);
+                let transfer = match transfer {
+                    Some(Transfer::Factor { spread, .. }) => self.factor(r, s, spread),
+                    Some(far) => far,
+                    None => self.factor(r, s, self.quick_factor(r, s).1),
+                };
                 let transfer = if partial {
                     self.occlude(r, s, transfer, counts)
                 } else {
@@ -266,16 +270,23 @@ impl Refiner<'_> {
                 rn.reflectance.mul_rgb(irradiance).mean() * rn.area,
             );
         }
-        // Nodes whose spheres overlap allow no estimate, only the bound; otherwise a quick one
-        // decides, and a kept link gets its factor the careful way.
+        // A quick estimate decides (nodes whose spheres overlap allow only the bound), and a
+        // kept link gets its factor the careful way; the quick spread is kept for judging it
+        // again.
+        let (quick, spread) = self.quick_factor(r, s);
         let touching = rn.centroid.distance(sn.centroid) <= rn.radius + sn.radius;
         let error = if touching && (rn.children.is_some() || sn.children.is_some()) {
             self.bound(r, s, state)
         } else {
-            let (factor, spread) = self.quick_factor(r, s);
-            self.factor_error(r, s, factor, spread, state)
+            self.factor_error(r, s, quick, spread, state)
         };
-        (None, error)
+        (
+            Some(Transfer::Factor {
+                factor: f64::NAN,
+                spread,
+            }),
+            error,
+        )
     }
 
     /// The form factor from element `r` to element `s` at `r`'s quadrature points and corners,
@@ -285,9 +296,10 @@ impl Refiner<'_> {
         let (rn, sn) = (h.node(r), h.node(s));
         let far = (FAR_DISTANCE * sn.radius).powi(2);
         let at = |p: DVec3| match sn.children {
-            None if p.distance_squared(sn.centroid) < far => form_factor(
+            None if p.distance_squared(sn.centroid) < far => leaf_factor(
                 &ReceivingPoint::interior(p, rn.normal),
                 &h.triangles[sn.first as usize].points,
+                sn.normal,
                 self.tol,
             ),
             _ => far_factor(p, rn.normal, sn),
@@ -316,22 +328,23 @@ impl Refiner<'_> {
         rn.reflectance.mul_rgb(limit).mean()
     }
 
-    /// The mean form factor from element `r` to element `s`, and its spread over `r`.
-    fn factor(&self, r: u32, s: u32) -> (Transfer, f64) {
+    /// The link from element `s` to element `r` with its mean form factor computed carefully
+    /// (`spread`, its quick spread over `r`, is kept with it).
+    fn factor(&self, r: u32, s: u32, spread: f64) -> Transfer {
         let h = self.hierarchy;
-        let rn = h.node(r);
-        let points = h.quadrature(r);
+        let (rn, sn) = (h.node(r), h.node(s));
         let at = |p: DVec3| point_factor(h, &ReceivingPoint::interior(p, rn.normal), s, self.tol);
-        let factors: smallvec::SmallVec<[f64; 4]> = points.iter().map(|&(p, _)| at(p)).collect();
-        let mut factor: f64 = factors.iter().zip(&points).map(|(f, (_, w))| f * w).sum();
-        let spread = spread(&factors, rn, at);
+        let points = h.quadrature(r);
+        let mut factor: f64 = points.iter().map(|&(p, w)| at(p) * w).sum();
         // A leaf cannot be split: where the form factor varies much over it (next to a
-        // junction, where it rises toward one half), its mean is integrated more finely.
-        if rn.is_leaf() && spread > LEAF_SPREAD * factor {
+        // junction, where it rises toward one half), its mean is integrated more finely, from
+        // leaves (inner sources varying that much are split by the oracle unless they send
+        // little).
+        if rn.is_leaf() && sn.is_leaf() && spread > LEAF_SPREAD * factor {
             let t = &h.triangles[rn.first as usize].points;
             factor = triangle_mean(t, &at, LEAF_DEPTH);
         }
-        (Transfer::Factor { factor, spread }, spread)
+        Transfer::Factor { factor, spread }
     }
 
     /// The light an element-to-element link with form factor `factor` (spread `spread` over

@@ -398,13 +398,14 @@ fn final_gather_all(
     options: &SolverOptions,
     progress: &dyn Progress,
 ) -> Option<(Vec<Rgb>, u64)> {
-    let gather_at = |stage: &str, linear: Option<&[Rgb]>| {
+    let gather_at = |stage: &str, linear: Option<(&[Rgb], &[Gathered])>| {
         each_vertex(disc, stage, options, progress, |v| {
             let leaf = vertex_leaf[v];
             if leaf == NONE || disc.reflectance[v].max_channel() <= 0.0 {
                 return Gathered::default();
             }
             let x = &disc.receivers[v];
+            let linear = linear.map(|(b, first)| (b, &first[v]));
             gather.irradiance(x, disc.receiver_surface[v], leaf, v as u64, linear)
         })
     };
@@ -418,7 +419,7 @@ fn final_gather_all(
         let vertex_b: Vec<Rgb> = (0..disc.receiver_count())
             .map(|v| disc.reflectance[v].mul_rgb(direct[v] + values[v].near + values[v].far))
             .collect();
-        let near = gather_at("final gather, near leaves", Some(&vertex_b))?;
+        let near = gather_at("final gather, near leaves", Some((&vertex_b, &values)))?;
         for (g, n) in values.iter_mut().zip(near) {
             g.near = n.near;
             rays += n.rays;

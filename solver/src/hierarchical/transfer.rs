@@ -101,7 +101,7 @@ pub(crate) fn point_factor(h: &Hierarchy, x: &ReceivingPoint, s: u32, tol: f64) 
         >= (FAR_DISTANCE * node.radius) * (FAR_DISTANCE * node.radius);
     match node.children {
         _ if far => far_factor(x.point, x.normal, node),
-        None => form_factor(x, &h.triangles[node.first as usize].points, tol),
+        None => leaf_factor(x, &h.triangles[node.first as usize].points, node.normal, tol),
         Some([a, b]) => point_factor(h, x, a, tol) + point_factor(h, x, b, tol),
     }
 }
@@ -129,4 +129,56 @@ pub(crate) fn triangle_mean(t: &[DVec3; 3], f: &impl Fn(DVec3) -> f64, depth: u3
         .map(|part| triangle_mean(part, f, depth - 1))
         .sum::<f64>()
         / 4.0
+}
+
+/// The form factor from `x` to triangle `t` (unit normal `normal`) by Lambert's formula; zero
+/// at once for a point in the triangle's plane but off it (the one-sided limit is zero there,
+/// and the formula's terms would cancel to nothing only after integrating).
+pub(crate) fn leaf_factor(x: &ReceivingPoint, t: &[DVec3; 3], normal: DVec3, tol: f64) -> f64 {
+    if normal.dot(x.point - t[0]).abs() <= tol {
+        let w = barycentric_nearest(x.point, t);
+        let nearest = t[0] * w[0] + t[1] * w[1] + t[2] * w[2];
+        if nearest.distance(x.point) > tol {
+            return 0.0;
+        }
+    }
+    form_factor(x, t, tol)
+}
+
+/// Barycentric coordinates of the point of triangle `t` nearest to `p`.
+pub(crate) fn barycentric_nearest(p: DVec3, t: &[DVec3; 3]) -> [f64; 3] {
+    let (a, b, c) = (t[0], t[1], t[2]);
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return [1.0, 0.0, 0.0];
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return [0.0, 1.0, 0.0];
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        let v = d1 / (d1 - d3);
+        return [1.0 - v, v, 0.0];
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return [0.0, 0.0, 1.0];
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        let w = d2 / (d2 - d6);
+        return [1.0 - w, 0.0, w];
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return [0.0, 1.0 - w, w];
+    }
+    let denom = 1.0 / (va + vb + vc);
+    let (v, w) = (vb * denom, vc * denom);
+    [1.0 - v - w, v, w]
 }
