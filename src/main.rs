@@ -330,6 +330,10 @@ struct SweepArgs {
     /// Rays per vertex–patch pair for visibility.
     #[arg(long, default_value_t = SolverOptions::default().visibility_rays)]
     rays: usize,
+    /// With --solvers hierarchical: the light a link may carry wrongly, as a fraction of the
+    /// emitted power.
+    #[arg(long, default_value_t = penumbra_solver::hierarchical::DEFAULT_LINK_TOL)]
+    link_tol: f64,
     /// No progress bar and no table.
     #[arg(long)]
     quiet: bool,
@@ -555,6 +559,7 @@ fn sweep(args: &SweepArgs) -> Result<(), Failure> {
             direct_only: args.direct_only,
             epsilon: args.epsilon,
             visibility_rays: args.rays,
+            link_tol: args.link_tol,
             ..SolverOptions::default()
         },
         solvers: args.solvers.iter().map(|&s| s.into()).collect(),

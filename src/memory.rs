@@ -107,6 +107,9 @@ pub fn estimate(scene: &Scene, options: &RunOptions, counts: MeshCounts) -> Memo
                 columns(p.min(3 * r * r))
             }
             (SolverMethod::Progressive, _) => 0,
+            (SolverMethod::Hierarchical, _) => {
+                penumbra_solver::hierarchical::estimated_bytes(counts.triangles, solver.link_tol)
+            }
             // K per channel, plus its copy under elimination.
             (SolverMethod::Direct, _) => columns(p).saturating_add(matrix.saturating_mul(4)),
             _ => columns(p).saturating_add(matrix.saturating_mul(3)),

@@ -20,7 +20,7 @@ use penumbra_scenes::{Rgb, SurfaceId};
 use smallvec::SmallVec;
 
 use super::iterate::{Field, System};
-use super::links::Link;
+use super::links::{Link, Transfer};
 use super::transfer::{FAR_DISTANCE, barycentric_nearest, leaf_factor, point_factor};
 use crate::elements::Element;
 use crate::lambert::ReceivingPoint;
@@ -91,7 +91,13 @@ impl FinalGather<'_> {
                     (Some(list), true) => list.next().map(|&f| f as f64),
                     _ => None,
                 };
-                let value = match known {
+                // A cluster's link carries little light (the oracle refines any that carries
+                // much), so its own visible fraction serves every point of its receiver.
+                let cluster_visible = match link.transfer {
+                    Transfer::Far { visible, .. } => Some(visible),
+                    Transfer::Factor { .. } => None,
+                };
+                let value = match known.or(cluster_visible) {
                     Some(visible) => unoccluded * visible,
                     None if link.partial && (near || unoccluded.max_channel() > 0.0) => {
                         let rays = if unoccluded.mean() < minor {

@@ -154,12 +154,19 @@ impl Refiner<'_> {
         if behind(sn, rn, self.tol) || behind(rn, sn, self.tol) {
             return;
         }
-        let sight = self.shafts.classify(rn, sn, candidates);
+        let (transfer, error) = self.estimate(r, s, state);
+        // Between clusters that are split anyway the shaft is not worth its cost (a box's hull
+        // has many faces and a cluster's shaft holds many triangles): their children look for
+        // their own blockers.
+        let sight = if error > self.tolerance && rn.is_cluster() && sn.is_cluster() {
+            Sight::Blocked
+        } else {
+            self.shafts.classify(rn, sn, candidates)
+        };
         if sight == Sight::Hidden {
             counts.hidden += 1;
             return;
         }
-        let (transfer, error) = self.estimate(r, s, state);
         let split = if error <= self.tolerance {
             None
         } else {
@@ -174,18 +181,20 @@ impl Refiner<'_> {
                 }),
             }
         };
-        let blockers: &[u32] = match &sight {
-            Sight::Partial(list) => list,
-            _ => &[],
+        // What the children's shafts (inside this one) need to test.
+        let blockers: Option<&[u32]> = match &sight {
+            Sight::Partial(list) => Some(list),
+            Sight::Blocked => None,
+            Sight::Full | Sight::Hidden => Some(&[]),
         };
         match split {
             Some((children, receiver_side)) => {
                 let pairs = children.map(|c| if receiver_side { (c, s) } else { (r, c) });
                 let depth = rn.depth + sn.depth;
-                self.refine_all(&pairs, Some(blockers), depth, state, out, counts);
+                self.refine_all(&pairs, blockers, depth, state, out, counts);
             }
             None => {
-                let partial = !blockers.is_empty();
+                let partial = sight != Sight::Full;
                 let transfer = match transfer {
                     Some(Transfer::Factor { spread, .. }) => self.factor(r, s, spread),
                     Some(far) => far,
@@ -262,9 +271,6 @@ impl Refiner<'_> {
                 rn.normal.dot(-direction).max(0.0)
             };
             let irradiance = state.intensity(sn, s, direction) * (facing / distance2);
-            if std::env::var("NOCLUSTER").is_ok() {
-                return (Some(transfer), f64::INFINITY);
-            }
             return (
                 Some(transfer),
                 rn.reflectance.mul_rgb(irradiance).mean() * rn.area,

@@ -53,6 +53,20 @@ pub const DEFAULT_LINK_TOL: f64 = 1e-5;
 /// again.
 pub const MAX_PASSES: usize = 6;
 
+/// Links per mesh triangle at [`DEFAULT_LINK_TOL`], rounded up from the Cornell box and
+/// boxworld (6 to 9), and how they grow as the tolerance shrinks (about as its inverse square
+/// root).
+const LINKS_PER_TRIANGLE: f64 = 10.0;
+
+/// Bytes the hierarchy and its links take for a mesh of `triangles` at `link_tol`: two nodes
+/// per triangle, their light, and the links.
+pub fn estimated_bytes(triangles: u64, link_tol: f64) -> u64 {
+    let node = (size_of::<tree::Node>() + 4 * size_of::<Rgb>() + 8) as f64;
+    let links = LINKS_PER_TRIANGLE * (DEFAULT_LINK_TOL / link_tol.max(f64::MIN_POSITIVE)).sqrt();
+    let per_triangle = 2.0 * node + links * size_of::<Link>() as f64;
+    (triangles as f64 * per_triangle).min(u64::MAX as f64) as u64
+}
+
 /// Figures of a hierarchical solve, under `solver.hierarchy` in `report.json`.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct HierarchyStats {
@@ -102,21 +116,12 @@ pub fn solve_hierarchical(
 
     let started = Instant::now();
     let hierarchy = Hierarchy::build(&disc, |s| scene.surfaces[s].reflectance);
-    let mut leaf_direct = vec![Rgb::ZERO; hierarchy.nodes.len()];
-    for (e, &leaf) in hierarchy.leaf_of_element.iter().enumerate() {
-        if leaf != NONE {
-            let el = &disc.elements[e];
-            let mean = el.vertices.iter().map(|&v| direct[v]).sum::<Rgb>() / 3.0;
-            leaf_direct[leaf as usize] = scene.surfaces[el.surface].reflectance.mul_rgb(mean);
-        }
-    }
-    let mut system = System::new(&hierarchy, leaf_direct);
+    let mut system = System::new(&hierarchy, leaf_direct(scene, &disc, &hierarchy, &direct));
     let shafts = Shafts::new(scene, visibility);
-    let emitted = scene.emitted_power();
     let refiner = Refiner {
         hierarchy: &hierarchy,
         shafts: &shafts,
-        tolerance: options.link_tol * emitted.mean(),
+        tolerance: options.link_tol * scene.emitted_power().mean(),
         rays: options.visibility_rays,
         seed: options.seed,
         tol: visibility.contact_distance(),
@@ -128,102 +133,27 @@ pub fn solve_hierarchical(
         clusters: system.clusters,
         ..HierarchyStats::default()
     };
-    let mut field = system.initial_field();
-    let mut history = Vec::new();
-    let mut stop;
-    let mut residual = f64::INFINITY;
-    let mut link_seconds = 0.0;
-    let mut sweep_seconds = 0.0;
-    if let Some(root) = hierarchy.root {
-        let t = Instant::now();
-        progress.start("linking", 1);
-        let (links, counts) = refine_pair(&refiner, root, root, &system.radiosities(&field));
-        progress.finish();
-        add_counts(&mut stats, counts);
-        system.set_links(links);
-        link_seconds += t.elapsed().as_secs_f64();
-        'passes: loop {
-            let t = Instant::now();
-            progress.start("sweeps", 1000);
-            let goal = -options.epsilon.log10();
-            loop {
-                if let Some(reason) = options.stop_now() {
-                    stop = reason;
-                    break 'passes;
-                }
-                if stats.sweeps >= options.max_shots {
-                    stop = StopReason::ShotLimit;
-                    break 'passes;
-                }
-                let next = system.sweep(&field);
-                let (change, _) = system.change(&field, &next);
-                field = next;
-                stats.sweeps += 1;
-                residual = change;
-                history.push(ConvergencePoint {
-                    iteration: stats.sweeps,
-                    residual,
-                    seconds: direct_seconds + started.elapsed().as_secs_f64(),
-                });
-                progress
-                    .set(((-residual.max(1e-300).log10() / goal).clamp(0.0, 1.0) * 1000.0) as u64);
-                if residual < options.epsilon {
-                    stop = StopReason::Converged;
-                    break;
-                }
-            }
-            progress.finish();
-            sweep_seconds += t.elapsed().as_secs_f64();
-            stats.refinement_passes += 1;
-            if stats.refinement_passes >= MAX_PASSES {
-                break;
-            }
-            let t = Instant::now();
-            let relinked = relink(&refiner, &system, &field);
-            link_seconds += t.elapsed().as_secs_f64();
-            match relinked {
-                Some((links, counts)) => {
-                    add_counts(&mut stats, counts);
-                    system.set_links(links);
-                }
-                None => break,
-            }
-        }
-    } else {
-        stop = StopReason::Converged;
-        residual = 0.0;
-    }
-    stats.link_seconds = link_seconds;
-    stats.sweep_seconds = sweep_seconds;
+    let clock = || direct_seconds + started.elapsed().as_secs_f64();
+    let solved = link_and_sweep(&mut system, &refiner, options, &mut stats, &clock, progress);
     link_figures(&mut stats, &system);
     let solve_seconds = started.elapsed().as_secs_f64();
 
     // The final gather, unless the run must stop: then each vertex keeps its leaf's value.
     let t = Instant::now();
     let vertex_leaf = vertex_leaves(&disc, &hierarchy);
-    let quick: Vec<Rgb> = vertex_leaf
-        .iter()
-        .map(|&l| {
-            if l == NONE {
-                Rgb::ZERO
-            } else {
-                field.irradiance[l as usize]
-            }
-        })
-        .collect();
     let gather = FinalGather {
         system: &system,
-        field: &field,
+        field: &solved.field,
         visibility,
         elements: &disc.elements,
         rays: options.visibility_rays,
         seed: options.seed,
     };
-    let gathered = if options.stop_now().is_some() {
-        None
-    } else {
-        final_gather_all(&disc, &vertex_leaf, &direct, &gather, options, progress)
+    let gathered = match options.stop_now() {
+        Some(_) => None,
+        None => final_gather_all(&disc, &vertex_leaf, &direct, &gather, options, progress),
     };
+    let mut stop = solved.stop;
     let reflected = match gathered {
         Some((values, rays)) => {
             stats.gather_rays = rays;
@@ -231,37 +161,190 @@ pub fn solve_hierarchical(
         }
         None => {
             stop = options.stop_now().unwrap_or(stop);
-            quick
+            let leaf_value = |&l: &u32| match l {
+                NONE => Rgb::ZERO,
+                l => solved.field.irradiance[l as usize],
+            };
+            vertex_leaf.iter().map(leaf_value).collect()
         }
     };
     let gather_seconds = t.elapsed().as_secs_f64();
-
     let irradiance: Vec<Rgb> = direct
         .iter()
         .zip(&reflected)
         .map(|(&d, &r)| d + r)
         .collect();
+    let solve_stats = SolveStats {
+        stop,
+        iterations: stats.sweeps,
+        residual: solved.residual,
+        direct_seconds,
+        direct_estimated: direct_beyond_cap,
+        direct_beyond_cap,
+        shooting_seconds: solve_seconds,
+        gathered: disc.receiver_count(),
+        gather_seconds,
+        ..energy_stats(scene, &disc, &irradiance, &system, &solved.field, &stats)
+    };
     let radiosity: Vec<Rgb> = (0..disc.receiver_count())
         .map(|v| disc.emission[v] + disc.reflectance[v].mul_rgb(irradiance[v]))
         .collect();
-    let absorbed = disc.integrate(&irradiance, |e| {
+    Ok(Solution {
+        radiosity: disc.per_surface(&radiosity),
+        irradiance: disc.per_surface(&irradiance),
+        ambient: Rgb::ZERO,
+        stats: SolveStats {
+            hierarchy: Some(stats),
+            ..solve_stats
+        },
+        convergence: solved.history,
+    })
+}
+
+/// What each leaf reflects of the exact direct light: ρ times the mean of its vertices' direct
+/// irradiance (the integral of the linear interpolant over the triangle).
+fn leaf_direct(
+    scene: &Scene,
+    disc: &Discretization,
+    hierarchy: &Hierarchy,
+    direct: &[Rgb],
+) -> Vec<Rgb> {
+    let mut out = vec![Rgb::ZERO; hierarchy.nodes.len()];
+    for (e, &leaf) in hierarchy.leaf_of_element.iter().enumerate() {
+        if leaf != NONE {
+            let el = &disc.elements[e];
+            let mean = el.vertices.iter().map(|&v| direct[v]).sum::<Rgb>() / 3.0;
+            out[leaf as usize] = scene.surfaces[el.surface].reflectance.mul_rgb(mean);
+        }
+    }
+    out
+}
+
+/// The hierarchy's solution, how it ended and how it got there.
+struct Solved {
+    field: Field,
+    stop: StopReason,
+    residual: f64,
+    history: Vec<ConvergencePoint>,
+}
+
+/// Links the hierarchy from its root, sweeps until the residual is below `epsilon`, judges the
+/// links again with the new radiosities and refines those that carry too much light wrongly,
+/// and sweeps again, until no link changes (or [`MAX_PASSES`], the sweep cap, the deadline or an
+/// interrupt). `clock` gives the seconds since the run began.
+fn link_and_sweep(
+    system: &mut System,
+    refiner: &Refiner,
+    options: &SolverOptions,
+    stats: &mut HierarchyStats,
+    clock: &dyn Fn() -> f64,
+    progress: &dyn Progress,
+) -> Solved {
+    let mut solved = Solved {
+        field: system.initial_field(),
+        stop: StopReason::Converged,
+        residual: 0.0,
+        history: Vec::new(),
+    };
+    let Some(root) = system.hierarchy.root else {
+        return solved;
+    };
+    let t = Instant::now();
+    progress.start("linking", 1);
+    let (links, counts) = refine_pair(refiner, root, root, &system.radiosities(&solved.field));
+    progress.finish();
+    add_counts(stats, counts);
+    system.set_links(links);
+    stats.link_seconds += t.elapsed().as_secs_f64();
+    loop {
+        let t = Instant::now();
+        let stop = sweep_until(system, &mut solved, options, stats, clock, progress);
+        stats.sweep_seconds += t.elapsed().as_secs_f64();
+        stats.refinement_passes += 1;
+        if stop.is_some() || stats.refinement_passes >= MAX_PASSES {
+            solved.stop = stop.unwrap_or(StopReason::Converged);
+            return solved;
+        }
+        let t = Instant::now();
+        let relinked = relink(refiner, system, &solved.field);
+        stats.link_seconds += t.elapsed().as_secs_f64();
+        let Some((links, counts)) = relinked else {
+            return solved;
+        };
+        add_counts(stats, counts);
+        system.set_links(links);
+    }
+}
+
+/// Jacobi sweeps until the relative residual is below `epsilon`; `Some` reason if the sweeps
+/// must stop before that (the sweep cap, the deadline, an interrupt).
+fn sweep_until(
+    system: &System,
+    solved: &mut Solved,
+    options: &SolverOptions,
+    stats: &mut HierarchyStats,
+    clock: &dyn Fn() -> f64,
+    progress: &dyn Progress,
+) -> Option<StopReason> {
+    progress.start("sweeps", 1000);
+    let goal = -options.epsilon.log10();
+    let stop = loop {
+        if let Some(reason) = options.stop_now() {
+            break Some(reason);
+        }
+        if stats.sweeps >= options.max_shots {
+            break Some(StopReason::ShotLimit);
+        }
+        let next = system.sweep(&solved.field);
+        let (change, _) = system.change(&solved.field, &next);
+        solved.field = next;
+        solved.residual = change;
+        stats.sweeps += 1;
+        solved.history.push(ConvergencePoint {
+            iteration: stats.sweeps,
+            residual: change,
+            seconds: clock(),
+        });
+        progress.set(((-change.max(1e-300).log10() / goal).clamp(0.0, 1.0) * 1000.0) as u64);
+        if change < options.epsilon {
+            break None;
+        }
+    };
+    progress.finish();
+    stop
+}
+
+/// The energy figures of a solution with `irradiance` at the vertices: what is absorbed, what
+/// the hierarchy's leaves send, what escapes, and the rest (as in the gathering solvers: the
+/// light the vertices reflect less what the leaves send).
+fn energy_stats(
+    scene: &Scene,
+    disc: &Discretization,
+    irradiance: &[Rgb],
+    system: &System,
+    field: &Field,
+    stats: &HierarchyStats,
+) -> SolveStats {
+    let emitted = scene.emitted_power();
+    let absorbed = disc.integrate(irradiance, |e| {
         Rgb::splat(1.0) - scene.surfaces[e.surface].reflectance
     });
-    let reflected_power = disc.integrate(&irradiance, |e| scene.surfaces[e.surface].reflectance);
-    let received = disc.integrate(&irradiance, |_| Rgb::splat(1.0));
-    let sent: Rgb = hierarchy
+    let reflected = disc.integrate(irradiance, |e| scene.surfaces[e.surface].reflectance);
+    let received = disc.integrate(irradiance, |_| Rgb::splat(1.0));
+    let sent: Rgb = system
+        .hierarchy
         .nodes
         .iter()
         .enumerate()
         .filter(|(_, n)| n.is_leaf() && !n.is_cluster())
         .map(|(i, n)| field.b[i] * n.area)
         .sum();
-    let unshot = reflected_power - sent;
-    let solve_stats = SolveStats {
-        stop,
+    let unshot = reflected - sent;
+    SolveStats {
+        stop: StopReason::Converged,
         shots: 0,
-        iterations: stats.sweeps,
-        residual: if residual.is_finite() { residual } else { 1.0 },
+        iterations: 0,
+        residual: 0.0,
         patches: stats.leaves,
         receivers: disc.receiver_count(),
         rays_cast: stats.link_rays + stats.gather_rays,
@@ -270,22 +353,15 @@ pub fn solve_hierarchical(
         unshot,
         escaped: emitted + sent - received,
         unshot_fraction: unshot.mean().abs() / emitted.mean().max(f64::MIN_POSITIVE),
-        direct_seconds,
-        direct_estimated: direct_beyond_cap,
-        direct_beyond_cap,
-        shooting_seconds: solve_seconds,
+        direct_seconds: 0.0,
+        direct_estimated: 0,
+        direct_beyond_cap: 0,
+        shooting_seconds: 0.0,
         remeshes: 0,
-        gathered: disc.receiver_count(),
-        gather_seconds,
-        hierarchy: Some(stats),
-    };
-    Ok(Solution {
-        radiosity: disc.per_surface(&radiosity),
-        irradiance: disc.per_surface(&irradiance),
-        ambient: Rgb::ZERO,
-        stats: solve_stats,
-        convergence: history,
-    })
+        gathered: 0,
+        gather_seconds: 0.0,
+        hierarchy: None,
+    }
 }
 
 fn add_counts(stats: &mut HierarchyStats, counts: RefineCounts) {
@@ -411,11 +487,7 @@ fn final_gather_all(
     };
     let mut values = gather_at("final gather", None)?;
     let mut rays: u64 = values.iter().map(|g| g.rays).sum();
-    let passes = std::env::var("LP")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(LINEAR_PASSES);
-    for _ in 0..passes {
+    for _ in 0..LINEAR_PASSES {
         let vertex_b: Vec<Rgb> = (0..disc.receiver_count())
             .map(|v| disc.reflectance[v].mul_rgb(direct[v] + values[v].near + values[v].far))
             .collect();
@@ -459,203 +531,113 @@ fn each_vertex<T: Send>(
 }
 
 #[cfg(test)]
-mod debug_tests {
+mod tests {
     use super::*;
+    use crate::progress::NoProgress;
     use penumbra_meshing::mesh_scene_uniform;
     use penumbra_scenes::builtin;
 
+    /// As the link tolerance shrinks, the leaves' radiosities approach those of the dense
+    /// system the hierarchy stands for: every pair of leaves linked, with the same form factors
+    /// and visibility, solved to rounding.
     #[test]
-    fn corner_sum() {
-        let scene = builtin::furnace(1.0, 0.5);
+    fn shrinking_link_tolerance_approaches_the_dense_leaf_system() {
+        let scene = builtin::cornell();
         let vis = Visibility::build(&scene);
-        let mesh = mesh_scene_uniform(&scene, 1200).unwrap();
-        let disc = Discretization::new(&scene, &mesh, 24);
+        let mesh = mesh_scene_uniform(&scene, 400).expect("meshes");
+        let options = SolverOptions {
+            epsilon: 1e-9,
+            ..SolverOptions::default()
+        };
+        let disc = Discretization::new(&scene, &mesh, options.elements_per_patch);
+        let (direct, _) =
+            direct_irradiance(&scene, &disc, &vis, &options, &NoProgress).expect("direct light");
         let hierarchy = Hierarchy::build(&disc, |s| scene.surfaces[s].reflectance);
-        let leaf_direct = vec![Rgb::splat(0.5); hierarchy.nodes.len()];
-        let mut system = System::new(&hierarchy, leaf_direct);
         let shafts = Shafts::new(&scene, &vis);
-        let refiner = Refiner {
+        let refiner = |tolerance: f64| Refiner {
             hierarchy: &hierarchy,
             shafts: &shafts,
-            tolerance: 1e-5 * 6.0,
-            rays: 16,
-            seed: 1,
+            tolerance,
+            rays: options.visibility_rays,
+            seed: options.seed,
             tol: vis.contact_distance(),
         };
+        let leaves: Vec<u32> = (0..hierarchy.nodes.len() as u32)
+            .filter(|&i| hierarchy.node(i).is_leaf())
+            .collect();
+        let e = leaf_direct(&scene, &disc, &hierarchy, &direct);
+        let system = System::new(&hierarchy, e.clone());
         let field = system.initial_field();
-        let root = hierarchy.root.unwrap();
-        let (links, _) = refine_pair(&refiner, root, root, &system.radiosities(&field));
-        system.set_links(links);
-        let leaves = vertex_leaves(&disc, &hierarchy);
-        let mut rows = vec![];
-        for (i, n) in hierarchy.nodes.iter().enumerate() {
-            if !n.is_leaf() {
-                continue;
-            }
-            let mut sum = 0.0;
-            for node in hierarchy.ancestry(i as u32) {
-                for l in system.links_of(node) {
-                    match l.transfer {
-                        links::Transfer::Factor { factor, .. } => sum += factor,
-                        _ => sum += 1000.0,
-                    }
-                }
-            }
-            rows.push((sum, n.centroid, n.surface));
-        }
-        rows.sort_by(|a, b| a.0.total_cmp(&b.0));
-        for r in rows.iter().take(4).chain(rows.iter().rev().take(6)) {
-            eprintln!("row {:?}", r);
-        }
-        let worst = hierarchy
-            .nodes
+        let whole = refiner(f64::INFINITY);
+        let rows: Vec<Vec<(usize, f64)>> = leaves
             .iter()
-            .position(|n| n.is_leaf() && n.centroid.distance(rows.last().unwrap().1) < 1e-12)
-            .unwrap();
-        let mut per = vec![0.0; 6];
-        for node in hierarchy.ancestry(worst as u32) {
-            for l in system.links_of(node) {
-                let sn = hierarchy.node(l.source);
-                if let links::Transfer::Factor { factor, spread } = l.transfer {
-                    per[sn.surface.unwrap()] += factor;
-                    if factor > 0.01 {
-                        eprintln!(
-                            "  recv depth {} src {} depth {} leaf {} c {:?} r {:.3} F {factor:.4} spread {spread:.4} partial {}",
-                            hierarchy.node(node).depth,
-                            l.source,
-                            sn.depth,
-                            sn.is_leaf(),
-                            sn.centroid,
-                            sn.radius,
-                            l.partial
-                        );
+            .map(|&r| {
+                let mut row = Vec::new();
+                for (j, &s) in leaves.iter().enumerate() {
+                    let mut links = Vec::new();
+                    let mut counts = RefineCounts::default();
+                    whole.refine(
+                        r,
+                        s,
+                        None,
+                        &system.radiosities(&field),
+                        &mut links,
+                        &mut counts,
+                    );
+                    for l in links {
+                        if let links::Transfer::Factor { factor, .. } = l.transfer {
+                            row.push((j, factor));
+                        }
                     }
                 }
+                row
+            })
+            .collect();
+        let mut b: Vec<Rgb> = leaves.iter().map(|&l| e[l as usize]).collect();
+        for _ in 0..500 {
+            for (i, row) in rows.iter().enumerate() {
+                let gathered: Rgb = row.iter().map(|&(j, f)| b[j] * f).sum();
+                let leaf = hierarchy.node(leaves[i]);
+                b[i] = e[leaves[i] as usize] + leaf.reflectance.mul_rgb(gathered);
             }
         }
-        eprintln!("per surface {:?}", per);
-        let mut ranges = vec![];
-        for node in hierarchy.ancestry(worst as u32) {
-            for l in system.links_of(node) {
-                let sn = hierarchy.node(l.source);
-                if sn.surface == Some(4) {
-                    ranges.push((sn.first, sn.end, sn.area, l.source));
-                }
-            }
-        }
-        ranges.sort_by_key(|r| (r.0, r.1));
-        let area: f64 = ranges.iter().map(|r| r.2).sum();
-        eprintln!("wall sources {} area {area}", ranges.len());
-        {
-            let tol = vis.contact_distance();
-            let rn = hierarchy.node(worst as u32);
-            let t = hierarchy.triangles[rn.first as usize].points;
-            let mut diffs = vec![];
-            for node in hierarchy.ancestry(worst as u32) {
-                for l in system.links_of(node) {
-                    if let links::Transfer::Factor { factor, .. } = l.transfer {
-                        let at = |p: glam::DVec3| {
-                            transfer::point_factor(
-                                &hierarchy,
-                                &crate::lambert::ReceivingPoint::interior(p, rn.normal),
-                                l.source,
-                                tol,
-                            )
-                        };
-                        let own = transfer::triangle_mean(&t, &at, 4);
-                        diffs.push((
-                            factor - own,
-                            factor,
-                            own,
-                            hierarchy.node(node).depth,
-                            l.source,
-                            hierarchy.node(l.source).surface,
-                        ));
-                    }
-                }
-            }
-            let total: f64 = diffs.iter().map(|d| d.0).sum();
-            diffs.sort_by(|a, b| b.0.abs().total_cmp(&a.0.abs()));
-            eprintln!("total diff {total}");
-            for d in diffs.iter().take(8) {
-                eprintln!("diff {:?}", d);
-            }
-        }
-        let wall_root = {
-            let mut n = ranges[0].3;
-            while hierarchy.node(n).parent != NONE
-                && hierarchy.node(hierarchy.node(n).parent).surface == Some(4)
-            {
-                n = hierarchy.node(n).parent;
-            }
-            n
-        };
-        for (p, _) in hierarchy.quadrature(worst as u32) {
-            let tol = vis.contact_distance();
-            let x =
-                crate::lambert::ReceivingPoint::interior(p, hierarchy.node(worst as u32).normal);
-            let exact = crate::lambert::form_factor(&x, &scene.surfaces[4].polygon, tol);
-            let pf = transfer::point_factor(&hierarchy, &x, wall_root, tol);
-            let links_sum: f64 = ranges
+        let area: f64 = leaves.iter().map(|&l| hierarchy.node(l).area).sum();
+        let mean = leaves
+            .iter()
+            .zip(&b)
+            .map(|(&l, b)| b.mean() * hierarchy.node(l).area)
+            .sum::<f64>()
+            / area;
+        let mut previous = f64::INFINITY;
+        for tol in [1e-3, 1e-4, 1e-5, 1e-6, 1e-7] {
+            let mut system = System::new(&hierarchy, e.clone());
+            let mut stats = HierarchyStats::default();
+            let emitted = scene.emitted_power().mean();
+            let solved = link_and_sweep(
+                &mut system,
+                &refiner(tol * emitted),
+                &options,
+                &mut stats,
+                &|| 0.0,
+                &NoProgress,
+            );
+            let rms = (leaves
                 .iter()
-                .map(|r| transfer::point_factor(&hierarchy, &x, r.3, tol))
-                .sum();
-            eprintln!("point {p:?}: exact {exact} root {pf} links {links_sum}");
-        }
-        for w in ranges.windows(2) {
-            if w[0].1 > w[1].0 {
-                eprintln!("overlap {:?} {:?}", w[0], w[1]);
-            }
-        }
-        let rn = hierarchy.node(worst as u32);
-        let tol = vis.contact_distance();
-        let t = hierarchy.triangles[rn.first as usize].points;
-        eprintln!("receiver tri {:?}", t);
-        for src in [483u32, 481] {
+                .zip(&b)
+                .map(|(&l, b)| {
+                    (solved.field.b[l as usize] - *b).mean().powi(2) * hierarchy.node(l).area
+                })
+                .sum::<f64>()
+                / area)
+                .sqrt()
+                / mean;
             eprintln!(
-                "src tri {:?}",
-                hierarchy.triangles[hierarchy.node(src).first as usize].points
+                "link tol {tol}: {} links, {rms:.6} of the mean from the dense system",
+                system.links.len()
             );
-            let at = |p: glam::DVec3| {
-                transfer::point_factor(
-                    &hierarchy,
-                    &crate::lambert::ReceivingPoint::interior(p, rn.normal),
-                    src,
-                    tol,
-                )
-            };
-            for d in 0..7 {
-                eprintln!("depth {d}: {}", transfer::triangle_mean(&t, &at, d));
-            }
-            let mut rng = penumbra_scenes::rng::SplitMix64::new(3);
-            let mut sum = 0.0;
-            let n = 200000;
-            for _ in 0..n {
-                let (r1, r2) = (rng.next_f64().sqrt(), rng.next_f64());
-                let p = t[0] * (1.0 - r1) + t[1] * (r1 * (1.0 - r2)) + t[2] * (r1 * r2);
-                sum += at(p);
-            }
-            eprintln!("mc {}", sum / n as f64);
+            assert!(rms < previous, "{tol}: {rms} after {previous}");
+            previous = rms;
         }
-        let tol = vis.contact_distance();
-        for v in 0..disc.receiver_count() {
-            let x = &disc.receivers[v];
-            if x.point.length() > 1e-9 {
-                continue;
-            }
-            let mut sum = 0.0;
-            let mut per_surface = vec![0.0; 6];
-            for node in hierarchy.ancestry(leaves[v]) {
-                for l in system.links_of(node) {
-                    let f = transfer::point_factor(&hierarchy, x, l.source, tol);
-                    sum += f;
-                    per_surface[hierarchy.node(l.source).surface.unwrap()] += f;
-                }
-            }
-            eprintln!(
-                "vertex {v} surface {} inward {:?}: {sum} {:?}",
-                disc.receiver_surface[v], x.inward, per_surface
-            );
-        }
+        assert!(previous < 1e-3, "{previous}");
     }
 }

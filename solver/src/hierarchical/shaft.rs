@@ -18,12 +18,18 @@ pub(crate) enum Sight {
     Full,
     /// Some segments may be blocked, by these scene triangles only.
     Partial(Vec<u32>),
+    /// Some segments may be blocked, by some of too many triangles to list.
+    Blocked,
     /// Every segment crosses one polygon.
     Hidden,
 }
 
 /// How many distinct blocking polygons are tried as the one that hides a shaft whole.
 const HIDING_CANDIDATES: usize = 8;
+
+/// Candidates beyond which a shaft's blockers are not listed (it is only found that one blocks):
+/// filtering long lists again at every level would cost more than asking the index again.
+const LISTED_CANDIDATES: usize = 64;
 
 /// The scene's blockers, and which of its polygons are convex (only those can prove a shaft
 /// hidden by a containment test of its crossing points).
@@ -59,18 +65,26 @@ impl<'a> Shafts<'a> {
             let tri = &triangles[t as usize];
             !own(tri.surface) && !shaft.excludes(&tri.vertices, self.tol)
         };
-        let blockers: Vec<u32> = match candidates {
-            Some(list) => list.iter().copied().filter(|&t| blocks(t)).collect(),
+        let queried;
+        let list: &[u32] = match candidates {
+            Some(list) => list,
             None => {
-                let mut list = Vec::new();
+                let mut found = Vec::new();
                 self.visibility
-                    .triangles_overlapping_between(a.bounds, b.bounds, |t| list.push(t as u32));
-                list.sort_unstable();
-                list.dedup();
-                list.retain(|&t| blocks(t));
-                list
+                    .triangles_overlapping_between(a.bounds, b.bounds, |t| found.push(t as u32));
+                found.sort_unstable();
+                found.dedup();
+                queried = found;
+                &queried
             }
         };
+        if list.len() > LISTED_CANDIDATES {
+            return match list.iter().find(|&&t| blocks(t)) {
+                Some(_) => Sight::Blocked,
+                None => Sight::Full,
+            };
+        }
+        let blockers: Vec<u32> = list.iter().copied().filter(|&t| blocks(t)).collect();
         if blockers.is_empty() {
             return Sight::Full;
         }
@@ -84,8 +98,7 @@ impl<'a> Shafts<'a> {
                 break;
             }
             tried.push(s);
-            if std::env::var("NOHIDE").is_err() && self.convex[s] && self.hides(s, &a.hull, &b.hull)
-            {
+            if self.convex[s] && self.hides(s, &a.hull, &b.hull) {
                 return Sight::Hidden;
             }
         }
@@ -135,6 +148,26 @@ fn is_convex(polygon: &[DVec3], normal: DVec3) -> bool {
     })
 }
 
+/// The plane `n · x = d` (unit `n`) oriented so that every point is on its inner side (within
+/// `tol`), or `None` if points lie on both sides; stops at the first point that tells.
+fn supporting(
+    n: DVec3,
+    d: f64,
+    points: impl Iterator<Item = DVec3>,
+    tol: f64,
+) -> Option<(DVec3, f64)> {
+    let (mut above, mut below) = (false, false);
+    for p in points {
+        let h = n.dot(p) - d;
+        above |= h > tol;
+        below |= h < -tol;
+        if above && below {
+            return None;
+        }
+    }
+    Some(if above { (-n, -d) } else { (n, d) })
+}
+
 /// The faces of the convex hull of two point sets, as planes `n · x = d` with outward unit `n`.
 struct Shaft {
     planes: SmallVec<[(DVec3, f64); 32]>,
@@ -144,23 +177,16 @@ impl Shaft {
     /// The hull's faces are among the planes through an edge of one hull and a point of the
     /// other, and the faces of each hull: of those, the planes with every point on one side.
     fn new(a: &[DVec3], b: &[DVec3], tol: f64) -> Shaft {
+        if a.len() == 8 && b.len() == 8 {
+            return Shaft::between_boxes(a, b, tol);
+        }
         let mut planes = SmallVec::new();
-        let points = || a.iter().chain(b);
+        let points = || a.iter().chain(b).copied();
         let mut consider = |normal: DVec3, at: DVec3| {
             let length = normal.length();
-            if !(length > 0.0) {
-                return;
-            }
-            let n = normal / length;
-            let d = n.dot(at);
-            let (lo, hi) = points().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
-                let h = n.dot(*p) - d;
-                (lo.min(h), hi.max(h))
-            });
-            if hi <= tol {
-                planes.push((n, d));
-            } else if lo >= -tol {
-                planes.push((-n, -d));
+            if length > 0.0 {
+                let n = normal / length;
+                planes.extend(supporting(n, n.dot(at), points(), tol));
             }
         };
         for (hull, other) in [(a, b), (b, a)] {
@@ -171,6 +197,35 @@ impl Shaft {
             }
             for (normal, at) in faces(hull) {
                 consider(normal, at);
+            }
+        }
+        Shaft { planes }
+    }
+
+    /// The shaft between two boxes (corners as from [`box_corners`](super::tree)): its faces
+    /// are faces of the boxes' union, or planes through an edge of one box and the parallel edge
+    /// of the other, since every edge runs along an axis.
+    fn between_boxes(a: &[DVec3], b: &[DVec3], tol: f64) -> Shaft {
+        let mut planes: SmallVec<[(DVec3, f64); 32]> = SmallVec::new();
+        let (lo, hi) = (a[0].min(b[0]), a[7].max(b[7]));
+        for axis in [DVec3::X, DVec3::Y, DVec3::Z] {
+            planes.push((-axis, -axis.dot(lo)));
+            planes.push((axis, axis.dot(hi)));
+        }
+        let points = || a.iter().chain(b).copied();
+        for bit in [1, 2, 4] {
+            let axis = a[bit] - a[0];
+            // The edges along this axis start at the corners without its bit.
+            for i in (0..8).filter(|i| i & bit == 0) {
+                for j in (0..8).filter(|j| j & bit == 0) {
+                    let normal = axis.cross(b[j] - a[i]);
+                    let length = normal.length();
+                    if !(length > 0.0) {
+                        continue;
+                    }
+                    let n = normal / length;
+                    planes.extend(supporting(n, n.dot(a[i]), points(), tol));
+                }
             }
         }
         Shaft { planes }

@@ -101,7 +101,12 @@ pub(crate) fn point_factor(h: &Hierarchy, x: &ReceivingPoint, s: u32, tol: f64) 
         >= (FAR_DISTANCE * node.radius) * (FAR_DISTANCE * node.radius);
     match node.children {
         _ if far => far_factor(x.point, x.normal, node),
-        None => leaf_factor(x, &h.triangles[node.first as usize].points, node.normal, tol),
+        None => leaf_factor(
+            x,
+            &h.triangles[node.first as usize].points,
+            node.normal,
+            tol,
+        ),
         Some([a, b]) => point_factor(h, x, a, tol) + point_factor(h, x, b, tol),
     }
 }
