@@ -390,10 +390,36 @@ fn run_failure(e: penumbra::RunError, options: BudgetOptions) -> Failure {
     if let Some(message) = budget_message(&e, options) {
         return usage(anyhow::anyhow!(message));
     }
+    if let penumbra::RunError::Solve(e) = e {
+        return solve_failure(e);
+    }
     if e.is_usage() {
         usage(e)
     } else {
         Failure::from(e)
+    }
+}
+
+/// A solver error; a bad option is told by the flag that set it.
+fn solve_failure(e: penumbra_solver::SolveError) -> Failure {
+    use penumbra_solver::SolveError;
+    let flag = |option: &str| match option {
+        "epsilon" => Some("--epsilon"),
+        "link tolerance" => Some("--link-tol"),
+        "visibility rays" => Some("--rays"),
+        "elements per patch" => Some("--elements-per-patch"),
+        "form-factor samples" => Some("--ff-samples"),
+        "form factors" => Some("--form-factors"),
+        "solver" => Some("--solver"),
+        "direct only" => Some("--direct-only"),
+        _ => None,
+    };
+    match e {
+        SolveError::InvalidOption { option, reason } => usage(match flag(option) {
+            Some(flag) => anyhow::anyhow!("invalid {flag} ({option}): {reason}"),
+            None => anyhow::anyhow!("invalid {option}: {reason}"),
+        }),
+        e => Failure::from(penumbra::RunError::Solve(e)),
     }
 }
 
@@ -564,7 +590,7 @@ fn sweep(args: &SweepArgs) -> Result<(), Failure> {
         },
         solvers: args.solvers.iter().map(|&s| s.into()).collect(),
     };
-    options.solver.validate().map_err(usage)?;
+    options.solver.validate().map_err(solve_failure)?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
     let scene = &loaded.scene;

@@ -573,6 +573,104 @@ fn solvers_agree_and_report_their_convergence() {
     );
 }
 
+/// `--solver hierarchical` converges, reports its hierarchy and links, agrees with the dense
+/// solve on the surfaces' means, stops at a spent time budget with a partial solution, and
+/// refuses a link tolerance outside (0, 1) by naming the option.
+#[test]
+fn hierarchical_runs_report_their_links() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    // The room's large surfaces (the blocks' sides, a few patches each for the dense solve at
+    // this budget, are where its own discretization errs most).
+    let means = |out: &Path| -> Vec<f64> {
+        json(&out.join("solution.json"))["surfaces"]
+            .as_array()
+            .expect("surfaces")
+            .iter()
+            .filter(|s| !s["name"].as_str().expect("name").contains("block"))
+            .map(|s| {
+                let b = s["radiosity"].as_array().expect("radiosity");
+                b.iter().map(|c| c[1].as_f64().expect("g")).sum::<f64>() / b.len() as f64
+            })
+            .collect()
+    };
+    let out = dir.path().join("hierarchical");
+    let common = [
+        "--max-elements",
+        "3000",
+        "--epsilon",
+        "1e-6",
+        "--convergence",
+    ];
+    run_quietly(
+        "cornell",
+        &out,
+        &[&common[..], &["--solver", "hierarchical"]].concat(),
+    );
+    let report = json(&out.join("report.json"));
+    let stats = &report["solver"];
+    assert_eq!(stats["stop"], "converged", "{stats}");
+    let h = &stats["hierarchy"];
+    let links = h["links"].as_u64().expect("links");
+    let by_depth: u64 = h["links_by_depth"]
+        .as_array()
+        .expect("by depth")
+        .iter()
+        .map(|n| n.as_u64().expect("count"))
+        .sum();
+    assert!(links > 0 && by_depth == links, "{h}");
+    assert_eq!(
+        h["links_open"].as_u64().expect("open") + h["links_partial"].as_u64().expect("partial"),
+        links
+    );
+    assert!(h["clusters"].as_u64().expect("clusters") > 0);
+    let csv = std::fs::read_to_string(out.join("convergence.csv")).expect("csv");
+    assert_eq!(
+        csv.lines().count() as u64 - 1,
+        stats["iterations"].as_u64().expect("iterations") + 1
+    );
+    let dense = dir.path().join("direct");
+    run_quietly(
+        "cornell",
+        &dense,
+        &[&common[..], &["--solver", "direct"]].concat(),
+    );
+    for (h, d) in means(&out).iter().zip(means(&dense)) {
+        assert!((h - d).abs() < 0.03 * d, "{h} against {d}");
+    }
+    let spent = dir.path().join("spent");
+    let o = penumbra(&[
+        "run",
+        "cornell",
+        "--solver",
+        "hierarchical",
+        "--time-budget",
+        "0.01",
+        "--out",
+        spent.to_str().expect("utf-8"),
+        "--quiet",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let report = json(&spent.join("report.json"));
+    assert_eq!(report["partial"], true);
+    assert_eq!(report["solver"]["stop"], "time_budget");
+    assert!(check_radiosity(&json(&spent.join("solution.json"))) > 0);
+    for bad in ["0", "-1", "NaN", "1"] {
+        let o = penumbra(&[
+            "run",
+            "textbook",
+            "--solver",
+            "hierarchical",
+            &format!("--link-tol={bad}"),
+            "--out",
+            dir.path().join("bad").to_str().expect("utf-8"),
+        ]);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{stderr}");
+        assert!(stderr.contains("--link-tol"), "{stderr}");
+        assert!(!dir.path().join("bad").exists());
+    }
+}
+
 /// `penumbra sweep --solvers` repeats each plain run with each solver (adaptive runs shoot), a
 /// row and a chart line each, the solver named in the CSV's last column.
 #[test]

@@ -240,11 +240,16 @@ fn link_and_sweep(
     clock: &dyn Fn() -> f64,
     progress: &dyn Progress,
 ) -> Solved {
+    // Before the first sweep none of the reflected light is gathered: a residual of one.
     let mut solved = Solved {
         field: system.initial_field(),
         stop: StopReason::Converged,
         residual: 0.0,
-        history: Vec::new(),
+        history: vec![ConvergencePoint {
+            iteration: 0,
+            residual: 1.0,
+            seconds: clock(),
+        }],
     };
     let Some(root) = system.hierarchy.root else {
         return solved;
