@@ -16,5 +16,6 @@ pub mod shard;
 pub mod sweep;
 
 pub use pipeline::{
-    DEFAULT_BUDGET, DEFAULT_MAX_ELEMENTS, MeshMethod, RunError, RunOptions, RunResult, run,
+    DEFAULT_BUDGET, DEFAULT_MAX_ELEMENTS, HIERARCHICAL_MAX_ELEMENTS, MeshMethod, RunError,
+    RunOptions, RunResult, default_budget, run,
 };

@@ -12,7 +12,7 @@ use anyhow::Context;
 use clap::{Parser, Subcommand, ValueEnum};
 use penumbra::outputs::{DEFAULT_SVG_SURFACES, SvgSelection, write_outputs};
 use penumbra::progress_bar::Bars;
-use penumbra::{DEFAULT_BUDGET, DEFAULT_MAX_ELEMENTS, MeshMethod, RunOptions};
+use penumbra::{DEFAULT_MAX_ELEMENTS, MeshMethod, RunOptions};
 use penumbra_meshing::grading::DEFAULT_PENUMBRA_DENSITY;
 use penumbra_meshing::{ElementBudget, FIT_TRIANGLES_PER_SURFACE, MeshError};
 use penumbra_scenes::{ObjOptions, SceneError, builtin, load_scene_with};
@@ -21,7 +21,10 @@ use penumbra_solver::{Interrupt, SolverOptions};
 
 // The help texts below give these figures in words.
 const _: () = assert!(
-    DEFAULT_MAX_ELEMENTS == 10_000 && FIT_TRIANGLES_PER_SURFACE == 1 && DEFAULT_SVG_SURFACES == 24
+    DEFAULT_MAX_ELEMENTS == 10_000
+        && penumbra::HIERARCHICAL_MAX_ELEMENTS == 25_000
+        && FIT_TRIANGLES_PER_SURFACE == 1
+        && DEFAULT_SVG_SURFACES == 24
 );
 
 #[derive(Parser, Debug)]
@@ -140,7 +143,8 @@ struct RunArgs {
     #[arg(long, value_enum)]
     mesh: Option<MeshArg>,
     /// Cap on triangles for the whole scene, spread over the surfaces by area. Default: what the
-    /// scene needs: 10,000, or, when that is too few, the least mesh of its polygons with their
+    /// scene needs: 10,000 (25,000 with --solver hierarchical, whose cost grows about linearly
+    /// with the vertices), or, when that is too few, the least mesh of its polygons with their
     /// discontinuities as edges and 1 triangle more per surface.
     #[arg(long)]
     max_elements: Option<usize>,
@@ -986,9 +990,10 @@ fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
             Some(MeshArg::Uniform) => MeshMethod::Uniform,
             Some(MeshArg::Discontinuity) => MeshMethod::Discontinuity,
         },
-        max_elements: args
-            .max_elements
-            .map_or(DEFAULT_BUDGET, ElementBudget::AtMost),
+        max_elements: args.max_elements.map_or(
+            penumbra::default_budget(args.solver.into()),
+            ElementBudget::AtMost,
+        ),
         penumbra_density,
         time_budget: args.time_budget,
         refine: args

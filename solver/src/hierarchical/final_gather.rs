@@ -9,8 +9,7 @@
 //! sees is the strip of the other surface right beside it, darker than that surface's elements
 //! on average (it sees the first surface's dark strip in turn), so a leaf's mean radiosity
 //! overstates it. Near leaves are therefore gathered again with their radiosity linear over them,
-//! from their vertices' values of the gather before, a few times over: the strips on both sides
-//! converge together.
+//! from their vertices' values of the gather before.
 
 use std::f64::consts::PI;
 
@@ -51,6 +50,9 @@ pub(crate) struct Gathered {
 /// part of a small part.
 const MINOR_SHARE: f64 = 0.02;
 const MINOR_RAYS: usize = 4;
+
+/// Levels below a linked element whose radiosities a vertex gathers.
+const SOURCE_LEVELS: u32 = 3;
 
 /// Rounds of subdividing a near leaf to integrate its linear radiosity against the kernel.
 const LINEAR_DEPTH: u32 = 4;
@@ -140,8 +142,23 @@ impl FinalGather<'_> {
                 .intensity(sn, s, direction)
                 * (facing / distance2)
         } else {
-            let tol = self.visibility.contact_distance();
-            self.field.b[s as usize] * point_factor(h, x, s, tol)
+            self.element_source(x, s, SOURCE_LEVELS)
+        }
+    }
+
+    /// What `x` receives from element `s`, unoccluded, with the radiosities of its descendants
+    /// `levels` down: a source's mean would miss how its brighter parts lie toward `x` (the
+    /// floor's bright middle under the ceiling's middle).
+    fn element_source(&self, x: &ReceivingPoint, s: u32, levels: u32) -> Rgb {
+        let h = self.system.hierarchy;
+        match h.node(s).children {
+            Some([a, b]) if levels > 0 => {
+                self.element_source(x, a, levels - 1) + self.element_source(x, b, levels - 1)
+            }
+            _ => {
+                let tol = self.visibility.contact_distance();
+                self.field.b[s as usize] * point_factor(h, x, s, tol)
+            }
         }
     }
 

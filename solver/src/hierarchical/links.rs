@@ -340,8 +340,7 @@ impl Refiner<'_> {
         let h = self.hierarchy;
         let (rn, sn) = (h.node(r), h.node(s));
         let at = |p: DVec3| point_factor(h, &ReceivingPoint::interior(p, rn.normal), s, self.tol);
-        let points = h.quadrature(r);
-        let mut factor: f64 = points.iter().map(|&(p, w)| at(p) * w).sum();
+        let mut factor: f64 = h.quadrature(r).iter().map(|&(p, w)| at(p) * w).sum();
         // A leaf cannot be split: where the form factor varies much over it (next to a
         // junction, where it rises toward one half), its mean is integrated more finely, from
         // leaves (inner sources varying that much are split by the oracle unless they send
