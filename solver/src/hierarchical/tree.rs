@@ -214,7 +214,7 @@ impl<F: Fn(SurfaceId) -> Rgb> Builder<'_, F> {
     fn cluster(&mut self, surfaces: &mut [SurfaceId], parent: u32, depth: u16) -> u32 {
         if let [s] = surfaces {
             let elements = std::mem::take(&mut self.by_surface[*s]);
-            return self.surface(elements, *s, parent, depth);
+            return self.surface(&elements, *s, parent, depth);
         }
         let centroid = |s: SurfaceId| -> DVec3 {
             let (sum, area) = self.by_surface[s]
@@ -351,7 +351,7 @@ impl<F: Fn(SurfaceId) -> Rgb> Builder<'_, F> {
     /// The tree of surface `s`: its connected pieces first (the two sides of a contact line
     /// share no vertex, so the floor under a block is never averaged with the floor beside it:
     /// the strongest discontinuities are split first), then each piece's own tree.
-    fn surface(&mut self, elements: Vec<u32>, s: SurfaceId, parent: u32, depth: u16) -> u32 {
+    fn surface(&mut self, elements: &[u32], s: SurfaceId, parent: u32, depth: u16) -> u32 {
         let mut pieces = connected_pieces(self.disc, elements);
         self.pieces(&mut pieces, s, parent, depth)
     }
@@ -428,7 +428,7 @@ impl<F: Fn(SurfaceId) -> Rgb> Builder<'_, F> {
 
 /// `elements` split into groups connected through shared vertices, each group in ascending
 /// order, groups ordered by their first element.
-fn connected_pieces(disc: &Discretization, elements: Vec<u32>) -> Vec<Vec<u32>> {
+fn connected_pieces(disc: &Discretization, elements: &[u32]) -> Vec<Vec<u32>> {
     let mut sets = penumbra_scenes::union_find::UnionFind::new(elements.len());
     let mut owner: std::collections::HashMap<usize, usize> = std::collections::HashMap::new();
     for (k, &e) in elements.iter().enumerate() {
