@@ -178,7 +178,7 @@ struct RunArgs {
     #[arg(long, value_enum, default_value_t = SolverArg::Progressive)]
     solver: SolverArg,
     /// With --solver hierarchical: the light a link may carry wrongly, as a fraction of the
-    /// emitted power; smaller is finer and slower.
+    /// light the surfaces reflect of the direct light; smaller is finer and slower.
     #[arg(long, default_value_t = penumbra_solver::hierarchical::DEFAULT_LINK_TOL)]
     link_tol: f64,
     /// How vertex-to-patch form factors are computed: Lambert's formula times a ray-sampled
@@ -335,7 +335,7 @@ struct SweepArgs {
     #[arg(long, default_value_t = SolverOptions::default().visibility_rays)]
     rays: usize,
     /// With --solvers hierarchical: the light a link may carry wrongly, as a fraction of the
-    /// emitted power.
+    /// light the surfaces reflect of the direct light.
     #[arg(long, default_value_t = penumbra_solver::hierarchical::DEFAULT_LINK_TOL)]
     link_tol: f64,
     /// No progress bar and no table.

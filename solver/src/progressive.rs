@@ -60,7 +60,7 @@ pub struct SolverOptions {
     /// How vertex-to-patch form factors are computed.
     pub form_factors: FormFactorMethod,
     /// The hierarchical solver's link tolerance: the light a link may carry wrongly, as a
-    /// fraction of the emitted power.
+    /// fraction of the light the surfaces reflect of the direct light.
     pub link_tol: f64,
 }
 

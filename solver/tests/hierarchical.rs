@@ -31,34 +31,45 @@ fn face_means(mesh: &SceneMesh, field: &[Vec<Rgb>]) -> Vec<f64> {
         .collect()
 }
 
+/// The closed furnace: B = E / (1 − ρ) everywhere. With the default link tolerance every face's
+/// mean is within 0.5 %; with a tighter one every vertex is (corner vertices are the last).
 #[test]
 fn furnace_gives_e_over_one_minus_rho() {
     for rho in [0.5, 0.9, 0.99] {
         let scene = builtin::furnace(1.0, rho);
         let mesh = mesh_scene_uniform(&scene, 1200).expect("cube meshes");
-        let options = SolverOptions {
-            epsilon: 1e-6,
-            ..SolverOptions::default()
-        };
-        let solution = solve(&scene, &mesh, &options);
-        assert_eq!(solution.stats.stop, StopReason::Converged);
         let expected = 1.0 / (1.0 - rho);
-        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-        for b in solution.radiosity.iter().flatten() {
-            for c in b.to_array() {
-                lo = lo.min(c / expected);
-                hi = hi.max(c / expected);
+        for link_tol in [SolverOptions::default().link_tol, 1e-6] {
+            let options = SolverOptions {
+                epsilon: 1e-6,
+                link_tol,
+                ..SolverOptions::default()
+            };
+            let solution = solve(&scene, &mesh, &options);
+            assert_eq!(solution.stats.stop, StopReason::Converged);
+            let worst = solution
+                .radiosity
+                .iter()
+                .flatten()
+                .flat_map(|b| b.to_array())
+                .map(|c| (c / expected - 1.0).abs())
+                .fold(0.0, f64::max);
+            let means = face_means(&mesh, &solution.radiosity);
+            let worst_mean = means
+                .iter()
+                .map(|m| (m / expected - 1.0).abs())
+                .fold(0.0, f64::max);
+            eprintln!(
+                "rho {rho}, link tol {link_tol}: vertices within {worst:.5}, faces {worst_mean:.5}"
+            );
+            assert!(
+                worst_mean < 5e-3,
+                "rho {rho}: a face mean is {worst_mean} off"
+            );
+            if link_tol < 1e-5 {
+                assert!(worst < 5e-3, "rho {rho}: a vertex is {worst} off");
             }
         }
-        let means = face_means(&mesh, &solution.radiosity);
-        eprintln!("rho {rho}: vertices {lo:.5} .. {hi:.5}, face means {means:?}");
-        for m in means {
-            assert!(
-                (m / expected - 1.0).abs() < 5e-3,
-                "rho {rho}: face mean {m}"
-            );
-        }
-        assert!(lo > 0.99 && hi < 1.02, "rho {rho}: {lo} .. {hi}");
     }
 }
 

@@ -21,6 +21,25 @@ pub(crate) struct Field {
     pub q: Vec<Axes>,
     /// Per node: an element's mean irradiance from reflected light, its ancestors' included.
     pub irradiance: Vec<Rgb>,
+    /// Per node: half the range of its leaves' radiosities, per channel (how far its mean may
+    /// be from its parts; a light in the middle of a wall leaves halves of equal means).
+    pub spread: Vec<Rgb>,
+    /// Per node: the least and greatest radiosity of its leaves.
+    low: Vec<Rgb>,
+    high: Vec<Rgb>,
+}
+
+impl Field {
+    fn new(nodes: usize, clusters: usize) -> Field {
+        Field {
+            b: vec![Rgb::ZERO; nodes],
+            q: vec![[Rgb::ZERO; 6]; clusters],
+            irradiance: vec![Rgb::ZERO; nodes],
+            spread: vec![Rgb::ZERO; nodes],
+            low: vec![Rgb::ZERO; nodes],
+            high: vec![Rgb::ZERO; nodes],
+        }
+    }
 }
 
 /// The hierarchy with its links grouped by receiver, and what each element reflects of the
@@ -101,6 +120,7 @@ impl<'a> System<'a> {
         Radiosities {
             b: &field.b,
             q: &field.q,
+            spread: &field.spread,
             slot: &self.slot,
         }
     }
@@ -108,11 +128,7 @@ impl<'a> System<'a> {
     /// The field before any reflected light has been gathered: the direct light reflected.
     pub fn initial_field(&self) -> Field {
         let n = self.hierarchy.nodes.len();
-        let mut field = Field {
-            b: vec![Rgb::ZERO; n],
-            q: vec![[Rgb::ZERO; 6]; self.clusters],
-            irradiance: vec![Rgb::ZERO; n],
-        };
+        let mut field = Field::new(n, self.clusters);
         if let Some(root) = self.hierarchy.root {
             let gathered = Gathered {
                 h: vec![Rgb::ZERO; n],
@@ -126,11 +142,7 @@ impl<'a> System<'a> {
     /// One Jacobi sweep from `field`: the new field.
     pub fn sweep(&self, field: &Field) -> Field {
         let gathered = self.gather(field);
-        let mut next = Field {
-            b: vec![Rgb::ZERO; field.b.len()],
-            q: vec![[Rgb::ZERO; 6]; self.clusters],
-            irradiance: vec![Rgb::ZERO; field.b.len()],
-        };
+        let mut next = Field::new(field.b.len(), self.clusters);
         if let Some(root) = self.hierarchy.root {
             self.push_pull(root, Down::Axes([Rgb::ZERO; 6]), &gathered, &mut next);
         }
@@ -200,17 +212,34 @@ impl<'a> System<'a> {
                 };
                 let total = down + gathered.h[id as usize];
                 out.irradiance[id as usize] = total;
-                out.b[id as usize] = match node.children {
-                    None => self.direct[id as usize] + node.reflectance.mul_rgb(total),
+                let i = id as usize;
+                match node.children {
+                    None => {
+                        let b = self.direct[i] + node.reflectance.mul_rgb(total);
+                        (out.b[i], out.low[i], out.high[i]) = (b, b, b);
+                    }
                     Some(children) => {
                         let mut sum = Rgb::ZERO;
+                        let (mut low, mut high) = (Rgb::splat(f64::INFINITY), Rgb::ZERO);
                         for c in children {
                             self.push_pull(c, Down::Irradiance(total), gathered, out);
-                            sum += out.b[c as usize] * self.hierarchy.node(c).area;
+                            let c = c as usize;
+                            sum += out.b[c] * self.hierarchy.nodes[c].area;
+                            low = Rgb::new(
+                                low.r.min(out.low[c].r),
+                                low.g.min(out.low[c].g),
+                                low.b.min(out.low[c].b),
+                            );
+                            high = Rgb::new(
+                                high.r.max(out.high[c].r),
+                                high.g.max(out.high[c].g),
+                                high.b.max(out.high[c].b),
+                            );
                         }
-                        sum / node.area
+                        (out.b[i], out.low[i], out.high[i]) = (sum / node.area, low, high);
                     }
-                };
+                }
+                out.spread[i] = (out.high[i] - out.low[i]) * 0.5;
             }
             slot => {
                 let mut total = match down {

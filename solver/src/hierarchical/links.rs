@@ -58,6 +58,8 @@ pub(crate) struct Radiosities<'s> {
     pub b: &'s [Rgb],
     pub q: &'s [Axes],
     /// Each node's slot in `q` (clusters only).
+    /// Half the range of each element's leaves' radiosities.
+    pub spread: &'s [Rgb],
     pub slot: &'s [u32],
 }
 
@@ -340,7 +342,7 @@ impl Refiner<'_> {
         let h = self.hierarchy;
         let (rn, sn) = (h.node(r), h.node(s));
         let at = |p: DVec3| point_factor(h, &ReceivingPoint::interior(p, rn.normal), s, self.tol);
-        let mut factor: f64 = h.quadrature(r).iter().map(|&(p, w)| at(p) * w).sum();
+        let mut factor: f64 = h.fine_quadrature(r).iter().map(|&(p, w)| at(p) * w).sum();
         // A leaf cannot be split: where the form factor varies much over it (next to a
         // junction, where it rises toward one half), its mean is integrated more finely, from
         // leaves (inner sources varying that much are split by the oracle unless they send
@@ -355,20 +357,9 @@ impl Refiner<'_> {
     /// The light an element-to-element link with form factor `factor` (spread `spread` over
     /// the receiver) carries wrongly.
     fn factor_error(&self, r: u32, s: u32, factor: f64, spread: f64, state: &Radiosities) -> f64 {
-        let h = self.hierarchy;
-        let (rn, sn) = (h.node(r), h.node(s));
-        let b = state.b[s as usize];
-        // The disc stands for a source of some size: off by about (radius / distance)².
-        let variation = match sn.children {
-            None => Rgb::ZERO,
-            Some(children) => children
-                .iter()
-                .map(|&c| (state.b[c as usize] - b).map(f64::abs))
-                .fold(Rgb::ZERO, |m, d| {
-                    Rgb::new(m.r.max(d.r), m.g.max(d.g), m.b.max(d.b))
-                }),
-        };
-        let wrong = b * spread + variation * factor;
+        let rn = self.hierarchy.node(r);
+        // The source's mean stands for parts up to its spread away from it.
+        let wrong = state.b[s as usize] * spread + state.spread[s as usize] * factor;
         rn.reflectance.mul_rgb(wrong).mean() * rn.area
     }
 

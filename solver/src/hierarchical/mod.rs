@@ -14,9 +14,9 @@
 //! 4. Every display vertex gathers the reflected light along the links of its leaf and the
 //!    leaf's ancestors ([`final_gather`]).
 //!
-//! The light a link may carry wrongly is `link_tol` of the emitted power: a larger scene with the
-//! same light gets links no finer where its light is weak, so the links grow about linearly with
-//! the scene. Results do not depend on the thread count: every parallel step collects in order.
+//! The light a link may carry wrongly is `link_tol` of the light the surfaces reflect of the
+//! direct light: a larger scene with the same light gets links no finer where its light is weak,
+//! so the links grow about linearly with the scene. Results do not depend on the thread count: every parallel step collects in order.
 
 mod final_gather;
 mod iterate;
@@ -46,8 +46,10 @@ use links::{Link, RefineCounts, Refiner};
 use shaft::Shafts;
 use tree::{Hierarchy, NONE};
 
-/// The light a link may carry wrongly by default, as a fraction of the emitted power.
-pub const DEFAULT_LINK_TOL: f64 = 1e-5;
+/// The light a link may carry wrongly by default, as a fraction of the light the surfaces reflect
+/// of the direct light (the light the hierarchy carries in the first place: measured against the
+/// emitted power instead, a dark room would get links too coarse for its little reflected light).
+pub const DEFAULT_LINK_TOL: f64 = 2e-5;
 
 /// Refinement passes at most: link, solve, refine the links the new radiosities condemn, solve
 /// again.
@@ -121,7 +123,7 @@ pub fn solve_hierarchical(
     let refiner = Refiner {
         hierarchy: &hierarchy,
         shafts: &shafts,
-        tolerance: options.link_tol * scene.emitted_power().mean(),
+        tolerance: options.link_tol * reflected_power(&system),
         rays: options.visibility_rays,
         seed: options.seed,
         tol: visibility.contact_distance(),
@@ -199,6 +201,18 @@ pub fn solve_hierarchical(
         },
         convergence: solved.history,
     })
+}
+
+/// The power the leaves reflect of the direct light (W, channel mean): the light the hierarchy
+/// carries in the first place.
+fn reflected_power(system: &System) -> f64 {
+    let h = system.hierarchy;
+    h.nodes
+        .iter()
+        .enumerate()
+        .filter(|(_, n)| n.is_leaf() && !n.is_cluster())
+        .map(|(i, n)| system.direct[i].mean() * n.area)
+        .sum()
 }
 
 /// What each leaf reflects of the exact direct light: ρ times the mean of its vertices' direct
@@ -542,6 +556,66 @@ mod tests {
     use crate::progress::NoProgress;
     use penumbra_meshing::mesh_scene_uniform;
     use penumbra_scenes::builtin;
+
+    /// The links between two faces of the unit cube carry its face-to-face form factors
+    /// (`../shared/analytic.md` §1.3 and §1.4): Σ area × form factor over the links from one
+    /// face's elements to the other's, over the first face's area.
+    #[test]
+    fn links_carry_the_unit_cubes_face_factors() {
+        const OPPOSITE: f64 = 0.199_824_895_698_387;
+        const ADJACENT: f64 = 0.200_043_776_075_403;
+        let scene = builtin::furnace(1.0, 0.5);
+        let vis = Visibility::build(&scene);
+        let mesh = mesh_scene_uniform(&scene, 1200).expect("meshes");
+        let options = SolverOptions::default();
+        let disc = Discretization::new(&scene, &mesh, options.elements_per_patch);
+        let (direct, _) =
+            direct_irradiance(&scene, &disc, &vis, &options, &NoProgress).expect("direct light");
+        let hierarchy = Hierarchy::build(&disc, |s| scene.surfaces[s].reflectance);
+        let shafts = Shafts::new(&scene, &vis);
+        let mut system = System::new(&hierarchy, leaf_direct(&scene, &disc, &hierarchy, &direct));
+        let refiner = Refiner {
+            hierarchy: &hierarchy,
+            shafts: &shafts,
+            tolerance: 1e-6 * scene.emitted_power().mean(),
+            rays: options.visibility_rays,
+            seed: options.seed,
+            tol: vis.contact_distance(),
+        };
+        let mut stats = HierarchyStats::default();
+        link_and_sweep(
+            &mut system,
+            &refiner,
+            &options,
+            &mut stats,
+            &|| 0.0,
+            &NoProgress,
+        );
+        let n = scene.surfaces.len();
+        let mut factors = vec![vec![0.0; n]; n];
+        for l in &system.links {
+            let (rn, sn) = (hierarchy.node(l.receiver), hierarchy.node(l.source));
+            if let (Some(i), Some(j), links::Transfer::Factor { factor, .. }) =
+                (rn.surface, sn.surface, l.transfer)
+            {
+                factors[i][j] += rn.area * factor / scene.surfaces[i].area();
+            }
+        }
+        let mut worst = 0.0f64;
+        for (i, row) in factors.iter().enumerate() {
+            for (j, &f) in row.iter().enumerate() {
+                let opposite = scene.surfaces[i].normal().dot(scene.surfaces[j].normal()) < -0.5;
+                let expected = match (i == j, opposite) {
+                    (true, _) => 0.0,
+                    (false, true) => OPPOSITE,
+                    (false, false) => ADJACENT,
+                };
+                worst = worst.max((f - expected).abs());
+            }
+        }
+        eprintln!("worst face factor off by {worst:.2e}");
+        assert!(worst < 1e-3, "{worst}");
+    }
 
     /// As the link tolerance shrinks, the leaves' radiosities approach those of the dense
     /// system the hierarchy stands for: every pair of leaves linked, with the same form factors

@@ -185,6 +185,44 @@ impl Hierarchy {
         out
     }
 
+    /// A finer rule than [`Self::quadrature`] for the mean over element `id`: each grandchild
+    /// (or leaf child) by its own second-moment rule (centroid ± half-axes) or, for a leaf, its
+    /// three-point rule. Centroids alone read a form factor that peaks inside the element too
+    /// high (its mean is below its middle's value), and that bias adds up at many bounces.
+    pub fn fine_quadrature(&self, id: u32) -> SmallVec<[(DVec3, f64); 16]> {
+        let n = self.node(id);
+        let mut out = SmallVec::new();
+        let mut add = |part: u32| {
+            let p = self.node(part);
+            let share = p.area / n.area;
+            match p.children {
+                None => out.extend(
+                    self.quadrature(part)
+                        .into_iter()
+                        .map(|(x, w)| (x, w * share)),
+                ),
+                Some(_) => {
+                    let [a, b] = p.axes;
+                    for offset in [a, -a, b, -b] {
+                        out.push((p.centroid + offset, share / 4.0));
+                    }
+                }
+            }
+        };
+        match n.children {
+            None => return self.quadrature(id).into_iter().collect(),
+            Some(children) => {
+                for c in children {
+                    match self.node(c).children {
+                        Some(grand) => grand.into_iter().for_each(&mut add),
+                        None => add(c),
+                    }
+                }
+            }
+        }
+        out
+    }
+
     /// The nodes from `id` up to the root.
     pub fn ancestry(&self, id: u32) -> impl Iterator<Item = u32> + '_ {
         std::iter::successors(Some(id), |&n| {
