@@ -321,7 +321,7 @@ struct SweepArgs {
     #[arg(long, value_delimiter = ',', value_parser = ["uniform", "uniform+adaptive", "discontinuity", "discontinuity+adaptive", "discontinuity-complete", "discontinuity-extremal"])]
     methods: Vec<String>,
     /// The solvers to compare, comma-separated (default: progressive). Adaptive runs use
-    /// progressive refinement only.
+    /// progressive refinement or the hierarchical solver.
     #[arg(long, value_delimiter = ',', value_enum)]
     solvers: Vec<SolverArg>,
     /// The adaptive runs start from this fraction of the budget (their initial meshes are not
@@ -416,6 +416,7 @@ fn solve_failure(e: penumbra_solver::SolveError) -> Failure {
         "form factors" => Some("--form-factors"),
         "solver" => Some("--solver"),
         "direct only" => Some("--direct-only"),
+        "refine indirect" => Some("--refine-indirect"),
         _ => None,
     };
     match e {

@@ -3,7 +3,7 @@
 
 use std::time::Instant;
 
-use crate::adaptive::{RefineOptions, RefineReport, refine_adaptively};
+use crate::adaptive::{RefineOptions, RefineReport, refine_adaptively, refine_hierarchically};
 use crate::memory::{self, MeshCounts};
 use crate::shard::{Shard, ShardError};
 use penumbra_meshing::discontinuity::{DiscontinuityOptions, find_discontinuities_reporting};
@@ -223,11 +223,24 @@ pub fn run(
     progress: &dyn Progress,
 ) -> Result<RunResult, RunError> {
     options.solver.validate()?;
-    if options.refine.is_some() {
-        if options.method != SolverMethod::Progressive {
+    if let Some(refine) = &options.refine {
+        if !matches!(
+            options.method,
+            SolverMethod::Progressive | SolverMethod::Hierarchical
+        ) {
             return Err(RunError::Solve(SolveError::InvalidOption {
                 option: "solver",
-                reason: "adaptive refinement feeds the progressive solver; use --solver progressive",
+                reason: "adaptive refinement feeds the progressive or the hierarchical solver",
+            }));
+        }
+        if options.method == SolverMethod::Hierarchical
+            && refine.indirect == penumbra_solver::estimate::IndirectEstimate::Gathered
+            && !options.solver.direct_only
+        {
+            return Err(RunError::Solve(SolveError::InvalidOption {
+                option: "refine indirect",
+                reason: "the hierarchical solver estimates the indirect light's error from its \
+                         gradient's jumps; use gradient",
             }));
         }
         if options.solver.form_factors.by_rows() && !options.solver.direct_only {
@@ -412,7 +425,13 @@ pub fn run(
     let t = Instant::now();
     let (refinement, solution) = match &options.refine {
         Some(refine) => {
-            let (report, solution) = refine_adaptively(
+            let refine_with = if options.method == SolverMethod::Hierarchical && !solver.direct_only
+            {
+                refine_hierarchically
+            } else {
+                refine_adaptively
+            };
+            let (report, solution) = refine_with(
                 scene,
                 &visibility,
                 &mut mesh,

@@ -105,8 +105,9 @@ pub struct SweepOptions {
     pub samples: usize,
     pub seed: u64,
     pub solver: SolverOptions,
-    /// The solvers to compare (each non-adaptive run is repeated with each; adaptive runs and
-    /// direct-light sweeps use progressive refinement only).
+    /// The solvers to compare (each non-adaptive run is repeated with each, adaptive runs with
+    /// progressive refinement and the hierarchical solver; direct-light sweeps use progressive
+    /// refinement only).
     pub solvers: Vec<SolverMethod>,
 }
 
@@ -213,7 +214,9 @@ pub fn sweep(
     let combinations: Vec<(SweepMethod, SolverMethod)> = methods
         .iter()
         .flat_map(|&m| solvers.iter().map(move |&s| (m, s)))
-        .filter(|&(m, s)| !m.adaptive() || s == SolverMethod::Progressive)
+        .filter(|&(m, s)| {
+            !m.adaptive() || matches!(s, SolverMethod::Progressive | SolverMethod::Hierarchical)
+        })
         .collect();
     progress.start("sweep", (options.budgets.len() * combinations.len()) as u64);
     for &budget in &options.budgets {

@@ -574,8 +574,8 @@ fn solvers_agree_and_report_their_convergence() {
 }
 
 /// `--solver hierarchical` converges, reports its hierarchy and links, agrees with the dense
-/// solve on the surfaces' means, stops at a spent time budget with a partial solution, and
-/// refuses a link tolerance outside (0, 1) by naming the option.
+/// solve on the surfaces' means, stops at a spent time budget with a partial solution, refines
+/// adaptively, and refuses a link tolerance outside (0, 1) by naming the option.
 #[test]
 fn hierarchical_runs_report_their_links() {
     let dir = tempfile::tempdir().expect("temp dir");
@@ -654,6 +654,42 @@ fn hierarchical_runs_report_their_links() {
     assert_eq!(report["partial"], true);
     assert_eq!(report["solver"]["stop"], "time_budget");
     assert!(check_radiosity(&json(&spent.join("solution.json"))) > 0);
+    // Adaptive refinement: new vertices gather through the links, then the refined mesh is
+    // solved with its own hierarchy.
+    let adaptive = dir.path().join("adaptive");
+    run_quietly(
+        "cornell",
+        &adaptive,
+        &[
+            "--solver",
+            "hierarchical",
+            "--max-elements",
+            "4000",
+            "--refine-tol",
+            "2e-3",
+        ],
+    );
+    let report = json(&adaptive.join("report.json"));
+    let rounds = report["refinement"]["rounds"].as_array().expect("rounds");
+    assert!(rounds.len() > 1, "{}", report["refinement"]);
+    assert!(report["solver"]["remeshes"].as_u64().expect("remeshes") > 0);
+    assert!(report["counts"]["triangles"].as_u64().expect("triangles") > 1000);
+    assert!(check_radiosity(&json(&adaptive.join("solution.json"))) > 0);
+    let o = penumbra(&[
+        "run",
+        "cornell",
+        "--solver",
+        "hierarchical",
+        "--refine-tol",
+        "1e-3",
+        "--refine-indirect",
+        "gathered",
+        "--out",
+        dir.path().join("gathered").to_str().expect("utf-8"),
+    ]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("--refine-indirect"), "{stderr}");
     for bad in ["0", "-1", "NaN", "1"] {
         let o = penumbra(&[
             "run",

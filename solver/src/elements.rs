@@ -161,6 +161,60 @@ impl Discretization {
         self.receivers.len()
     }
 
+    /// Two per-receiver fields of `old` carried over to this discretization where receivers
+    /// match ([`Self::matching_receivers`]; zero elsewhere), and the receivers that match none.
+    pub fn carried(
+        &self,
+        old: &Discretization,
+        fields: [&[Rgb]; 2],
+    ) -> ([Vec<Rgb>; 2], Vec<usize>) {
+        let n = self.receiver_count();
+        let mut out = [vec![Rgb::ZERO; n], vec![Rgb::ZERO; n]];
+        let mut fresh = Vec::new();
+        for (v, same) in self.matching_receivers(old).into_iter().enumerate() {
+            match same {
+                Some(o) => {
+                    out[0][v] = fields[0][o];
+                    out[1][v] = fields[1][o];
+                }
+                None => fresh.push(v),
+            }
+        }
+        (out, fresh)
+    }
+
+    /// For each receiver, the receiver of `old` (a coarser discretization of the same scene)
+    /// that stands for it, if any: the same point of the same surface. Where a position repeats
+    /// (the sides of a contact line, the corners of a block standing on the surface) each copy's
+    /// value is a one-sided limit from its own triangles, so a copy matches only an old one that
+    /// looked from the same direction; elsewhere the light is continuous.
+    pub fn matching_receivers(&self, old: &Discretization) -> Vec<Option<usize>> {
+        let positions = |d: &Discretization| {
+            let mut at: HashMap<(SurfaceId, [u64; 3]), Vec<usize>> = HashMap::new();
+            for (v, x) in d.receivers.iter().enumerate() {
+                at.entry((d.receiver_surface[v], x.point.to_array().map(f64::to_bits)))
+                    .or_default()
+                    .push(v);
+            }
+            at
+        };
+        let (old_at, new_at) = (positions(old), positions(self));
+        (0..self.receiver_count())
+            .map(|v| {
+                let x = &self.receivers[v];
+                let key = (
+                    self.receiver_surface[v],
+                    x.point.to_array().map(f64::to_bits),
+                );
+                let olds = old_at.get(&key).map_or(&[][..], Vec::as_slice);
+                let unique = olds.len() == 1 && new_at.get(&key).is_some_and(|c| c.len() == 1);
+                olds.iter()
+                    .copied()
+                    .find(|&o| unique || old.receivers[o].inward.dot(x.inward) >= 1.0 - 1e-9)
+            })
+            .collect()
+    }
+
     /// Splits a per-receiver vector into per-surface vectors.
     pub fn per_surface<T: Clone>(&self, values: &[T]) -> Vec<Vec<T>> {
         (0..self.offsets.len())

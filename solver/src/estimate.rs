@@ -55,27 +55,46 @@ pub fn solution_residuals(
     solver: &ProgressiveSolver,
     how: IndirectEstimate,
 ) -> Vec<Vec<f64>> {
-    let direct_values = solver.direct_radiosity();
-    let values = solver.radiosity();
-    let indirect = solver.has_indirect();
-    solver
-        .meshes()
+    let estimate = |mesh: &SurfaceMesh, part: &[f64]| match how {
+        IndirectEstimate::GradientJumps => gradient_jump_estimate(mesh, part),
+        IndirectEstimate::Gathered => gathered_estimate(scene, solver, mesh, part),
+    };
+    residuals_of(
+        scene,
+        solver.direct_light(),
+        solver.meshes(),
+        &solver.direct_radiosity(),
+        &solver.radiosity(),
+        solver.has_indirect(),
+        estimate,
+    )
+}
+
+/// Residuals of a solution with `values` (and their direct part `direct_values`) at the
+/// vertices of `meshes`, per surface and triangle: the direct light's against the exact
+/// evaluator, and, when there is `indirect` light, the larger of that and `estimate` of the
+/// indirect part's error.
+pub fn residuals_of(
+    scene: &Scene,
+    direct: &DirectLight,
+    meshes: &[SurfaceMesh],
+    direct_values: &[Vec<Rgb>],
+    values: &[Vec<Rgb>],
+    indirect: bool,
+    estimate: impl Fn(&SurfaceMesh, &[f64]) -> Vec<f64>,
+) -> Vec<Vec<f64>> {
+    meshes
         .iter()
         .map(|mesh| {
             let s = mesh.surface;
-            let mut residuals =
-                direct_residuals(scene, solver.direct_light(), mesh, &direct_values[s]);
+            let mut residuals = direct_residuals(scene, direct, mesh, &direct_values[s]);
             if indirect {
                 let part: Vec<f64> = values[s]
                     .iter()
                     .zip(&direct_values[s])
                     .map(|(b, d)| (*b - *d).mean())
                     .collect();
-                let estimate = match how {
-                    IndirectEstimate::GradientJumps => gradient_jump_estimate(mesh, &part),
-                    IndirectEstimate::Gathered => gathered_estimate(scene, solver, mesh, &part),
-                };
-                for (r, j) in residuals.iter_mut().zip(estimate) {
+                for (r, j) in residuals.iter_mut().zip(estimate(mesh, &part)) {
                     *r = r.max(j);
                 }
             }

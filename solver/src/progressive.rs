@@ -248,10 +248,10 @@ fn direct_on(
 
 /// When the exact direct light must stop: at an interrupt (an error: no solution yet), or at a
 /// deadline, after which the vertices not done yet are estimated with `rays` rays per emitter.
-struct Limits<'o> {
-    interrupt: Option<&'o Interrupt>,
-    deadline: Option<Instant>,
-    rays: usize,
+pub(crate) struct Limits<'o> {
+    pub interrupt: Option<&'o Interrupt>,
+    pub deadline: Option<Instant>,
+    pub rays: usize,
 }
 
 /// Receivers closer than this fraction of the scene's diagonal share one evaluation of what
@@ -264,14 +264,14 @@ pub const SHARED_POINT: f64 = 1e-12;
 /// crossings of its edges, which the edges bound only by their square: a light seen through a
 /// lattice of beams and rods crosses each new batch of shadows with the many holes left so far
 /// (with 2^15 edges, one Sponza vertex took minutes and gigabytes in a single overlay).
-const OVERLAY_CAP: usize = 1 << 13;
+pub(crate) const OVERLAY_CAP: usize = 1 << 13;
 
 /// The exact direct irradiance at the `receivers` that `wanted` accepts (the others get zero),
 /// computed once per point for receivers that share one (faces of a mesh meeting at a vertex;
 /// see [`DirectLight::irradiance_group`]). Points within [`SHARED_POINT`] of the scene are one:
 /// the view from the grid point they round to serves them all, so a receiver's value does not
 /// depend on which others share its point, or are wanted.
-fn direct_at(
+pub(crate) fn direct_at(
     direct: &DirectLight,
     disc: &Discretization,
     receivers: &[usize],
@@ -369,9 +369,9 @@ fn direct_at(
 /// Vertices whose direct light was estimated by rays: left at the deadline, or whose view of a
 /// light was beyond the overlay cap.
 #[derive(Clone, Copy, Debug, Default)]
-struct Estimated {
-    late: usize,
-    beyond_cap: usize,
+pub(crate) struct Estimated {
+    pub late: usize,
+    pub beyond_cap: usize,
 }
 
 /// `f` at each of `receivers`, in parallel, with a progress bar; stops early, with
@@ -806,43 +806,9 @@ impl<'a> ProgressiveSolver<'a> {
             .map(|e| moved[e.surface][e.triangle])
             .collect();
 
-        // Vertices that were there before keep their values. Where a position repeats (the
-        // sides of a contact line, the corners of a block standing on the surface) each copy's
-        // value is a one-sided limit from its own triangles, so a copy is reused only when the
-        // old one looked from the same direction; elsewhere the light is continuous.
-        let positions = |d: &Discretization| {
-            let mut at: HashMap<(SurfaceId, [u64; 3]), Vec<usize>> = HashMap::new();
-            for (v, x) in d.receivers.iter().enumerate() {
-                at.entry((d.receiver_surface[v], x.point.to_array().map(f64::to_bits)))
-                    .or_default()
-                    .push(v);
-            }
-            at
-        };
-        let (old_at, new_at) = (positions(&self.disc), positions(&disc));
-        let n = disc.receiver_count();
-        let (mut direct, mut irradiance) = (vec![Rgb::ZERO; n], vec![Rgb::ZERO; n]);
-        let mut fresh = Vec::new();
-        for v in 0..n {
-            let x = &disc.receivers[v];
-            let key = (
-                disc.receiver_surface[v],
-                x.point.to_array().map(f64::to_bits),
-            );
-            let olds = old_at.get(&key).map_or(&[][..], Vec::as_slice);
-            let unique = olds.len() == 1 && new_at.get(&key).is_some_and(|c| c.len() == 1);
-            let same = olds
-                .iter()
-                .copied()
-                .find(|&old| unique || self.disc.receivers[old].inward.dot(x.inward) >= 1.0 - 1e-9);
-            match same {
-                Some(old) => {
-                    direct[v] = self.direct_irradiance[old];
-                    irradiance[v] = self.irradiance[old];
-                }
-                None => fresh.push(v),
-            }
-        }
+        // Vertices that were there before keep their values.
+        let ([mut direct, mut irradiance], fresh) =
+            disc.carried(&self.disc, [&self.direct_irradiance, &self.irradiance]);
         let t = Instant::now();
         // Remeshing runs to its end: the refinement loop checks for interrupts between rounds,
         // and stopping here would lose the solution it has.

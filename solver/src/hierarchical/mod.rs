@@ -28,17 +28,19 @@ mod tree;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
-use penumbra_meshing::SceneMesh;
+use penumbra_meshing::locate::TriangleLocator;
+use penumbra_meshing::{SceneMesh, SurfaceMesh};
 use penumbra_scenes::{Rgb, Scene, Visibility};
 use rayon::prelude::*;
 use serde::Serialize;
 
+use crate::direct::DirectLight;
 use crate::elements::Discretization;
 use crate::error::SolveError;
 use crate::progress::Progress;
 use crate::progressive::{
-    ConvergencePoint, Solution, SolveStats, SolverOptions, StopReason, check_mesh,
-    direct_irradiance,
+    ConvergencePoint, Limits, OVERLAY_CAP, Solution, SolveStats, SolverOptions, StopReason,
+    check_mesh, direct_at, direct_irradiance,
 };
 use final_gather::{FinalGather, Gathered};
 use iterate::{Field, System};
@@ -108,17 +110,46 @@ pub fn solve_hierarchical(
     options: &SolverOptions,
     progress: &dyn Progress,
 ) -> Result<Solution, SolveError> {
+    let (_, solution) =
+        solve_hierarchical_refining(scene, mesh, visibility, options, progress, &mut |_| {
+            Ok(None)
+        })?;
+    Ok(solution)
+}
+
+/// What a round of adaptive refinement sees: the meshes, the radiosity and its direct part at
+/// their vertices, and the exact direct light.
+#[derive(Debug)]
+pub struct Round<'r> {
+    pub meshes: &'r [SurfaceMesh],
+    pub radiosity: Vec<Vec<Rgb>>,
+    pub direct: Vec<Vec<Rgb>>,
+    pub direct_light: &'r DirectLight<'r>,
+}
+
+/// [`solve_hierarchical`], then rounds of refinement of the display mesh: `refine` looks at each
+/// round's solution and gives a refined mesh (the same surfaces, every vertex kept) or `None` to
+/// stop. The hierarchy stays that of the first mesh: a new vertex gets the exact direct light
+/// and gathers along the links of the leaf it lies in. Returns the last mesh and its solution.
+pub fn solve_hierarchical_refining(
+    scene: &Scene,
+    mesh: &SceneMesh,
+    visibility: &Visibility,
+    options: &SolverOptions,
+    progress: &dyn Progress,
+    refine: &mut dyn FnMut(&Round) -> Result<Option<SceneMesh>, SolveError>,
+) -> Result<(SceneMesh, Solution), SolveError> {
     options.validate()?;
     check_mesh(scene, mesh)?;
     let started = Instant::now();
-    let disc = Discretization::new(scene, mesh, options.elements_per_patch);
+    let first = Discretization::new(scene, mesh, options.elements_per_patch);
     let (direct, direct_beyond_cap) =
-        direct_irradiance(scene, &disc, visibility, options, progress)?;
-    let direct_seconds = started.elapsed().as_secs_f64();
+        direct_irradiance(scene, &first, visibility, options, progress)?;
+    let mut direct_seconds = started.elapsed().as_secs_f64();
 
     let started = Instant::now();
-    let hierarchy = Hierarchy::build(&disc, |s| scene.surfaces[s].reflectance);
-    let mut system = System::new(&hierarchy, leaf_direct(scene, &disc, &hierarchy, &direct));
+    let hierarchy = Hierarchy::build(&first, |s| scene.surfaces[s].reflectance);
+    let mut system = System::new(&hierarchy, leaf_direct(scene, &first, &hierarchy, &direct));
     let shafts = Shafts::new(scene, visibility);
     let refiner = Refiner {
         hierarchy: &hierarchy,
@@ -142,38 +173,96 @@ pub fn solve_hierarchical(
 
     // The final gather, unless the run must stop: then each vertex keeps its leaf's value.
     let t = Instant::now();
-    let vertex_leaf = vertex_leaves(&disc, &hierarchy);
     let gather = FinalGather {
         system: &system,
         field: &solved.field,
         visibility,
-        elements: &disc.elements,
+        elements: &first.elements,
         rays: options.visibility_rays,
         seed: options.seed,
     };
-    let gathered = match options.stop_now() {
-        Some(_) => None,
-        None => final_gather_all(&disc, &vertex_leaf, &direct, &gather, options, progress),
-    };
+    let all: Vec<usize> = (0..first.receiver_count()).collect();
+    let leaves = vertex_leaves(&first, &hierarchy);
     let mut stop = solved.stop;
-    let reflected = match gathered {
-        Some((values, rays)) => {
-            stats.gather_rays = rays;
-            values
+    let (reflected, first_b) = match final_gather_at(
+        &first, &all, &leaves, &direct, &gather, None, options, progress,
+    ) {
+        Some((values, rays, first_b)) => {
+            stats.gather_rays += rays;
+            (values, first_b)
         }
         None => {
             stop = options.stop_now().unwrap_or(stop);
-            let leaf_value = |&l: &u32| match l {
-                NONE => Rgb::ZERO,
-                l => solved.field.irradiance[l as usize],
-            };
-            vertex_leaf.iter().map(leaf_value).collect()
+            (leaf_values(&leaves, &solved.field), Vec::new())
         }
     };
-    let gather_seconds = t.elapsed().as_secs_f64();
-    let irradiance: Vec<Rgb> = direct
+    let mut gather_seconds = t.elapsed().as_secs_f64();
+    let mut current = Current {
+        mesh: mesh.clone(),
+        disc: first.clone(),
+        direct,
+        reflected,
+    };
+
+    // Rounds of refinement: new vertices gather through the links of the first mesh's leaves.
+    let exact = DirectLight::new(scene, visibility).with_overlay_cap(OVERLAY_CAP);
+    let (mut remeshes, mut gathered) = (0, first.receiver_count());
+    if !first_b.is_empty() {
+        let locate = LeafLocator::new(mesh, &first, &hierarchy);
+        while let Some(next) = refine(&current.round(&exact))? {
+            check_mesh(scene, &next)?;
+            let disc = Discretization::new(scene, &next, options.elements_per_patch);
+            let ([mut direct, mut reflected], fresh) =
+                disc.carried(&current.disc, [&current.direct, &current.reflected]);
+            let t = Instant::now();
+            // New vertices are solved to the end: refinement checks for interrupts between rounds.
+            let limits = Limits {
+                interrupt: None,
+                deadline: None,
+                rays: options.visibility_rays,
+            };
+            let (new_direct, _) = direct_at(&exact, &disc, &fresh, &|_| true, &limits, progress)?;
+            direct_seconds += t.elapsed().as_secs_f64();
+            let t = Instant::now();
+            let leaves: Vec<u32> = fresh.iter().map(|&v| locate.leaf(&disc, v)).collect();
+            let unstoppable = SolverOptions {
+                deadline: None,
+                interrupt: None,
+                ..options.clone()
+            };
+            let (values, rays, _) = final_gather_at(
+                &disc,
+                &fresh,
+                &leaves,
+                &new_direct,
+                &gather,
+                Some(&first_b),
+                &unstoppable,
+                progress,
+            )
+            .unwrap_or_default();
+            stats.gather_rays += rays;
+            gather_seconds += t.elapsed().as_secs_f64();
+            for (k, &v) in fresh.iter().enumerate() {
+                direct[v] = new_direct[k];
+                reflected[v] = values[k];
+            }
+            gathered += fresh.len();
+            remeshes += 1;
+            current = Current {
+                mesh: next,
+                disc,
+                direct,
+                reflected,
+            };
+        }
+    }
+
+    let disc = &current.disc;
+    let irradiance: Vec<Rgb> = current
+        .direct
         .iter()
-        .zip(&reflected)
+        .zip(&current.reflected)
         .map(|(&d, &r)| d + r)
         .collect();
     let solve_stats = SolveStats {
@@ -184,14 +273,15 @@ pub fn solve_hierarchical(
         direct_estimated: direct_beyond_cap,
         direct_beyond_cap,
         shooting_seconds: solve_seconds,
-        gathered: disc.receiver_count(),
+        remeshes,
+        gathered,
         gather_seconds,
-        ..energy_stats(scene, &disc, &irradiance, &system, &solved.field, &stats)
+        ..energy_stats(scene, disc, &irradiance, &system, &solved.field, &stats)
     };
     let radiosity: Vec<Rgb> = (0..disc.receiver_count())
         .map(|v| disc.emission[v] + disc.reflectance[v].mul_rgb(irradiance[v]))
         .collect();
-    Ok(Solution {
+    let solution = Solution {
         radiosity: disc.per_surface(&radiosity),
         irradiance: disc.per_surface(&irradiance),
         ambient: Rgb::ZERO,
@@ -200,7 +290,88 @@ pub fn solve_hierarchical(
             ..solve_stats
         },
         convergence: solved.history,
-    })
+    };
+    Ok((current.mesh, solution))
+}
+
+/// The display mesh of the latest round and the light at its vertices.
+struct Current {
+    mesh: SceneMesh,
+    disc: Discretization,
+    direct: Vec<Rgb>,
+    reflected: Vec<Rgb>,
+}
+
+impl Current {
+    fn round<'r>(&'r self, exact: &'r DirectLight<'r>) -> Round<'r> {
+        let disc = &self.disc;
+        let radiosity_of = |h: &dyn Fn(usize) -> Rgb| -> Vec<Vec<Rgb>> {
+            let values: Vec<Rgb> = (0..disc.receiver_count())
+                .map(|v| disc.emission[v] + disc.reflectance[v].mul_rgb(h(v)))
+                .collect();
+            disc.per_surface(&values)
+        };
+        Round {
+            meshes: &self.mesh.surfaces,
+            radiosity: radiosity_of(&|v| self.direct[v] + self.reflected[v]),
+            direct: radiosity_of(&|v| self.direct[v]),
+            direct_light: exact,
+        }
+    }
+}
+
+/// Finds the first mesh's leaf that holds a vertex of a refined mesh.
+struct LeafLocator<'h> {
+    mesh: &'h SceneMesh,
+    locators: Vec<TriangleLocator>,
+    /// Per surface and triangle of the first mesh, its leaf.
+    leaf: Vec<Vec<u32>>,
+}
+
+impl<'h> LeafLocator<'h> {
+    fn new(mesh: &'h SceneMesh, first: &Discretization, hierarchy: &Hierarchy) -> LeafLocator<'h> {
+        let mut leaf: Vec<Vec<u32>> = mesh
+            .surfaces
+            .iter()
+            .map(|m| vec![NONE; m.triangle_count()])
+            .collect();
+        for (e, el) in first.elements.iter().enumerate() {
+            leaf[el.surface][el.triangle] = hierarchy.leaf_of_element[e];
+        }
+        LeafLocator {
+            mesh,
+            locators: mesh.surfaces.iter().map(TriangleLocator::new).collect(),
+            leaf,
+        }
+    }
+
+    /// The leaf of vertex `v` of `disc`, looked for a little way into its own triangles (a
+    /// vertex on a contact line belongs to its own side).
+    fn leaf(&self, disc: &Discretization, v: usize) -> u32 {
+        let s = disc.receiver_surface[v];
+        let m = &self.mesh.surfaces[s];
+        let x = &disc.receivers[v];
+        let nudge = LOCATE_NUDGE * m.scale;
+        [x.point + x.inward * nudge, x.point]
+            .iter()
+            .find_map(|&p| self.locators[s].locate(m, m.frame.to_2d(p) / m.scale))
+            .map_or(NONE, |(t, _)| self.leaf[s][t])
+    }
+}
+
+/// How far into its own triangles a new vertex is looked for, in its surface's scale.
+const LOCATE_NUDGE: f64 = 1e-9;
+
+/// Each vertex's leaf's own irradiance (zero where it has no leaf): what a vertex keeps when
+/// the run stops before the final gather.
+fn leaf_values(leaves: &[u32], field: &Field) -> Vec<Rgb> {
+    leaves
+        .iter()
+        .map(|&l| match l {
+            NONE => Rgb::ZERO,
+            l => field.irradiance[l as usize],
+        })
+        .collect()
 }
 
 /// The power the leaves reflect of the direct light (W, channel mean): the light the hierarchy
@@ -483,53 +654,79 @@ fn vertex_leaves(disc: &Discretization, hierarchy: &Hierarchy) -> Vec<u32> {
 /// the Cornell box one pass gets nearest the path-traced reference; a second overshoots).
 pub const LINEAR_PASSES: usize = 1;
 
-/// The final gather at every vertex, in parallel and in order, with a progress bar, and the
-/// rays it cast; `None` if the run must stop first. `direct` is the direct irradiance at every
-/// vertex.
-fn final_gather_all(
+/// The final gather at `points` of `disc` (the `leaves` they lie in, their `direct`
+/// irradiance), in parallel and in order, with a progress bar: their reflected irradiance, the
+/// rays cast, and the reflected radiosity at every vertex, for later gathers. Near leaves are
+/// gathered again with linear radiosities from `linear` (the reflected radiosity at the first
+/// mesh's vertices), or, when `None` (the points are all of the first mesh's vertices), from
+/// this gather. `None` if the run must stop first.
+#[allow(clippy::too_many_arguments)]
+fn final_gather_at(
     disc: &Discretization,
-    vertex_leaf: &[u32],
+    points: &[usize],
+    leaves: &[u32],
     direct: &[Rgb],
     gather: &FinalGather,
+    linear: Option<&[Rgb]>,
     options: &SolverOptions,
     progress: &dyn Progress,
-) -> Option<(Vec<Rgb>, u64)> {
+) -> Option<(Vec<Rgb>, u64, Vec<Rgb>)> {
     let gather_at = |stage: &str, linear: Option<(&[Rgb], &[Gathered])>| {
-        each_vertex(disc, stage, options, progress, |v| {
-            let leaf = vertex_leaf[v];
-            if leaf == NONE || disc.reflectance[v].max_channel() <= 0.0 {
+        each_point(points, stage, options, progress, |k| {
+            let v = points[k];
+            if leaves[k] == NONE || disc.reflectance[v].max_channel() <= 0.0 {
                 return Gathered::default();
             }
             let x = &disc.receivers[v];
-            let linear = linear.map(|(b, first)| (b, &first[v]));
-            gather.irradiance(x, disc.receiver_surface[v], leaf, v as u64, linear)
+            let linear = linear.map(|(b, first)| (b, &first[k]));
+            gather.irradiance(x, disc.receiver_surface[v], leaves[k], v as u64, linear)
         })
     };
     let mut values = gather_at("final gather", None)?;
     let mut rays: u64 = values.iter().map(|g| g.rays).sum();
+    let own: Vec<Rgb>;
+    let vertex_b = match linear {
+        Some(b) => b,
+        None => {
+            own = points
+                .iter()
+                .zip(&values)
+                .zip(direct)
+                .map(|((&v, g), &d)| disc.reflectance[v].mul_rgb(d + g.near + g.far))
+                .collect();
+            &own
+        }
+    };
     for _ in 0..LINEAR_PASSES {
-        let vertex_b: Vec<Rgb> = (0..disc.receiver_count())
-            .map(|v| disc.reflectance[v].mul_rgb(direct[v] + values[v].near + values[v].far))
-            .collect();
-        let near = gather_at("final gather, near leaves", Some((&vertex_b, &values)))?;
+        let near = gather_at("final gather, near leaves", Some((vertex_b, &values)))?;
         for (g, n) in values.iter_mut().zip(near) {
             g.near = n.near;
             rays += n.rays;
         }
     }
-    Some((values.iter().map(|g| g.near + g.far).collect(), rays))
+    let reflected: Vec<Rgb> = values.iter().map(|g| g.near + g.far).collect();
+    let first_b = match linear {
+        Some(_) => Vec::new(),
+        None => points
+            .iter()
+            .zip(&reflected)
+            .zip(direct)
+            .map(|((&v, &r), &d)| disc.reflectance[v].mul_rgb(d + r))
+            .collect(),
+    };
+    Some((reflected, rays, first_b))
 }
 
-/// `f` at every vertex, in parallel and in order, with a progress bar; `None` if the run must
-/// stop first.
-fn each_vertex<T: Send>(
-    disc: &Discretization,
+/// `f` of each index into `points`, in parallel and in order, with a progress bar; `None` if the
+/// run must stop first.
+fn each_point<T: Send>(
+    points: &[usize],
     stage: &str,
     options: &SolverOptions,
     progress: &dyn Progress,
     f: impl Fn(usize) -> T + Sync,
 ) -> Option<Vec<T>> {
-    let n = disc.receiver_count();
+    let n = points.len();
     progress.start(stage, n as u64);
     let done = AtomicU64::new(0);
     let values: Vec<Option<T>> = (0..n)
