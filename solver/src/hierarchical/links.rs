@@ -6,11 +6,14 @@
 //! tolerance, and otherwise replaced by the links of the larger node's children. What a link
 //! carries wrongly (BF refinement) is the receiver's reflectance times its area times:
 //! - between elements, the source's radiosity times the spread of the form factor over the
-//!   receiver's quadrature points (plus the disc approximation's own error where the source is
-//!   large for its distance), and the form factor times the spread of the source's radiosity
-//!   over its children;
+//!   receiver (at its quadrature points and corners), and the form factor times half the range
+//!   of the source's leaves' radiosities; nodes whose spheres overlap allow only a bound, all
+//!   the light the link could carry;
 //! - from or to a cluster, all the light the link carries (a cluster's light is only
 //!   approximately directional, see [`super::transfer`]).
+//!
+//! The oracle's form factors are quick (centroids, corners); a kept link's is computed with a
+//! finer rule over the receiver ([`super::tree::Hierarchy::fine_quadrature`]).
 //!
 //! Visibility comes from shaft culling ([`super::shaft`]); only partial links cast rays, a
 //! stratified, seeded set between the two nodes.

@@ -4,19 +4,20 @@
 //!
 //! 1. Every vertex of the display mesh gets the exact direct light, as in the other solvers; each
 //!    triangle reflects its mean, exactly (the integral of the linear interpolant).
-//! 2. The hierarchy ([`tree`]) is built over the mesh's triangles and the surfaces, and linked
-//!    from the root cluster down, each link as coarse as the oracle allows ([`links`]), with
-//!    visibility from shaft culling ([`shaft`]) and rays only where a shaft holds blockers.
-//! 3. Jacobi sweeps with push–pull ([`iterate`]) carry the reflected light until the relative
+//! 2. The hierarchy (`tree.rs`) is built over the mesh's triangles and the surfaces, and linked
+//!    from the root cluster down, each link as coarse as the oracle allows (`links.rs`), with
+//!    visibility from shaft culling (`shaft.rs`) and rays only where a shaft holds blockers.
+//! 3. Jacobi sweeps with push–pull (`iterate.rs`) carry the reflected light until the relative
 //!    residual is below `epsilon`; the links are then judged again with the new radiosities,
 //!    those carrying too much light wrongly are refined, and the sweeps go on, until no link
 //!    changes.
 //! 4. Every display vertex gathers the reflected light along the links of its leaf and the
-//!    leaf's ancestors ([`final_gather`]).
+//!    leaf's ancestors (`final_gather.rs`).
 //!
 //! The light a link may carry wrongly is `link_tol` of the light the surfaces reflect of the
 //! direct light: a larger scene with the same light gets links no finer where its light is weak,
-//! so the links grow about linearly with the scene. Results do not depend on the thread count: every parallel step collects in order.
+//! so the links grow about linearly with the scene. Results do not depend on the thread count:
+//! every parallel step collects in order.
 
 mod final_gather;
 mod iterate;
