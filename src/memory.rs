@@ -131,6 +131,46 @@ pub fn cache_bytes(requested: usize, needed: u64, limit: u64) -> usize {
     usize::try_from(spare).map_or(requested, |spare| requested.min(spare))
 }
 
+/// With the hierarchical solver, the least link tolerance (above the run's) at which the
+/// estimate for a mesh of `counts` fits in `limit`, rounded up to two digits; `None` for other
+/// solvers, or when even the coarsest links do not fit (the nodes and the mesh alone are too
+/// many).
+pub fn least_fitting_link_tol(
+    scene: &Scene,
+    options: &RunOptions,
+    counts: MeshCounts,
+    limit: u64,
+) -> Option<f64> {
+    if options.method != SolverMethod::Hierarchical || options.solver.direct_only {
+        return None;
+    }
+    let fits = |link_tol: f64| {
+        let trial = RunOptions {
+            solver: penumbra_solver::SolverOptions {
+                link_tol,
+                ..options.solver.clone()
+            },
+            ..options.clone()
+        };
+        estimate(scene, &trial, counts).total() <= limit
+    };
+    let (mut lo, mut hi) = (options.solver.link_tol, 0.5);
+    if !fits(hi) {
+        return None;
+    }
+    // The estimate falls as the tolerance grows: bisect on its logarithm.
+    for _ in 0..50 {
+        let mid = (lo * hi).sqrt();
+        if fits(mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    let digits = 10f64.powi(hi.log10().floor() as i32 - 1);
+    Some((hi / digits).ceil() * digits)
+}
+
 /// The largest element budget at most `max_elements` whose predicted estimate fits in `limit`,
 /// if any does.
 pub fn largest_fitting_budget(

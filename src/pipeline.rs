@@ -164,7 +164,7 @@ pub enum RunError {
     Render(#[from] VizError),
     #[error(transparent)]
     Shard(#[from] ShardError),
-    #[error("{}", memory_message(.needed, .limit, .suggestion))]
+    #[error("{}", memory_message(.needed, .limit, .suggestion, .link_tol))]
     Memory {
         /// Estimated bytes.
         needed: u64,
@@ -172,19 +172,33 @@ pub enum RunError {
         limit: u64,
         /// The largest `--max-elements` that would fit, if any.
         suggestion: Option<usize>,
+        /// With the hierarchical solver: the least `--link-tol` that would fit, if any.
+        link_tol: Option<f64>,
     },
 }
 
-fn memory_message(needed: &u64, limit: &u64, suggestion: &Option<usize>) -> String {
+fn memory_message(
+    needed: &u64,
+    limit: &u64,
+    suggestion: &Option<usize>,
+    link_tol: &Option<f64>,
+) -> String {
     let head = format!(
         "this run would need about {} of memory, and {} is available",
         memory::human(*needed),
         memory::human(*limit)
     );
+    let links = link_tol.map_or(String::new(), |t| {
+        format!(", or --link-tol {t:.1e} or more")
+    });
     match suggestion {
-        Some(n) => {
-            format!("{head}; use --max-elements {n} or fewer (or --memory-limit, if more is free)")
-        }
+        Some(n) => format!(
+            "{head}; use --max-elements {n} or fewer{links} (or --memory-limit, if more is free)"
+        ),
+        None if link_tol.is_some() => format!(
+            "{head}; use --link-tol {:.1e} or more (or --memory-limit, if more is free)",
+            link_tol.unwrap_or_default()
+        ),
         None => format!(
             "{head}; even the coarsest mesh of this scene does not fit (options: --direct-only, \
              --solver progressive, smaller --width/--height, or a machine with more memory)"
@@ -300,6 +314,7 @@ pub fn run(
                     planned_elements.max(counts.triangles as usize),
                     limit,
                 ),
+                link_tol: memory::least_fitting_link_tol(scene, options, counts, limit),
             }),
             _ => Ok(estimate),
         }

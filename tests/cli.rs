@@ -690,6 +690,25 @@ fn hierarchical_runs_report_their_links() {
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("--refine-indirect"), "{stderr}");
+    // Links that cannot fit are refused before the run starts, with a tolerance that fits.
+    let o = penumbra(&[
+        "run",
+        "cornell",
+        "--solver",
+        "hierarchical",
+        "--link-tol",
+        "1e-9",
+        "--memory-limit",
+        "1000",
+        "--out",
+        dir.path().join("links").to_str().expect("utf-8"),
+    ]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("--link-tol") && stderr.contains("or more"),
+        "{stderr}"
+    );
     for bad in ["0", "-1", "NaN", "1"] {
         let o = penumbra(&[
             "run",
