@@ -143,9 +143,9 @@ struct RunArgs {
     #[arg(long, value_enum)]
     mesh: Option<MeshArg>,
     /// Cap on triangles for the whole scene, spread over the surfaces by area. Default: what the
-    /// scene needs: 10,000 (25,000 with --solver hierarchical, whose cost grows about linearly
-    /// with the vertices), or, when that is too few, the least mesh of its polygons with their
-    /// discontinuities as edges and 1 triangle more per surface.
+    /// scene needs: 25,000 with the hierarchical solver (its cost grows about linearly with the
+    /// vertices), 10,000 with the others or --direct-only, or, when that is too few, the least
+    /// mesh of its polygons with their discontinuities as edges and 1 triangle more per surface.
     #[arg(long)]
     max_elements: Option<usize>,
     /// Discontinuity meshes: how many times smaller in area triangles are in partial shadow than
@@ -170,12 +170,13 @@ struct RunArgs {
     /// With --refine-tol: rounds of refinement at most.
     #[arg(long, default_value_t = penumbra::adaptive::DEFAULT_MAX_ROUNDS)]
     refine_rounds: usize,
-    /// How the radiosity system is solved: progressive refinement (shooting), Jacobi or
-    /// Gauss–Seidel gathering over the patch form-factor matrix, or its dense direct solve (the
-    /// discrete system's exact answer), or hierarchical radiosity with clustering (links refined
-    /// to --link-tol, then a final gather at every vertex). Gathering, direct and hierarchical
-    /// solves stop at a relative residual of --epsilon, or after --max-shots sweeps.
-    #[arg(long, value_enum, default_value_t = SolverArg::Progressive)]
+    /// How the radiosity system is solved: hierarchical radiosity with clustering (links refined
+    /// to --link-tol, then a final gather at every vertex), progressive refinement (shooting: an
+    /// image at any moment), Jacobi or Gauss–Seidel gathering over the patch form-factor matrix,
+    /// or its dense direct solve (the discrete system's exact answer). Hierarchical, gathering
+    /// and direct solves stop at a relative residual of --epsilon, or after --max-shots sweeps;
+    /// progressive refinement when the unshot power is below --epsilon.
+    #[arg(long, value_enum, default_value_t = SolverArg::Hierarchical)]
     solver: SolverArg,
     /// With --solver hierarchical: the light a link may carry wrongly, as a fraction of the
     /// light the surfaces reflect of the direct light; smaller is finer and slower.
@@ -992,7 +993,7 @@ fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
             Some(MeshArg::Discontinuity) => MeshMethod::Discontinuity,
         },
         max_elements: args.max_elements.map_or(
-            penumbra::default_budget(args.solver.into()),
+            penumbra::default_budget(args.solver.into(), args.direct_only),
             ElementBudget::AtMost,
         ),
         penumbra_density,

@@ -45,10 +45,11 @@ pub const DEFAULT_BUDGET: ElementBudget = ElementBudget::fit(DEFAULT_MAX_ELEMENT
 /// the exact direct light needs for 1 % on the Cornell box, costs it little.
 pub const HIERARCHICAL_MAX_ELEMENTS: usize = 25_000;
 
-/// The element budget of a run with `method` when none is given.
-pub fn default_budget(method: SolverMethod) -> ElementBudget {
+/// The element budget of a run with `method` when none is given (direct-only runs, which do
+/// not use the solver, get [`DEFAULT_BUDGET`]).
+pub fn default_budget(method: SolverMethod, direct_only: bool) -> ElementBudget {
     match method {
-        SolverMethod::Hierarchical => ElementBudget::fit(HIERARCHICAL_MAX_ELEMENTS),
+        SolverMethod::Hierarchical if !direct_only => ElementBudget::fit(HIERARCHICAL_MAX_ELEMENTS),
         _ => DEFAULT_BUDGET,
     }
 }

@@ -330,6 +330,8 @@ fn adaptive_refinement_is_reported() {
             "cornell",
             &out,
             &[
+                "--solver",
+                "progressive",
                 "--max-elements",
                 "4000",
                 "--refine-tol",
@@ -476,7 +478,16 @@ fn a_spent_time_budget_is_reported() {
     run_quietly(
         "cornell",
         &out,
-        &["--time-budget", "0.2", "--width", "64", "--height", "64"],
+        &[
+            "--solver",
+            "progressive",
+            "--time-budget",
+            "0.2",
+            "--width",
+            "64",
+            "--height",
+            "64",
+        ],
     );
     let report = json(&out.join("report.json"));
     assert_eq!(report["solver"]["stop"], "time_budget");
@@ -786,7 +797,14 @@ fn hemicube_form_factors_run_and_refuse_refinement() {
         run_quietly(
             "cornell",
             &out,
-            &["--max-elements", "1500", "--form-factors", ff],
+            &[
+                "--solver",
+                "progressive",
+                "--max-elements",
+                "1500",
+                "--form-factors",
+                ff,
+            ],
         );
         check_radiosity(&json(&out.join("solution.json")));
         let report = json(&out.join("report.json"));
@@ -833,6 +851,8 @@ fn interrupted_runs_write_their_partial_solution() {
             .args([
                 "run",
                 "cornell",
+                "--solver",
+                "progressive",
                 "--max-elements",
                 "20000",
                 "--epsilon",

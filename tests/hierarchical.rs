@@ -16,7 +16,7 @@ fn cornell_box_within_one_percent_of_path_tracing() {
     let loaded = load_scene("cornell").expect("built in");
     let options = RunOptions {
         method: SolverMethod::Hierarchical,
-        max_elements: penumbra::default_budget(SolverMethod::Hierarchical),
+        max_elements: penumbra::default_budget(SolverMethod::Hierarchical, false),
         render: penumbra_viz::RenderOptions {
             width: 1,
             height: 1,
