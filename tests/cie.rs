@@ -199,6 +199,44 @@ fn cie_5_6_floor_reflection() {
     check("5.6", &points, &values, 2e-3);
 }
 
+/// The area means of `values` (per surface and vertex, linear over each triangle) over the six
+/// faces of 5.8's cube, checked against `reference` by [`check`].
+fn check_face_means(
+    case: &str,
+    scene: &Scene,
+    mesh: &SceneMesh,
+    values: &[Vec<f64>],
+    reference: f64,
+    bound: f64,
+) {
+    let faces = [
+        "floor", "wall_x0", "wall_x1", "wall_y0", "wall_y1", "ceiling",
+    ];
+    let means: Vec<f64> = faces
+        .iter()
+        .map(|&face| {
+            let s = scene.surface_id(face).expect("face");
+            let m = &mesh.surfaces[s];
+            let (mut sum, mut covered) = (0.0, 0.0);
+            for (t, tri) in m.triangles.iter().enumerate() {
+                let a = m.triangle_area(t);
+                sum += a * tri.iter().map(|&v| values[s][v as usize]).sum::<f64>() / 3.0;
+                covered += a;
+            }
+            sum / covered
+        })
+        .collect();
+    let points: Vec<Point> = faces
+        .iter()
+        .map(|&surface| Point {
+            at: DVec3::ZERO,
+            surface,
+            reference,
+        })
+        .collect();
+    check(case, &points, &means, bound);
+}
+
 /// 5.8: the 4 m cube at reflectances 0.05 to 0.95, solved exactly (the dense solve of the patch
 /// system, since at 0.95 shooting takes thousands of shots). The reflected illuminance (total
 /// less the exact direct light, vertex by vertex) against Φ ρ / (S (1 − ρ)).
@@ -232,35 +270,11 @@ fn cie_5_8_inter_reflection() {
             .map(|(&h, &d)| h - d)
             .collect();
         let reference = cie::reflected_illuminance(cie::CUBE_FLUX, area, rho);
-        // Face means, each face's elements weighted by area.
-        let faces = [
-            "floor", "wall_x0", "wall_x1", "wall_y0", "wall_y1", "ceiling",
-        ];
-        let mut means = Vec::new();
-        for face in faces {
-            let s = scene.surface_id(face).expect("face");
-            let (mut sum, mut covered) = (0.0, 0.0);
-            for e in system.disc.elements.iter().filter(|e| e.surface == s) {
-                let mean = e.vertices.iter().map(|&v| reflected[v].mean()).sum::<f64>() / 3.0;
-                sum += e.area * mean;
-                covered += e.area;
-            }
-            means.push(sum / covered);
-        }
-        let face_points: Vec<Point> = faces
-            .iter()
-            .map(|&surface| Point {
-                at: DVec3::ZERO,
-                surface,
-                reference,
-            })
-            .collect();
-        check(
-            &format!("5.8 rho {rho}, face means"),
-            &face_points,
-            &means,
-            5e-3,
-        );
+        let means: Vec<Vec<f64>> = system
+            .disc
+            .per_surface(&reflected.iter().map(|h| h.mean()).collect::<Vec<_>>());
+        let case = format!("5.8 rho {rho}, face means");
+        check_face_means(&case, &scene, &mesh, &means, reference, 5e-3);
         // Points: the centre of every face, and off-centre floor and wall points.
         let field = system.disc.per_surface(&reflected);
         let point = |x: f64, y: f64, z: f64, surface: &'static str| Point {
@@ -322,39 +336,13 @@ fn cie_5_8_inter_reflection_hierarchical() {
         let direct = solve_progressive(&scene, &mesh, &visibility, &direct_only, &NoProgress)
             .expect("solves");
         let reference = cie::reflected_illuminance(cie::CUBE_FLUX, area, rho);
-        let faces = [
-            "floor", "wall_x0", "wall_x1", "wall_y0", "wall_y1", "ceiling",
-        ];
-        let means: Vec<f64> = faces
+        let reflected: Vec<Vec<f64>> = full
+            .irradiance
             .iter()
-            .map(|&face| {
-                let s = scene.surface_id(face).expect("face");
-                let m = &mesh.surfaces[s];
-                let (mut sum, mut covered) = (0.0, 0.0);
-                for (t, tri) in m.triangles.iter().enumerate() {
-                    let reflected = |v: &u32| {
-                        (full.irradiance[s][*v as usize] - direct.irradiance[s][*v as usize]).mean()
-                    };
-                    let a = m.triangle_area(t);
-                    sum += a * tri.iter().map(reflected).sum::<f64>() / 3.0;
-                    covered += a;
-                }
-                sum / covered
-            })
+            .zip(&direct.irradiance)
+            .map(|(f, d)| f.iter().zip(d).map(|(&f, &d)| (f - d).mean()).collect())
             .collect();
-        let face_points: Vec<Point> = faces
-            .iter()
-            .map(|&surface| Point {
-                at: DVec3::ZERO,
-                surface,
-                reference,
-            })
-            .collect();
-        check(
-            &format!("5.8 hierarchical, rho {rho}, face means"),
-            &face_points,
-            &means,
-            2e-2,
-        );
+        let case = format!("5.8 hierarchical, rho {rho}, face means");
+        check_face_means(&case, &scene, &mesh, &reflected, reference, 2e-2);
     }
 }

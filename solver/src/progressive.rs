@@ -366,6 +366,24 @@ pub(crate) fn direct_at(
     ))
 }
 
+/// The exact direct light at the new vertices `fresh` of a refined mesh, run to its end: the
+/// refinement loop checks for interrupts between rounds, and stopping here would lose the
+/// solution it has.
+pub(crate) fn direct_at_new(
+    direct: &DirectLight,
+    disc: &Discretization,
+    fresh: &[usize],
+    options: &SolverOptions,
+    progress: &dyn Progress,
+) -> Result<Vec<Rgb>, SolveError> {
+    let limits = Limits {
+        interrupt: None,
+        deadline: None,
+        rays: options.visibility_rays,
+    };
+    Ok(direct_at(direct, disc, fresh, &|_| true, &limits, progress)?.0)
+}
+
 /// Vertices whose direct light was estimated by rays: left at the deadline, or whose view of a
 /// light was beyond the overlay cap.
 #[derive(Clone, Copy, Debug, Default)]
@@ -810,14 +828,7 @@ impl<'a> ProgressiveSolver<'a> {
         let ([mut direct, mut irradiance], fresh) =
             disc.carried(&self.disc, [&self.direct_irradiance, &self.irradiance]);
         let t = Instant::now();
-        // Remeshing runs to its end: the refinement loop checks for interrupts between rounds,
-        // and stopping here would lose the solution it has.
-        let limits = Limits {
-            interrupt: None,
-            deadline: None,
-            rays: self.options.visibility_rays,
-        };
-        let (new_direct, _) = direct_at(&self.direct, &disc, &fresh, &|_| true, &limits, progress)?;
+        let new_direct = direct_at_new(&self.direct, &disc, &fresh, &self.options, progress)?;
         self.direct_seconds += t.elapsed().as_secs_f64();
         let t = Instant::now();
         let rays = std::sync::atomic::AtomicU64::new(0);

@@ -21,9 +21,6 @@ pub(crate) struct Field {
     pub q: Vec<Axes>,
     /// Per node: an element's mean irradiance from reflected light, its ancestors' included.
     pub irradiance: Vec<Rgb>,
-    /// Per node: half the range of its leaves' radiosities, per channel (how far its mean may
-    /// be from its parts; a light in the middle of a wall leaves halves of equal means).
-    pub spread: Vec<Rgb>,
     /// Per node: the least and greatest radiosity of its leaves.
     low: Vec<Rgb>,
     high: Vec<Rgb>,
@@ -35,7 +32,6 @@ impl Field {
             b: vec![Rgb::ZERO; nodes],
             q: vec![[Rgb::ZERO; 6]; clusters],
             irradiance: vec![Rgb::ZERO; nodes],
-            spread: vec![Rgb::ZERO; nodes],
             low: vec![Rgb::ZERO; nodes],
             high: vec![Rgb::ZERO; nodes],
         }
@@ -120,7 +116,8 @@ impl<'a> System<'a> {
         Radiosities {
             b: &field.b,
             q: &field.q,
-            spread: &field.spread,
+            low: &field.low,
+            high: &field.high,
             slot: &self.slot,
         }
     }
@@ -239,7 +236,6 @@ impl<'a> System<'a> {
                         (out.b[i], out.low[i], out.high[i]) = (sum / node.area, low, high);
                     }
                 }
-                out.spread[i] = (out.high[i] - out.low[i]) * 0.5;
             }
             slot => {
                 let mut total = match down {

@@ -61,12 +61,19 @@ pub(crate) struct Radiosities<'s> {
     pub b: &'s [Rgb],
     pub q: &'s [Axes],
     /// Each node's slot in `q` (clusters only).
-    /// Half the range of each element's leaves' radiosities.
-    pub spread: &'s [Rgb],
+    /// The least and greatest radiosity of each element's leaves.
+    pub low: &'s [Rgb],
+    pub high: &'s [Rgb],
     pub slot: &'s [u32],
 }
 
 impl Radiosities<'_> {
+    /// Half the range of element `id`'s leaves' radiosities: how far its mean may be from its
+    /// parts (a light in the middle of a wall leaves halves of equal means).
+    pub fn spread(&self, id: u32) -> Rgb {
+        (self.high[id as usize] - self.low[id as usize]) * 0.5
+    }
+
     /// The power the source sends (W).
     pub fn power(&self, node: &Node, id: u32) -> Rgb {
         if node.is_cluster() {
@@ -201,9 +208,8 @@ impl Refiner<'_> {
             None => {
                 let partial = sight != Sight::Full;
                 let transfer = match transfer {
-                    Some(Transfer::Factor { spread, .. }) => self.factor(r, s, spread),
-                    Some(far) => far,
-                    None => self.factor(r, s, self.quick_factor(r, s).1),
+                    Transfer::Factor { spread, .. } => self.factor(r, s, spread),
+                    far => far,
                 };
                 let transfer = if partial {
                     self.occlude(r, s, transfer, counts)
@@ -253,11 +259,9 @@ impl Refiner<'_> {
     /// The link's unoccluded transfer, and the light it would carry wrongly (W). Nodes nearer
     /// than their radii allow no estimate but a bound: the receiver reflects at most all the
     /// light the source sends, and at most its own area times the source's radiosity.
-    fn estimate(&self, r: u32, s: u32, state: &Radiosities) -> (Option<Transfer>, f64) {
+    fn estimate(&self, r: u32, s: u32, state: &Radiosities) -> (Transfer, f64) {
         let h = self.hierarchy;
         let (rn, sn) = (h.node(r), h.node(s));
-        let touching = rn.centroid.distance(sn.centroid) <= rn.radius + sn.radius;
-        let bound = || self.bound(r, s, state);
         if rn.is_cluster() || sn.is_cluster() {
             let offset = rn.centroid - sn.centroid;
             let distance2 = offset.length_squared().max(f64::MIN_POSITIVE);
@@ -267,8 +271,8 @@ impl Refiner<'_> {
                 distance2,
                 visible: 1.0,
             };
-            if touching {
-                return (Some(transfer), bound());
+            if touching(rn, sn) {
+                return (transfer, self.bound(r, s, state));
             }
             let facing = if rn.is_cluster() {
                 1.0
@@ -277,27 +281,15 @@ impl Refiner<'_> {
             };
             let irradiance = state.intensity(sn, s, direction) * (facing / distance2);
             return (
-                Some(transfer),
+                transfer,
                 rn.reflectance.mul_rgb(irradiance).mean() * rn.area,
             );
         }
-        // A quick estimate decides (nodes whose spheres overlap allow only the bound), and a
-        // kept link gets its factor the careful way; the quick spread is kept for judging it
-        // again.
-        let (quick, spread) = self.quick_factor(r, s);
-        let touching = rn.centroid.distance(sn.centroid) <= rn.radius + sn.radius;
-        let error = if touching && (rn.children.is_some() || sn.children.is_some()) {
-            self.bound(r, s, state)
-        } else {
-            self.factor_error(r, s, quick, spread, state)
-        };
-        (
-            Some(Transfer::Factor {
-                factor: f64::NAN,
-                spread,
-            }),
-            error,
-        )
+        // A quick estimate decides, and a kept link gets its factor the careful way (the quick
+        // spread is kept for judging it again).
+        let (factor, spread) = self.quick_factor(r, s);
+        let transfer = Transfer::Factor { factor, spread };
+        (transfer, self.factor_error(r, s, factor, spread, state))
     }
 
     /// The form factor from element `r` to element `s` at `r`'s quadrature points and corners,
@@ -358,11 +350,15 @@ impl Refiner<'_> {
     }
 
     /// The light an element-to-element link with form factor `factor` (spread `spread` over
-    /// the receiver) carries wrongly.
+    /// the receiver) carries wrongly; for nodes whose spheres overlap, one of which can still be
+    /// split, only the bound tells.
     fn factor_error(&self, r: u32, s: u32, factor: f64, spread: f64, state: &Radiosities) -> f64 {
-        let rn = self.hierarchy.node(r);
+        let (rn, sn) = (self.hierarchy.node(r), self.hierarchy.node(s));
+        if touching(rn, sn) && (rn.children.is_some() || sn.children.is_some()) {
+            return self.bound(r, s, state);
+        }
         // The source's mean stands for parts up to its spread away from it.
-        let wrong = state.b[s as usize] * spread + state.spread[s as usize] * factor;
+        let wrong = state.b[s as usize] * spread + state.spread(s) * factor;
         rn.reflectance.mul_rgb(wrong).mean() * rn.area
     }
 
@@ -370,16 +366,8 @@ impl Refiner<'_> {
     /// `tolerance` are refined again.
     pub fn error_of(&self, link: &Link, state: &Radiosities) -> f64 {
         let (r, s) = (link.receiver, link.source);
-        let (rn, sn) = (self.hierarchy.node(r), self.hierarchy.node(s));
         match link.transfer {
-            Transfer::Factor { factor, spread } => {
-                let touching = rn.centroid.distance(sn.centroid) <= rn.radius + sn.radius;
-                if touching && (rn.children.is_some() || sn.children.is_some()) {
-                    self.bound(r, s, state)
-                } else {
-                    self.factor_error(r, s, factor, spread, state)
-                }
-            }
+            Transfer::Factor { factor, spread } => self.factor_error(r, s, factor, spread, state),
             Transfer::Far { .. } => self.estimate(r, s, state).1,
         }
     }
@@ -446,6 +434,11 @@ fn spread(factors: &[f64], rn: &Node, at: impl Fn(DVec3) -> f64) -> f64 {
             (lo.min(f), hi.max(f))
         });
     (hi - lo).max(0.0)
+}
+
+/// Whether two nodes' bounding spheres overlap: then no estimate holds, only a bound.
+fn touching(a: &Node, b: &Node) -> bool {
+    a.centroid.distance(b.centroid) <= a.radius + b.radius
 }
 
 /// Whether element `a` lies wholly behind (or in) the plane of element `b` (so `b` cannot send

@@ -40,8 +40,8 @@ use crate::elements::Discretization;
 use crate::error::SolveError;
 use crate::progress::Progress;
 use crate::progressive::{
-    ConvergencePoint, Limits, OVERLAY_CAP, Solution, SolveStats, SolverOptions, StopReason,
-    check_mesh, direct_at, direct_irradiance,
+    ConvergencePoint, OVERLAY_CAP, Solution, SolveStats, SolverOptions, StopReason, check_mesh,
+    direct_at_new, direct_irradiance,
 };
 use final_gather::{FinalGather, Gathered};
 use iterate::{Field, System};
@@ -222,13 +222,7 @@ pub fn solve_hierarchical_refining(
             let ([mut direct, mut reflected], fresh) =
                 disc.carried(&current.disc, [&current.direct, &current.reflected]);
             let t = Instant::now();
-            // New vertices are solved to the end: refinement checks for interrupts between rounds.
-            let limits = Limits {
-                interrupt: None,
-                deadline: None,
-                rays: options.visibility_rays,
-            };
-            let (new_direct, _) = direct_at(&exact, &disc, &fresh, &|_| true, &limits, progress)?;
+            let new_direct = direct_at_new(&exact, &disc, &fresh, options, progress)?;
             direct_seconds += t.elapsed().as_secs_f64();
             let t = Instant::now();
             let leaves: Vec<u32> = fresh.iter().map(|&v| locate.leaf(&disc, v)).collect();

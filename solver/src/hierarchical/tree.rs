@@ -298,10 +298,7 @@ impl<F: Fn(SurfaceId) -> Rgb> Builder<'_, F> {
             area,
             centroid,
             normal: DVec3::ZERO,
-            radius: hull
-                .iter()
-                .map(|p| p.distance(centroid))
-                .fold(0.0, f64::max),
+            radius: farthest(&hull, centroid),
             bounds,
             hull,
             reflectance,
@@ -336,11 +333,7 @@ impl<F: Fn(SurfaceId) -> Rgb> Builder<'_, F> {
                 area: el.area,
                 centroid,
                 normal,
-                radius: el
-                    .points
-                    .iter()
-                    .map(|p| p.distance(centroid))
-                    .fold(0.0, f64::max),
+                radius: farthest(&el.points, centroid),
                 bounds: Bounds::from_points(&el.points),
                 hull: SmallVec::from_slice(&el.points),
                 axes: moment.axes(normal, el.area),
@@ -450,10 +443,7 @@ impl<F: Fn(SurfaceId) -> Rgb> Builder<'_, F> {
             area,
             centroid,
             normal,
-            radius: hull
-                .iter()
-                .map(|p| p.distance(centroid))
-                .fold(0.0, f64::max),
+            radius: farthest(&hull, centroid),
             bounds,
             hull,
             axes: moment.axes(normal, area),
@@ -506,6 +496,14 @@ fn placeholder(parent: u32, depth: u16) -> Node {
         reflectance: Rgb::ZERO,
         depth,
     }
+}
+
+/// The largest distance from `center` to one of `points`.
+fn farthest(points: &[DVec3], center: DVec3) -> f64 {
+    points
+        .iter()
+        .map(|p| p.distance(center))
+        .fold(0.0, f64::max)
 }
 
 /// The axis along which `points` spread most.
