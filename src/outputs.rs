@@ -232,7 +232,7 @@ pub fn quality_warning(below: usize, triangles: usize, adaptive: bool) -> Option
         let cause = if adaptive {
             format!(
                 "adaptive splits restore angles of {} degrees only",
-                penumbra_meshing::constrained::SPLIT_MIN_ANGLE_DEG
+                penumbra_meshing::SPLIT_MIN_ANGLE_DEG
             )
         } else {
             "the element budget cannot hold the least mesh at that angle of every surface".into()
@@ -241,7 +241,7 @@ pub fn quality_warning(below: usize, triangles: usize, adaptive: bool) -> Option
             "{below} of {} triangles have an angle under {} degrees that the input does not \
              force (mesh_quality.triangles_below_min_angle): {cause}",
             triangles,
-            penumbra_meshing::mesh::FORCING_WEDGE_DEG
+            penumbra_meshing::FORCING_WEDGE_DEG
         )
     })
 }

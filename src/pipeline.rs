@@ -6,8 +6,8 @@ use std::time::Instant;
 use crate::adaptive::{RefineOptions, RefineReport, refine_adaptively, refine_hierarchically};
 use crate::memory::{self, MeshCounts};
 use crate::shard::{Shard, ShardError};
+use penumbra_meshing::DEFAULT_PENUMBRA_DENSITY;
 use penumbra_meshing::discontinuity::{DiscontinuityOptions, find_discontinuities_reporting};
-use penumbra_meshing::grading::DEFAULT_PENUMBRA_DENSITY;
 use penumbra_meshing::{
     ElementBudget, MeshError, SceneMesh, mesh_scene_discontinuity_on, mesh_scene_uniform,
     polygon_minimum,

@@ -758,7 +758,7 @@ fn ambient_of(scene: &Scene, unshot: Rgb) -> Rgb {
         .map(|s| s.reflectance * s.area())
         .sum::<Rgb>()
         / area;
-    penumbra_solver::progressive::ambient_term(unshot, area, mean_reflectance)
+    penumbra_solver::ambient_term(unshot, area, mean_reflectance)
 }
 
 /// An RGB triple at `path` in a report, zero if absent.

@@ -9,9 +9,8 @@
 
 use glam::DVec3;
 use penumbra_meshing::discontinuity::{DiscontinuityOptions, EmitterProbe, EventSet};
-use penumbra_meshing::grading::DEFAULT_PENUMBRA_DENSITY;
-use penumbra_meshing::locate::TriangleLocator;
-use penumbra_scenes::rng::SplitMix64;
+use penumbra_meshing::{DEFAULT_PENUMBRA_DENSITY, TriangleLocator};
+use penumbra_scenes::SplitMix64;
 use penumbra_scenes::{LoadedScene, Scene, SurfaceId, Visibility};
 use penumbra_solver::path_trace::ReferenceValue;
 use penumbra_solver::{DirectLight, Progress, ReceivingPoint, SolverMethod, SolverOptions};

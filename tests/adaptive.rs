@@ -5,8 +5,8 @@ use penumbra::adaptive::{RefineOptions, RefineStop, refine_adaptively};
 use penumbra_meshing::discontinuity::{DiscontinuityOptions, find_discontinuities};
 use penumbra_meshing::{SceneMesh, mesh_scene_discontinuity, mesh_scene_uniform};
 use penumbra_scenes::{Scene, Visibility, builtin};
+use penumbra_solver::direct_interpolation_error;
 use penumbra_solver::estimate::IndirectEstimate;
-use penumbra_solver::measure::direct_interpolation_error;
 use penumbra_solver::{DirectLight, NoProgress, SolverOptions, solve_progressive};
 
 fn direct_only() -> SolverOptions {

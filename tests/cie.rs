@@ -9,10 +9,10 @@ use std::f64::consts::PI;
 
 use glam::DVec3;
 use penumbra::{RunOptions, run};
-use penumbra_meshing::locate::TriangleLocator;
+use penumbra_meshing::TriangleLocator;
 use penumbra_meshing::{SceneMesh, mesh_scene_uniform};
 use penumbra_scenes::{LoadedScene, Rgb, Scene, Visibility, cie};
-use penumbra_solver::gathering::PatchSystem;
+use penumbra_solver::PatchSystem;
 use penumbra_solver::{
     NoProgress, SolverMethod, SolverOptions, solve_hierarchical, solve_progressive,
 };

@@ -7,7 +7,7 @@ use penumbra_meshing::discontinuity::{
     Boundary, DiscontinuityOptions, Event, find_discontinuities,
 };
 use penumbra_scenes::{LoadedScene, Scene, Visibility, builtin};
-use penumbra_solver::measure::direct_interpolation_error;
+use penumbra_solver::direct_interpolation_error;
 use penumbra_solver::{DirectLight, NoProgress, SolverOptions};
 
 fn loaded(scene: Scene) -> LoadedScene {

@@ -11,8 +11,8 @@ use glam::{DVec2, DVec3};
 use penumbra_meshing::discontinuity::{
     DiscontinuityOptions, DiscontinuitySegment, Event, EventSet, find_discontinuities,
 };
-use penumbra_meshing::planar::clip_segment;
-use penumbra_scenes::rng::SplitMix64;
+use penumbra_scenes::SplitMix64;
+use penumbra_scenes::polygon::clip_segment;
 use penumbra_scenes::{PlaneFrame, Rgb, Scene, Surface, SurfaceId, Visibility, builtin};
 use penumbra_solver::{DirectLight, ReceivingPoint};
 use rayon::prelude::*;

@@ -266,7 +266,7 @@ fn light_is_continuous_across_t_junctions() {
     let locate = |name: &str, p: DVec3| {
         let s = scene.surface_id(name).expect("tile");
         let m = &result.mesh.surfaces[s];
-        penumbra_meshing::locate::TriangleLocator::new(m)
+        penumbra_meshing::TriangleLocator::new(m)
             .interpolate(m, &result.solution.radiosity[s], p)
             .mean()
     };

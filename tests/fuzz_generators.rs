@@ -2,7 +2,7 @@
 //! scene parsers and through the whole pipeline on small scenes. Nothing may panic; a parsed and
 //! solved scene must be physical (see `penumbra::fuzzing`).
 
-use penumbra_scenes::rng::SplitMix64;
+use penumbra_scenes::SplitMix64;
 
 fn random_bytes(rng: &mut SplitMix64, len: usize) -> Vec<u8> {
     (0..len).map(|_| rng.next_u64() as u8).collect()
@@ -19,7 +19,7 @@ fn random_bytes_never_crash_the_parsers() {
         let _ = case;
     }
     // Mostly well-formed text too: a valid scene with one byte changed.
-    let valid = penumbra_scenes::load::to_json(&penumbra_scenes::builtin::textbook());
+    let valid = penumbra_scenes::to_json(&penumbra_scenes::builtin::textbook());
     for _ in 0..500 {
         let mut text = valid.clone().into_bytes();
         let at = (rng.next_u64() as usize) % text.len();

@@ -3,7 +3,7 @@
 
 use penumbra::sweep::sample_points;
 use penumbra::{RunOptions, run};
-use penumbra_meshing::locate::TriangleLocator;
+use penumbra_meshing::TriangleLocator;
 use penumbra_scenes::{Visibility, load_scene};
 use penumbra_solver::path_trace::{PathTraceOptions, PathTracer};
 use penumbra_solver::{NoProgress, SolverMethod};

@@ -5,7 +5,7 @@
 
 use glam::DVec3;
 use libfuzzer_sys::fuzz_target;
-use penumbra_meshing::constrained::ConstrainedSurface;
+use penumbra_meshing::ConstrainedSurface;
 use penumbra_meshing::fuzzing::constraints_from_bytes;
 use penumbra_scenes::{Rgb, Surface};
 

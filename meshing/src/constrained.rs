@@ -18,8 +18,8 @@ use penumbra_scenes::{PlaneFrame, Surface, SurfaceId};
 use crate::error::MeshError;
 use crate::grading::Density;
 use crate::mesh::{ON_SEGMENT_TOLERANCE, SurfaceMesh};
-use crate::planar::clip_segment;
 use crate::uniform::{Cdt, MeshCoordinates, SurfaceTriangulation, insert_segment, snap};
+use penumbra_scenes::polygon::clip_segment;
 use spade::Triangulation as _;
 
 /// Constraint endpoints closer than this (in mesh units, where the polygon's extent is 1) are

@@ -76,7 +76,7 @@ impl Density {
             .filter_map(|face| {
                 let corners = face.positions().map(|p| DVec2::new(p.x, p.y));
                 let centroid = (corners[0] + corners[1] + corners[2]) / 3.0;
-                if !crate::planar::inside_polygon(centroid, &coords.boundary) {
+                if !penumbra_scenes::polygon::inside_polygon(centroid, &coords.boundary) {
                     return None;
                 }
                 let mut points = vec![to_3d(coords, centroid)];

@@ -12,25 +12,28 @@
 //! mesh.sanity_check().unwrap();
 //! ```
 
-pub mod budget;
-pub mod constrained;
-pub mod error;
+mod budget;
+mod constrained;
+pub mod discontinuity;
+mod error;
+#[doc(hidden)]
 pub mod fuzzing;
-pub mod grading;
-pub mod locate;
-pub mod mesh;
-pub mod planar;
-pub mod progress;
-pub mod scene_mesh;
-pub mod uniform;
-pub mod wedges;
+mod grading;
+mod locate;
+mod mesh;
+mod progress;
+mod scene_mesh;
+mod uniform;
+mod wedges;
 
 pub use budget::{ElementBudget, FIT_TRIANGLES_PER_SURFACE, polygon_minimum};
+pub use constrained::{ConstrainedSurface, Constraint, RefinableSurface, SPLIT_MIN_ANGLE_DEG};
 pub use error::MeshError;
-pub use mesh::{MeshQuality, SurfaceMesh, quality_of};
+pub use grading::DEFAULT_PENUMBRA_DENSITY;
+pub use locate::{TriangleLocator, transfer_density};
+pub use mesh::{FORCING_WEDGE_DEG, MeshQuality, SurfaceMesh, quality_of};
+pub use progress::{Interrupt, NoProgress, Progress};
 pub use scene_mesh::{
     SceneMesh, mesh_scene_discontinuity, mesh_scene_discontinuity_on, mesh_scene_uniform,
-    share_alone, spread_by_area,
 };
-pub use uniform::{MeshCoordinates, mesh_surface_uniform};
-pub mod discontinuity;
+pub use uniform::mesh_surface_uniform;

@@ -333,7 +333,7 @@ impl SurfaceTriangulation {
                 let points = split_points(&cdt, |face| {
                     let centroid = face_centroid(face);
                     face.area() > max_area / density.at(centroid)
-                        && crate::planar::inside_polygon(centroid, &self.coords.boundary)
+                        && penumbra_scenes::polygon::inside_polygon(centroid, &self.coords.boundary)
                 });
                 if points.is_empty() || cdt.num_vertices() > 2 * target + 64 {
                     break;
@@ -468,7 +468,7 @@ impl SurfaceTriangulation {
                 .inner_faces()
                 .filter(|&face| face.area() > max_area)
                 .map(face_centroid)
-                .filter(|&c| crate::planar::inside_polygon(c, &self.coords.boundary))
+                .filter(|&c| penumbra_scenes::polygon::inside_polygon(c, &self.coords.boundary))
                 .take(room)
                 .collect();
             if skipped.is_empty() {
@@ -561,7 +561,9 @@ impl SurfaceTriangulation {
                 .cdt
                 .inner_faces()
                 .map(|f| (f.area(), face_centroid(f)))
-                .filter(|&(_, c)| crate::planar::inside_polygon(c, &self.coords.boundary))
+                .filter(|&(_, c)| {
+                    penumbra_scenes::polygon::inside_polygon(c, &self.coords.boundary)
+                })
                 .collect();
             inside.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.x.total_cmp(&b.1.x)));
             // A split and the repairs around it add about four triangles, unless the repairs
@@ -656,7 +658,7 @@ fn faces_outside_polygon(cdt: &Cdt, polygon: &[DVec2]) -> Vec<FixedFaceHandle<In
         .filter(|f| {
             let [a, b, c] = f.positions();
             let centroid = DVec2::new((a.x + b.x + c.x) / 3.0, (a.y + b.y + c.y) / 3.0);
-            !crate::planar::inside_polygon(centroid, polygon)
+            !penumbra_scenes::polygon::inside_polygon(centroid, polygon)
         })
         .map(|f| f.fix())
         .collect()
@@ -787,7 +789,7 @@ mod tests {
     /// ceiling's triangle in the frame it had then.
     #[test]
     fn right_triangles_with_legs_along_the_axes_refine() {
-        let mut rng = penumbra_scenes::rng::SplitMix64::new(17);
+        let mut rng = penumbra_scenes::SplitMix64::new(17);
         let mut cases = vec![[
             DVec2::new(0.0, 0.0),
             DVec2::new(1.0, 0.0),

@@ -3,8 +3,8 @@
 //! sane mesh in which every segment is a chain of mesh edges.
 
 use glam::{DVec2, DVec3};
-use penumbra_meshing::constrained::{ConstrainedSurface, Constraint};
-use penumbra_scenes::rng::SplitMix64;
+use penumbra_meshing::{ConstrainedSurface, Constraint};
+use penumbra_scenes::SplitMix64;
 use penumbra_scenes::{Rgb, Surface};
 
 fn square(size: f64) -> Surface {
@@ -198,7 +198,7 @@ fn angles_forced_by_constraints_are_told_apart() {
     let q = mesh.quality();
     assert!(q.min_angle_deg <= 10.0 + 1e-9, "{q:?}");
     assert!(
-        q.min_angle_unforced_deg >= penumbra_meshing::mesh::FORCING_WEDGE_DEG - 1e-6,
+        q.min_angle_unforced_deg >= penumbra_meshing::FORCING_WEDGE_DEG - 1e-6,
         "{q:?}"
     );
     // A square alone has no forced corner: both figures agree.

@@ -17,10 +17,10 @@
 //! small budgets too, from any corner.
 
 use glam::{DAffine3, DQuat, DVec3};
+use penumbra_meshing::DEFAULT_PENUMBRA_DENSITY;
 use penumbra_meshing::discontinuity::{DiscontinuityOptions, find_discontinuities};
-use penumbra_meshing::grading::DEFAULT_PENUMBRA_DENSITY;
 use penumbra_meshing::{SceneMesh, SurfaceMesh, mesh_scene_discontinuity, mesh_scene_uniform};
-use penumbra_scenes::rng::SplitMix64;
+use penumbra_scenes::SplitMix64;
 use penumbra_scenes::{Rgb, Scene, Surface, Visibility, builtin};
 
 /// Meshes of two rotations may differ by this much, relative to the surface's diameter (lengths)

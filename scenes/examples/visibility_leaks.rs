@@ -8,7 +8,7 @@ use std::error::Error;
 use std::io::Write;
 use std::time::Instant;
 
-use penumbra_scenes::rng::SplitMix64;
+use penumbra_scenes::SplitMix64;
 use penumbra_scenes::visibility_check::{ProbeKind, closest_hit_mismatch, sample_segment};
 use penumbra_scenes::{Visibility, load_scene};
 

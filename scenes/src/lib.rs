@@ -18,28 +18,31 @@
 
 pub mod builtin;
 pub mod cie;
-pub mod color;
-pub mod coplanar;
-pub mod error;
+mod color;
+mod coplanar;
+mod error;
 pub mod extremes;
-pub mod frame;
+mod frame;
+#[doc(hidden)]
 pub mod fuzzing;
-pub mod load;
-pub mod model;
-pub mod obj;
+mod load;
+mod model;
+mod obj;
 pub mod polygon;
-pub mod rng;
+mod rng;
 pub mod tessellated;
-pub mod union_find;
-pub mod validate;
-pub mod visibility;
+mod union_find;
+mod validate;
+mod visibility;
 pub mod visibility_check;
 
 pub use color::Rgb;
 pub use error::SceneError;
 pub use frame::PlaneFrame;
-pub use load::{LoadedScene, load_scene, load_scene_with};
+pub use load::{LoadedScene, load_scene, load_scene_with, parse_json, read_scene_file, to_json};
 pub use model::{Bounds, Camera, Scene, Surface, SurfaceId};
-pub use obj::ObjOptions;
-pub use validate::{Problem, ProblemKind, validate};
+pub use obj::{MAX_OBJ_REFLECTANCE, ObjOptions, parse_obj_text, parse_obj_text_with};
+pub use rng::SplitMix64;
+pub use union_find::UnionFind;
+pub use validate::{Problem, ProblemKind, polygon_problem, validate};
 pub use visibility::{CONTACT_TOLERANCE, Hit, IndexBox, SceneTriangle, Visibility};

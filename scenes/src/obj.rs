@@ -57,11 +57,6 @@ impl Default for ObjOptions {
     }
 }
 
-/// Reads an OBJ file and the MTL files it names (beside it), with the default options.
-pub fn read_obj(path: &Path) -> Result<(Scene, Vec<String>), SceneError> {
-    read_obj_with(path, &ObjOptions::default())
-}
-
 /// Reads an OBJ file and the MTL files it names, looked for beside it.
 pub fn read_obj_with(
     path: &Path,

@@ -6,8 +6,8 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use glam::DVec3;
-use penumbra_scenes::obj::{ObjOptions, parse_obj_text, parse_obj_text_with, read_obj};
-use penumbra_scenes::validate::polygon_problem;
+use penumbra_scenes::polygon_problem;
+use penumbra_scenes::{ObjOptions, parse_obj_text, parse_obj_text_with, read_scene_file};
 use penumbra_scenes::{ProblemKind, Scene, SceneError, load_scene};
 
 const MTL: &str =
@@ -312,7 +312,7 @@ fn a_missing_library_names_the_path_looked_for() {
     let obj = "mtllib missing.mtl\nusemtl red\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
     let path = dir.path().join("scene.obj");
     std::fs::write(&path, obj).expect("write obj");
-    let (_, warnings) = read_obj(&path).expect("reads");
+    let (_, warnings) = read_scene_file(&path).expect("reads");
     let looked_for = dir.path().join("missing.mtl");
     let expected = format!(
         "material library not found: looked for {} (mtllib at line 1)",
@@ -430,7 +430,7 @@ fn merging_keeps_each_materials_area() {
 /// merges, every material keeps its area and every surface is valid.
 #[test]
 fn random_tessellations_merge_exactly() {
-    let mut rng = penumbra_scenes::rng::SplitMix64::new(11);
+    let mut rng = penumbra_scenes::SplitMix64::new(11);
     let mut merged_any = 0;
     for case in 0..200 {
         let mut random = |n: u64| (rng.next_u64() % n) as usize;
@@ -492,7 +492,7 @@ fn names_that_collide_through_slashes_are_made_unique() {
 /// keep refusing reflectance 1.
 #[test]
 fn reflectance_of_one_or_more_is_clamped_with_a_warning_per_material() {
-    use penumbra_scenes::obj::MAX_OBJ_REFLECTANCE;
+    use penumbra_scenes::MAX_OBJ_REFLECTANCE;
     let mtl = "newmtl bricks\nKd 1 1 1\nnewmtl red\nKd 1.2 0.5 0.25\nnewmtl unused\nKd 1 1 1\n\
                newmtl lamp\nKd 0 0 0\nKe 5 5 5\n";
     // Four faces of bricks and two of red, apart so that none merge.

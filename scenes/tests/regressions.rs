@@ -27,7 +27,7 @@ fn fuzz_regressions() {
 #[test]
 fn a_short_mtl_colour_is_a_material_error() {
     let obj = "mtllib m.mtl\nusemtl a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
-    let refused = penumbra_scenes::obj::parse_obj_text(obj, "newmtl a\nKs\n", "t.obj".as_ref());
+    let refused = penumbra_scenes::parse_obj_text(obj, "newmtl a\nKs\n", "t.obj".as_ref());
     // tobj reports unreadable materials as a warning on the models it still returns.
     match refused {
         Ok((_, warnings)) => assert!(
@@ -39,7 +39,7 @@ fn a_short_mtl_colour_is_a_material_error() {
         Err(e) => assert!(e.to_string().contains("t.obj"), "{e}"),
     }
     let (scene, _) =
-        penumbra_scenes::obj::parse_obj_text(obj, "newmtl a\nKd 0.25 0.5 0.75\n", "t.obj".as_ref())
+        penumbra_scenes::parse_obj_text(obj, "newmtl a\nKd 0.25 0.5 0.75\n", "t.obj".as_ref())
             .expect("parses");
     assert_eq!(scene.surfaces[0].reflectance.g, 0.5);
 }

@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use glam::DVec3;
-use penumbra_scenes::load::parse_json;
+use penumbra_scenes::parse_json;
 use penumbra_scenes::{
     ProblemKind, Rgb, Scene, SceneError, Surface, builtin, load_scene, validate,
 };
@@ -259,7 +259,7 @@ fn json_errors_have_line_and_column_and_unknown_keys_are_rejected() {
 #[test]
 fn json_round_trip_and_closing_vertex() {
     let scene = builtin::textbook();
-    let text = penumbra_scenes::load::to_json(&scene);
+    let text = penumbra_scenes::to_json(&scene);
     let back = parse_json(&text, Path::new("t.json")).expect("round trip");
     assert_eq!(back, scene);
     // A polygon written closed (first vertex repeated at the end) is the same polygon.

@@ -18,7 +18,7 @@ use crate::hemicube::{Hemicube, OCCLUDER};
 use crate::lambert::{ReceivingPoint, edge_term, form_factor};
 use crate::progress::Progress;
 use crate::progressive::Interrupt;
-use penumbra_scenes::rng::SplitMix64;
+use penumbra_scenes::SplitMix64;
 
 /// How point-to-patch form factors are computed.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]

@@ -1389,7 +1389,7 @@ mod tests {
                 ));
             }
         }
-        let mut rng = penumbra_scenes::rng::SplitMix64::new(7);
+        let mut rng = penumbra_scenes::SplitMix64::new(7);
         for k in 0..400 {
             let c = DVec3::new(
                 -2.5 + 5.0 * rng.next_f64(),

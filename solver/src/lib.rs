@@ -17,32 +17,33 @@
 //! assert!((direct.irradiance(&at(1.0), floor).r - 0.0279891563025598).abs() < 1e-12);
 //! ```
 
-pub mod clip;
+mod clip;
 pub mod coupling;
-pub mod direct;
-pub mod elements;
-pub mod error;
+mod direct;
+mod elements;
+mod error;
 pub mod estimate;
-pub mod gathering;
+mod gathering;
 pub mod hemicube;
 pub mod hierarchical;
-pub mod lambert;
-pub mod measure;
+mod lambert;
+mod measure;
 mod occluder_tree;
 pub mod path_trace;
-pub mod progress;
-pub mod progressive;
+mod progress;
+mod progressive;
 mod shadow_union;
-pub mod solids;
+mod solids;
 
-pub use direct::DirectLight;
-pub use elements::Discretization;
+pub use direct::{DirectLight, SEQUENTIAL_SHADOWS};
+pub use elements::{Discretization, Element, Patch};
 pub use error::SolveError;
-pub use gathering::{SolverMethod, solve_gathering};
+pub use gathering::{PatchSystem, SolverMethod, SystemSolution, solve_gathering};
 pub use hierarchical::solve_hierarchical;
 pub use lambert::{ReceivingPoint, form_factor};
-pub use progress::{NoProgress, Progress};
+pub use measure::{InterpolationError, direct_interpolation_error};
+pub use progress::{Interrupt, NoProgress, Progress};
 pub use progressive::{
-    ConvergencePoint, Interrupt, ProgressiveSolver, Solution, SolveStats, SolverOptions,
-    StopReason, solve_direct_on, solve_progressive,
+    ConvergencePoint, DEFAULT_EPSILON, ProgressiveSolver, SHARED_POINT, Solution, SolveStats,
+    SolverOptions, StopReason, ambient_term, solve_direct_on, solve_progressive,
 };

@@ -3,7 +3,7 @@
 
 use glam::DVec3;
 use penumbra_meshing::SurfaceMesh;
-use penumbra_scenes::rng::SplitMix64;
+use penumbra_scenes::SplitMix64;
 use penumbra_scenes::{Rgb, Scene};
 use serde::Serialize;
 

@@ -311,7 +311,7 @@ impl Meshes {
     fn of(faces: &[TreeFace], centroids: &[DVec3]) -> Meshes {
         let mut first: std::collections::HashMap<CornerKey, usize> =
             std::collections::HashMap::new();
-        let mut joined = penumbra_scenes::union_find::UnionFind::new(faces.len());
+        let mut joined = penumbra_scenes::UnionFind::new(faces.len());
         for (i, f) in faces.iter().enumerate() {
             for &k in f.keys {
                 let j = *first.entry(k).or_insert(i);

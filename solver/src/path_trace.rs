@@ -16,7 +16,7 @@
 //! this cuts the standard error at the same number of paths about threefold.
 
 use glam::DVec3;
-use penumbra_scenes::rng::SplitMix64;
+use penumbra_scenes::SplitMix64;
 use penumbra_scenes::{PlaneFrame, Rgb, Scene, SurfaceId, Visibility};
 use rayon::prelude::*;
 use serde::Serialize;

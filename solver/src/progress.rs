@@ -1,3 +1,3 @@
 //! Progress reporting from long computations (shared with the meshing crate).
 
-pub use penumbra_meshing::progress::{Interrupt, NoProgress, Progress};
+pub use penumbra_meshing::{Interrupt, NoProgress, Progress};

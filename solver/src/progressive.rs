@@ -22,8 +22,7 @@ use std::sync::atomic::Ordering;
 use std::time::Instant;
 
 use glam::DVec3;
-use penumbra_meshing::locate::{TriangleLocator, transfer_density};
-use penumbra_meshing::{SceneMesh, SurfaceMesh};
+use penumbra_meshing::{SceneMesh, SurfaceMesh, TriangleLocator, transfer_density};
 use penumbra_scenes::{Rgb, Scene, SurfaceId, Visibility};
 use rayon::prelude::*;
 use serde::Serialize;

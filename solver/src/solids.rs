@@ -7,7 +7,7 @@ use std::collections::HashMap;
 
 use glam::DVec3;
 use penumbra_scenes::Scene;
-use penumbra_scenes::union_find::UnionFind;
+use penumbra_scenes::UnionFind;
 
 /// A corner identified by its exact coordinates (faces of a welded mesh share them).
 fn key(p: DVec3) -> [u64; 3] {

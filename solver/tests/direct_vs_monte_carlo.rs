@@ -3,7 +3,7 @@
 //! within 4 standard errors, at points in penumbrae where occlusion matters.
 
 use glam::DVec3;
-use penumbra_scenes::rng::SplitMix64;
+use penumbra_scenes::SplitMix64;
 use penumbra_scenes::{Scene, SurfaceId, Visibility, builtin};
 use penumbra_solver::{DirectLight, ReceivingPoint};
 

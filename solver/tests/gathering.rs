@@ -4,7 +4,7 @@
 
 use penumbra_meshing::{SceneMesh, mesh_scene_uniform};
 use penumbra_scenes::{Scene, Visibility, builtin};
-use penumbra_solver::gathering::PatchSystem;
+use penumbra_solver::PatchSystem;
 use penumbra_solver::{
     NoProgress, Solution, SolverMethod, SolverOptions, solve_gathering, solve_progressive,
 };

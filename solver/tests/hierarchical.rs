@@ -4,7 +4,7 @@
 use glam::DVec3;
 use penumbra_meshing::{SceneMesh, mesh_scene_uniform};
 use penumbra_scenes::{Rgb, Scene, Visibility, builtin};
-use penumbra_solver::gathering::PatchSystem;
+use penumbra_solver::PatchSystem;
 use penumbra_solver::{
     NoProgress, Solution, SolverMethod, SolverOptions, StopReason, solve_hierarchical,
 };

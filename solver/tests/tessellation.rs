@@ -2,7 +2,7 @@
 //! two ways of subtracting shadows (one by one, or all at once by a polygon difference) agree.
 
 use glam::DVec3;
-use penumbra_scenes::rng::SplitMix64;
+use penumbra_scenes::SplitMix64;
 use penumbra_scenes::tessellated::tessellated;
 use penumbra_scenes::{Scene, Visibility, builtin};
 use penumbra_solver::{DirectLight, ReceivingPoint};
@@ -48,7 +48,7 @@ fn tessellated_occluders_cast_the_same_light_as_their_polygons() {
         let fine = floor_irradiance(
             &tessellated(n),
             &points,
-            penumbra_solver::direct::SEQUENTIAL_SHADOWS,
+            penumbra_solver::SEQUENTIAL_SHADOWS,
         );
         let worst = solid
             .iter()
@@ -166,7 +166,7 @@ fn the_faces_at_a_blob_corner_share_their_view_exactly() {
     let mesh = penumbra_meshing::mesh_scene_uniform(&scene, least).expect("meshes");
     let disc = Discretization::new(&scene, &mesh, 24);
     // Grouped as the solver groups them: by the grid point they round to.
-    let quantum = penumbra_solver::progressive::SHARED_POINT * direct.scene_diagonal();
+    let quantum = penumbra_solver::SHARED_POINT * direct.scene_diagonal();
     let mut at_point: BTreeMap<[i64; 3], Vec<usize>> = BTreeMap::new();
     for (v, x) in disc.receivers.iter().enumerate() {
         let q = (x.point / quantum).round();

@@ -32,18 +32,19 @@
 //! assert!(svg.contains("floor"));
 //! ```
 
-pub mod camera;
-pub mod chart;
+mod camera;
+mod chart;
 mod clip;
-pub mod error;
+mod error;
 mod raster;
-pub mod render;
-pub mod surface_svg;
+mod render;
+mod surface_svg;
 mod svg_plot;
-pub mod tonemap;
+mod tonemap;
 
 pub use camera::{camera_looking, default_camera};
 pub use chart::{LogLogChart, Series};
 pub use error::VizError;
 pub use render::{Render, RenderOptions, encode_png, render};
 pub use surface_svg::surface_svg;
+pub use tonemap::srgb_encode;

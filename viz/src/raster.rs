@@ -150,7 +150,7 @@ fn row_span(p: &[DVec2; 3], y: f64) -> Option<(f64, f64)> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use penumbra_scenes::rng::SplitMix64;
+    use penumbra_scenes::SplitMix64;
 
     fn coverage(triangles: &[ScreenTriangle], size: u32) -> Vec<u32> {
         let mut count = vec![0; (size * size) as usize];

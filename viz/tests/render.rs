@@ -103,7 +103,7 @@ fn furnace_from_inside_covers_every_pixel() {
         let out = render(&scene, &mesh, &radiosity, &options).expect("furnace renders");
         // Every face emits, so exposure falls back to all visible surfaces: 2 maps to 0.8.
         assert!((out.exposure * 2.0 - 0.8).abs() < 1e-12);
-        let expected = (penumbra_viz::tonemap::srgb_encode(0.8) * 255.0).round() as u8;
+        let expected = (penumbra_viz::srgb_encode(0.8) * 255.0).round() as u8;
         for (x, y, p) in out.image.enumerate_pixels() {
             assert_eq!(p.0, [expected; 3], "pixel ({x}, {y}) at size {size}");
         }
@@ -158,7 +158,7 @@ fn fixed_exposure_and_ambient() {
         ..dark
     };
     let out = render(&scene, &mesh, &zero, &grey).expect("renders");
-    let expected = (penumbra_viz::tonemap::srgb_encode(0.5) * 255.0).round() as u8;
+    let expected = (penumbra_viz::srgb_encode(0.5) * 255.0).round() as u8;
     assert!(
         out.image
             .pixels()
@@ -189,7 +189,7 @@ fn backs_of_surfaces_are_black() {
     assert!(dark.image.pixels().all(|p| p.0 == [0, 0, 0]));
     options.ambient = Rgb::splat(2.0);
     let grey = render(&scene, &mesh, &radiosity, &options).expect("renders");
-    let expected = (penumbra_viz::tonemap::srgb_encode(0.2) * 255.0).round() as u8;
+    let expected = (penumbra_viz::srgb_encode(0.2) * 255.0).round() as u8;
     assert!(grey.image.pixels().all(|p| p.0 == [expected; 3]));
 }
 

@@ -2,7 +2,7 @@
 //! blocker edge and the VE wedges of its emitter vertices all lie in one plane.
 
 use glam::DVec2;
-use penumbra_scenes::union_find::UnionFind;
+use penumbra_scenes::UnionFind;
 
 /// A segment on a receiver in its plane-frame coordinates, with what generated it.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -8,19 +8,19 @@
 //! (the parallel case) are merged. Blockers touching the receiver add contact (D0) lines. Every
 //! segment is classified by what lies on either side: umbra, penumbra or lit.
 
-pub mod between;
-pub mod contact;
-pub mod eee;
-pub mod horizon;
-pub mod hull;
-pub mod merge;
+mod between;
+mod contact;
+mod eee;
+mod horizon;
+mod hull;
+mod merge;
 mod pair;
-pub mod patches;
+mod patches;
 mod shaft;
-pub mod strength;
-pub mod topology;
-pub mod trim;
-pub mod wedge;
+mod strength;
+mod topology;
+mod trim;
+mod wedge;
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -398,7 +398,7 @@ pub(crate) fn clip_to_polygon(
     q: DVec3,
 ) -> Vec<[DVec3; 2]> {
     let flat: Vec<DVec2> = polygon.iter().map(|&x| frame.to_2d(x)).collect();
-    crate::planar::clip_segment(frame.to_2d(p), frame.to_2d(q), &flat)
+    penumbra_scenes::polygon::clip_segment(frame.to_2d(p), frame.to_2d(q), &flat)
         .into_iter()
         .map(|[s, t]| [p.lerp(q, s), p.lerp(q, t)])
         .collect()

@@ -5,7 +5,7 @@
 
 use glam::DVec3;
 use penumbra_scenes::SurfaceId;
-use penumbra_scenes::union_find::UnionFind;
+use penumbra_scenes::UnionFind;
 
 use super::topology::Topology;
 
@@ -17,11 +17,10 @@ const COPLANAR_COSINE: f64 = 1.0 - 1e-12;
 /// vertices where their outline turns.
 const FEW_FACES: usize = 8;
 
-/// Each surface's flat patch, each patch's faces, and the points a patch's outline turns at.
+/// Each surface's flat patch, and the points each patch's outline turns at.
 #[derive(Clone, Debug)]
 pub struct Patches {
     pub of_surface: Vec<usize>,
-    pub faces: Vec<Vec<SurfaceId>>,
     pub corners: Vec<Vec<DVec3>>,
 }
 
@@ -66,7 +65,6 @@ impl Patches {
             .collect();
         Patches {
             of_surface,
-            faces,
             corners,
         }
     }
@@ -125,7 +123,7 @@ mod tests {
             let topology = Topology::new(&scene, 1e-9 * scene.diagonal());
             let patches = Patches::new(&topology);
             // Light, floor and the prism's eight sides.
-            assert_eq!(patches.faces.len(), 10, "tessellated-{n}");
+            assert_eq!(patches.corners.len(), 10, "tessellated-{n}");
         }
     }
 

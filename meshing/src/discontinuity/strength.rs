@@ -16,7 +16,7 @@
 use glam::{DVec2, DVec3};
 use penumbra_scenes::{PlaneFrame, Scene, SurfaceId};
 
-use crate::planar::closest_point_in_polygon;
+use penumbra_scenes::polygon::closest_point_in_polygon;
 
 /// What a blocker patch can do on a receiver.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -14,7 +14,7 @@
 use std::f64::consts::PI;
 
 use glam::DVec3;
-use penumbra_scenes::rng::SplitMix64;
+use penumbra_scenes::SplitMix64;
 use penumbra_scenes::{Rgb, SurfaceId};
 use smallvec::SmallVec;
 

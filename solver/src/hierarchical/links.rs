@@ -19,7 +19,7 @@
 //! stratified, seeded set between the two nodes.
 
 use glam::DVec3;
-use penumbra_scenes::rng::SplitMix64;
+use penumbra_scenes::SplitMix64;
 use penumbra_scenes::{Rgb, Visibility};
 use rayon::prelude::*;
 

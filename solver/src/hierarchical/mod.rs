@@ -29,8 +29,7 @@ mod tree;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
-use penumbra_meshing::locate::TriangleLocator;
-use penumbra_meshing::{SceneMesh, SurfaceMesh};
+use penumbra_meshing::{SceneMesh, SurfaceMesh, TriangleLocator};
 use penumbra_scenes::{Rgb, Scene, Visibility};
 use rayon::prelude::*;
 use serde::Serialize;

@@ -9,7 +9,7 @@
 //! holds a contiguous range of them: points are sampled on any node by area in one search.
 
 use glam::DVec3;
-use penumbra_scenes::rng::SplitMix64;
+use penumbra_scenes::SplitMix64;
 use penumbra_scenes::{Bounds, Rgb, SurfaceId};
 use smallvec::SmallVec;
 
@@ -457,7 +457,7 @@ impl<F: Fn(SurfaceId) -> Rgb> Builder<'_, F> {
 /// `elements` split into groups connected through shared vertices, each group in ascending
 /// order, groups ordered by their first element.
 fn connected_pieces(disc: &Discretization, elements: &[u32]) -> Vec<Vec<u32>> {
-    let mut sets = penumbra_scenes::union_find::UnionFind::new(elements.len());
+    let mut sets = penumbra_scenes::UnionFind::new(elements.len());
     let mut owner: std::collections::HashMap<usize, usize> = std::collections::HashMap::new();
     for (k, &e) in elements.iter().enumerate() {
         for &v in &disc.elements[e as usize].vertices {
