@@ -7,7 +7,7 @@
 use std::io::Write;
 use std::time::Instant;
 
-use penumbra::pipeline::DEFAULT_BUDGET;
+use penumbra::DEFAULT_BUDGET;
 use penumbra_meshing::discontinuity::{DiscontinuityOptions, find_discontinuities};
 use penumbra_meshing::polygon_minimum;
 use penumbra_scenes::{Visibility, load_scene};

@@ -25,7 +25,9 @@ use serde::Serialize;
 /// How adaptive refinement runs.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RefineOptions {
-    /// Split triangles whose residual exceeds this fraction of the scene's mean radiosity.
+    /// Split triangles whose residual exceeds this fraction of the mean reflected radiosity
+    /// (B − E, area-weighted over the surfaces that reflect): the light a dim floor under a
+    /// bright lamp reflects sets its scale, not the lamp's own exitance.
     pub tolerance: f64,
     /// Triangles of the mesh refinement starts from (the budget caps where it ends);
     /// [`INITIAL_FRACTION`] of the budget by default.
@@ -58,6 +60,9 @@ pub enum RefineStop {
 /// quarter.
 pub const INITIAL_FRACTION: f64 = 0.1;
 
+/// What refinement tolerances are relative to, as `report.json` names it.
+pub const TOLERANCE_RELATIVE_TO: &str = "mean_reflected_radiosity";
+
 /// Rounds of refinement at most, by default. A round takes at most a third of the room left, so
 /// going from a tenth of the budget to its last half percent takes about 13.
 pub const DEFAULT_MAX_ROUNDS: usize = 32;
@@ -73,6 +78,9 @@ pub struct RefineRound {
     /// Patch shots so far (none in direct-only runs).
     pub shots: usize,
     pub residual: ResidualSummary,
+    /// The residual a triangle may have, in radiosity units: the tolerance times the mean
+    /// reflected radiosity.
+    pub threshold: f64,
     /// Triangles over the tolerance, how many of them were split, and the triangles that made.
     pub over_tolerance: usize,
     pub split: usize,
@@ -82,7 +90,11 @@ pub struct RefineRound {
 /// What adaptive refinement did.
 #[derive(Clone, Debug, Serialize)]
 pub struct RefineReport {
+    /// The tolerance asked for, relative to [`RefineReport::tolerance_relative_to`].
     pub tolerance: f64,
+    /// What the tolerance is a fraction of: always `"mean_reflected_radiosity"`, the
+    /// area-weighted mean of B − E over the surfaces that reflect, round by round.
+    pub tolerance_relative_to: &'static str,
     pub rounds: Vec<RefineRound>,
     pub stop: RefineStop,
     /// The residuals of the final mesh.
@@ -109,7 +121,7 @@ pub fn refine_adaptively(
         limits.round = round;
         solver.shoot(ROUND_EPSILON.max(solver_options.epsilon), progress);
         let residuals = solution_residuals(scene, &solver, options.indirect);
-        residual = summarize(&mesh.surfaces, &solver.radiosity(), &residuals);
+        residual = summarize(scene, &mesh.surfaces, &solver.radiosity(), &residuals);
         let (this, plan) = plan_round(scene, mesh, &residuals, residual, solver.shots(), &limits);
         rounds.push(this);
         match plan {
@@ -126,6 +138,7 @@ pub fn refine_adaptively(
     solver.shoot(solver_options.epsilon, progress);
     let report = RefineReport {
         tolerance: options.tolerance,
+        tolerance_relative_to: TOLERANCE_RELATIVE_TO,
         rounds,
         stop,
         residual,
@@ -162,7 +175,7 @@ pub fn refine_hierarchically(
             true,
             gradient_jump_estimate,
         );
-        residual = summarize(r.meshes, &r.radiosity, &residuals);
+        residual = summarize(scene, r.meshes, &r.radiosity, &residuals);
         limits.round = rounds.len();
         let (this, plan) = plan_round(scene, &current, &residuals, residual, 0, &limits);
         rounds.push(this);
@@ -204,6 +217,7 @@ pub fn refine_hierarchically(
     };
     let report = RefineReport {
         tolerance: options.tolerance,
+        tolerance_relative_to: TOLERANCE_RELATIVE_TO,
         rounds,
         stop,
         residual,
@@ -247,7 +261,7 @@ fn plan_round(
     limits: &RoundLimits,
 ) -> (RefineRound, Plan) {
     let (options, max_elements) = (limits.options, limits.max_elements);
-    let tolerance = options.tolerance * residual.mean_radiosity;
+    let tolerance = options.tolerance * residual.mean_reflected_radiosity;
     let mut over: Vec<(f64, usize, usize)> = residuals
         .iter()
         .enumerate()
@@ -262,6 +276,7 @@ fn plan_round(
         triangles: mesh.triangle_count(),
         shots,
         residual,
+        threshold: tolerance,
         over_tolerance: over.len(),
         split: 0,
         added: 0,

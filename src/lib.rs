@@ -9,13 +9,15 @@ pub mod energy;
 pub mod form_factor_study;
 pub mod fuzzing;
 pub mod memory;
+pub mod options;
 pub mod outputs;
 pub mod pipeline;
 pub mod progress_bar;
 pub mod shard;
 pub mod sweep;
 
-pub use pipeline::{
-    DEFAULT_BUDGET, DEFAULT_MAX_ELEMENTS, HIERARCHICAL_MAX_ELEMENTS, MeshMethod, RunError,
-    RunOptions, RunResult, default_budget, run,
+pub use options::{
+    DEFAULT_BUDGET, DEFAULT_MAX_ELEMENTS, HIERARCHICAL_MAX_ELEMENTS, InvalidOption, MeshMethod,
+    RunOptions, default_budget,
 };
+pub use pipeline::{RunError, RunResult, run};

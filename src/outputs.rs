@@ -93,9 +93,29 @@ pub fn solution_json_of(scene: &str, surfaces: &[SurfaceSolution]) -> String {
     })
 }
 
+/// How a run was asked for on the command line: `report.json` records it so that the run can
+/// be repeated (`penumbra run --replay`).
+#[derive(Clone, Debug, Serialize, serde::Deserialize)]
+pub struct Invocation {
+    /// The command line, the program first.
+    pub arguments: Vec<String>,
+    /// The directory that relative paths on it are relative to.
+    pub working_directory: String,
+    /// Every option of the command as it was resolved, defaults included, by option name.
+    pub options: serde_json::Value,
+}
+
+/// The version of penumbra that wrote a report.
+pub const VERSION: &str = env!("CARGO_PKG_VERSION");
+
 #[derive(Serialize)]
 struct Report<'a> {
     format: &'static str,
+    /// The version of penumbra that made the run.
+    version: &'static str,
+    /// The command line and every option, when the run came from one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    invocation: Option<&'a Invocation>,
     /// The run was cut short (interrupted, or its time budget spent): the solution is the best
     /// so far, not a converged one, or its mesh lacks the events of the emitter–receiver pairs
     /// the discontinuity search had no time for.
@@ -132,6 +152,8 @@ struct SvgSummary {
 struct SceneSummary<'a> {
     name: &'a str,
     source: &'a str,
+    /// A hash of every number of the scene as loaded: a replay checks it found the same scene.
+    fingerprint: String,
     surfaces: usize,
     emitters: usize,
     bounding_box_diagonal: f64,
@@ -141,7 +163,7 @@ struct SceneSummary<'a> {
 struct Method {
     /// The mesh that was built (`auto` chooses by whether the scene casts shadows).
     mesh: &'static str,
-    mesh_requested: crate::pipeline::MeshMethod,
+    mesh_requested: crate::options::MeshMethod,
     solver: &'static str,
     /// The element budget used: the mesh's, or the cap of adaptive refinement.
     max_elements: usize,
@@ -263,6 +285,8 @@ pub fn report_json(result: &RunResult, svgs: &SvgSelection) -> String {
     ));
     let report = Report {
         format: REPORT_FORMAT,
+        version: VERSION,
+        invocation: result.invocation.as_ref(),
         partial: matches!(stats.stop, StopReason::Interrupted | StopReason::TimeBudget)
             || result
                 .mesh
@@ -272,6 +296,7 @@ pub fn report_json(result: &RunResult, svgs: &SvgSelection) -> String {
         scene: SceneSummary {
             name: &scene.name,
             source: &result.loaded.source,
+            fingerprint: crate::shard::scene_fingerprint(&result.loaded),
             surfaces: scene.surfaces.len(),
             emitters: scene.emitters().count(),
             bounding_box_diagonal: scene.diagonal(),

@@ -3,10 +3,10 @@
 
 use std::time::Instant;
 
-use crate::adaptive::{RefineOptions, RefineReport, refine_adaptively, refine_hierarchically};
+use crate::adaptive::{RefineReport, refine_adaptively, refine_hierarchically};
 use crate::memory::{self, MeshCounts};
-use crate::shard::{Shard, ShardError};
-use penumbra_meshing::DEFAULT_PENUMBRA_DENSITY;
+use crate::options::{InvalidOption, MeshMethod, RunOptions};
+use crate::shard::ShardError;
 use penumbra_meshing::discontinuity::{DiscontinuityOptions, find_discontinuities_reporting};
 use penumbra_meshing::{
     ElementBudget, MeshError, SceneMesh, mesh_scene_discontinuity_on, mesh_scene_uniform,
@@ -17,83 +17,8 @@ use penumbra_solver::{
     Progress, Solution, SolveError, SolverMethod, SolverOptions, solve_direct_on, solve_gathering,
     solve_hierarchical, solve_progressive,
 };
-use penumbra_viz::{Render, RenderOptions, VizError};
+use penumbra_viz::{Render, VizError};
 use serde::Serialize;
-
-/// How surfaces are meshed.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum MeshMethod {
-    /// Constrained Delaunay triangulation of each polygon, refined to a uniform size.
-    Uniform,
-    /// The same, with the discontinuities of the direct light as constraint edges.
-    Discontinuity,
-    /// Discontinuity meshing where the scene casts shadows, uniform meshing where it has none.
-    Auto,
-}
-
-/// Triangles for the whole scene by default: this many, or what the scene needs when that is
-/// more (its least mesh and [`penumbra_meshing::FIT_TRIANGLES_PER_SURFACE`] per surface; see
-/// [`ElementBudget::Fit`]).
-pub const DEFAULT_MAX_ELEMENTS: usize = 10_000;
-
-/// The element budget of a run when none is given.
-pub const DEFAULT_BUDGET: ElementBudget = ElementBudget::fit(DEFAULT_MAX_ELEMENTS);
-
-/// Triangles for the whole scene by default with the hierarchical solver: its cost grows about
-/// linearly with the vertices (each gathers along its own links), so a finer display mesh, which
-/// the exact direct light needs for 1 % on the Cornell box, costs it little.
-pub const HIERARCHICAL_MAX_ELEMENTS: usize = 25_000;
-
-/// The element budget of a run with `method` when none is given (direct-only runs, which do
-/// not use the solver, get [`DEFAULT_BUDGET`]).
-pub fn default_budget(method: SolverMethod, direct_only: bool) -> ElementBudget {
-    match method {
-        SolverMethod::Hierarchical if !direct_only => ElementBudget::fit(HIERARCHICAL_MAX_ELEMENTS),
-        _ => DEFAULT_BUDGET,
-    }
-}
-
-#[derive(Clone, Debug)]
-pub struct RunOptions {
-    pub mesh: MeshMethod,
-    /// Triangles for the whole scene: a cap, or fitted to the scene ([`DEFAULT_BUDGET`]).
-    pub max_elements: ElementBudget,
-    /// How many times smaller in area discontinuity-mesh triangles are in penumbrae (1: none).
-    pub penumbra_density: f64,
-    /// How discontinuities are found (EEE events on or off, tolerances).
-    pub discontinuity: DiscontinuityOptions,
-    /// Adaptive refinement from a coarser mesh up to `max_elements`, if asked for.
-    pub refine: Option<RefineOptions>,
-    /// Seconds after which refinement and shooting stop and the best solution so far is kept.
-    pub time_budget: Option<f64>,
-    pub solver: SolverOptions,
-    /// How the radiosity system is solved (progressive refinement unless asked otherwise).
-    pub method: SolverMethod,
-    pub render: RenderOptions,
-    /// Bytes the run may use (default: what the machine has available when it starts).
-    pub memory_limit: Option<u64>,
-    /// Light only this shard's surfaces (direct light only; see [`crate::shard`]).
-    pub shard: Option<Shard>,
-}
-
-impl Default for RunOptions {
-    fn default() -> Self {
-        RunOptions {
-            mesh: MeshMethod::Auto,
-            max_elements: DEFAULT_BUDGET,
-            penumbra_density: DEFAULT_PENUMBRA_DENSITY,
-            discontinuity: DiscontinuityOptions::default(),
-            refine: None,
-            time_budget: None,
-            solver: SolverOptions::default(),
-            method: SolverMethod::Progressive,
-            render: RenderOptions::default(),
-            memory_limit: None,
-            shard: None,
-        }
-    }
-}
 
 /// Wall-clock seconds per stage.
 #[derive(Clone, Debug, Default, Serialize)]
@@ -125,7 +50,7 @@ pub struct StagePeaks {
 /// What the run was expected to need, what it could have, and what it used.
 #[derive(Clone, Debug, Serialize)]
 pub struct MemoryReport {
-    /// Bytes the run could use: `--memory-limit`, or what the machine had available.
+    /// Bytes the run could use: the run's memory limit, or what the machine had available.
     pub limit_bytes: Option<u64>,
     /// Estimated from the mesh that was built.
     pub estimate_bytes: u64,
@@ -148,11 +73,16 @@ pub struct RunResult {
     pub render: Render,
     pub times: StageTimes,
     pub memory: MemoryReport,
+    /// The command line that asked for the run, if one did (set by the front end; recorded in
+    /// `report.json`).
+    pub invocation: Option<crate::outputs::Invocation>,
 }
 
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum RunError {
+    #[error(transparent)]
+    InvalidOption(#[from] InvalidOption),
     #[error(transparent)]
     Mesh(#[from] MeshError),
     /// The starting mesh of adaptive refinement does not fit its budget
@@ -171,9 +101,9 @@ pub enum RunError {
         needed: u64,
         /// Bytes the run may use.
         limit: u64,
-        /// The largest `--max-elements` that would fit, if any.
+        /// The largest element budget that would fit, if any.
         suggestion: Option<usize>,
-        /// With the hierarchical solver: the least `--link-tol` that would fit, if any.
+        /// With the hierarchical solver: the least link tolerance that would fit, if any.
         link_tol: Option<f64>,
     },
 }
@@ -189,21 +119,14 @@ fn memory_message(
         memory::human(*needed),
         memory::human(*limit)
     );
-    let links = link_tol.map_or(String::new(), |t| {
-        format!(", or --link-tol {t:.1e} or more")
-    });
-    match suggestion {
-        Some(n) => format!(
-            "{head}; use --max-elements {n} or fewer{links} (or --memory-limit, if more is free)"
-        ),
-        None if link_tol.is_some() => format!(
-            "{head}; use --link-tol {:.1e} or more (or --memory-limit, if more is free)",
-            link_tol.unwrap_or_default()
-        ),
-        None => format!(
-            "{head}; even the coarsest mesh of this scene does not fit (options: --direct-only, \
-             --solver progressive, smaller --width/--height, or a machine with more memory)"
-        ),
+    match (suggestion, link_tol) {
+        (None, None) => format!("{head}; even the coarsest mesh of this scene does not fit"),
+        _ => {
+            let budget = suggestion.map(|n| format!("an element budget of {n} or fewer"));
+            let links = link_tol.map(|t| format!("a link tolerance of {t:.1e} or more"));
+            let fits: Vec<String> = budget.into_iter().chain(links).collect();
+            format!("{head}; {} would fit", fits.join(", or "))
+        }
     }
 }
 
@@ -214,6 +137,7 @@ impl RunError {
             self,
             RunError::Mesh(MeshError::BudgetTooSmall { .. })
                 | RunError::InitialBudget(MeshError::BudgetTooSmall { .. })
+                | RunError::InvalidOption(_)
                 | RunError::Solve(SolveError::InvalidOption { .. })
                 | RunError::Memory { .. }
                 | RunError::Shard(_)
@@ -237,34 +161,7 @@ pub fn run(
     options: &RunOptions,
     progress: &dyn Progress,
 ) -> Result<RunResult, RunError> {
-    options.solver.validate()?;
-    if let Some(refine) = &options.refine {
-        if !matches!(
-            options.method,
-            SolverMethod::Progressive | SolverMethod::Hierarchical
-        ) {
-            return Err(RunError::Solve(SolveError::InvalidOption {
-                option: "solver",
-                reason: "adaptive refinement feeds the progressive or the hierarchical solver",
-            }));
-        }
-        if options.method == SolverMethod::Hierarchical
-            && refine.indirect == penumbra_solver::estimate::IndirectEstimate::Gathered
-            && !options.solver.direct_only
-        {
-            return Err(RunError::Solve(SolveError::InvalidOption {
-                option: "refine indirect",
-                reason: "the hierarchical solver estimates the indirect light's error from its \
-                         gradient's jumps; use gradient",
-            }));
-        }
-        if options.solver.form_factors.by_rows() && !options.solver.direct_only {
-            return Err(RunError::Solve(SolveError::InvalidOption {
-                option: "form factors",
-                reason: "the hemicube gives the rows of a fixed mesh; adaptive refinement needs analytic or monte-carlo",
-            }));
-        }
-    }
+    options.validate()?;
     if let Some(shard) = options.shard {
         shard.check(options)?;
     }
@@ -532,5 +429,6 @@ pub fn run(
             cache_bytes: solver.cache_bytes,
             peak_bytes: peaks,
         },
+        invocation: None,
     })
 }

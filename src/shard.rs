@@ -37,7 +37,8 @@ use crate::outputs::{
     DEFAULT_SVG_SURFACES, SVG_DIR, Staging, SurfaceSolution, SvgSelection, report_json,
     solution_json_of, surface_solution, svg_name, worth_looking_at,
 };
-use crate::pipeline::{RunOptions, RunResult};
+use crate::options::RunOptions;
+use crate::pipeline::RunResult;
 
 /// The file a shard writes into its output directory.
 pub const SHARD_FILE: &str = "shard.json";
@@ -311,9 +312,9 @@ pub enum MergeError {
         what: &'static str,
     },
     #[error(
-        "{} meshed its surfaces by {mesh} but {} by {first_mesh}: with --mesh auto, a shard whose \
-         surfaces have no discontinuities meshes them uniformly, unlike the run not split; run \
-         every shard with --mesh discontinuity",
+        "{} meshed its surfaces by {mesh} but {} by {first_mesh}: when the mesh is chosen by the \
+         scene, a shard whose surfaces have no discontinuities meshes them uniformly, unlike the \
+         run not split; mesh every shard by discontinuity",
         .dir.display(), .first.display()
     )]
     MeshChoice {

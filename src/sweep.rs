@@ -18,7 +18,8 @@ use penumbra_viz::{LogLogChart, Series};
 use serde::Serialize;
 
 use crate::adaptive::RefineOptions;
-use crate::pipeline::{MeshMethod, RunError, RunOptions, run};
+use crate::options::{InvalidOption, MeshMethod, RunOptions};
+use crate::pipeline::{RunError, run};
 
 /// A way of meshing that a sweep compares.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -108,6 +109,34 @@ pub struct SweepOptions {
     /// progressive refinement and the hierarchical solver; direct-light sweeps use progressive
     /// refinement only).
     pub solvers: Vec<SolverMethod>,
+}
+
+impl SweepOptions {
+    /// Checks every option's range before anything is computed (a path-traced reference takes
+    /// minutes), with the same names as [`RunOptions::validate`].
+    pub fn validate(&self) -> Result<(), InvalidOption> {
+        let bad = |option, reason: String| Err(InvalidOption { option, reason });
+        if self.budgets.is_empty() || self.budgets.contains(&0) {
+            return bad("max elements", "every budget must be at least 1 triangle".into());
+        }
+        if self.samples == 0 {
+            return bad("samples", "must be at least 1".into());
+        }
+        if !(self.refine_tol > 0.0 && self.refine_tol <= 1.0) {
+            return bad(
+                "refine tolerance",
+                format!("must be a fraction in (0, 1], not {}", self.refine_tol),
+            );
+        }
+        if !(self.initial_fraction > 0.0 && self.initial_fraction <= 1.0) {
+            return bad(
+                "initial elements",
+                format!("the fraction must be in (0, 1], not {}", self.initial_fraction),
+            );
+        }
+        self.solver.validate()?;
+        Ok(())
+    }
 }
 
 /// What the runs are scored against.

@@ -257,7 +257,7 @@ fn merge_refuses_missing_duplicate_and_mixed_shards() {
         .collect();
     refused(
         &["merge", "--out", out_s, path(&alone[0]), path(&alone[1])],
-        &["by discontinuity but", "--mesh discontinuity"],
+        &["by discontinuity but", "with --mesh discontinuity"],
     );
     assert!(!out.exists(), "nothing written");
 }

@@ -13,6 +13,7 @@ use crate::validate::validate;
 /// A validated scene and what loading it had to repair.
 #[derive(Clone, Debug)]
 pub struct LoadedScene {
+    /// The scene, valid.
     pub scene: Scene,
     /// Where it came from: a path, or `builtin:NAME`.
     pub source: String,
@@ -134,7 +135,34 @@ pub fn drop_repeated_vertices(polygon: &mut Vec<DVec3>) {
     }
 }
 
-/// Writes a scene in the JSON format (pretty-printed).
+/// Writes a scene in the JSON format: indented, each point or colour on one line, ending with a
+/// newline; [`parse_json`] reads it back to the same scene.
 pub fn to_json(scene: &Scene) -> String {
-    serde_json::to_string_pretty(scene).unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"))
+    let pretty = serde_json::to_string_pretty(scene)
+        .unwrap_or_else(|e| format!("{{\"error\": {:?}}}", e.to_string()));
+    let mut out = String::with_capacity(pretty.len());
+    let mut lines = pretty.lines().peekable();
+    while let Some(line) = lines.next() {
+        out.push_str(line);
+        if line.ends_with('[') {
+            // An array of numbers (a point, a colour) goes on its opening line.
+            let mut numbers = Vec::new();
+            while let Some(next) = lines.peek() {
+                let item = next.trim().trim_end_matches(',');
+                if item.parse::<f64>().is_err() {
+                    break;
+                }
+                numbers.push(item.to_owned());
+                lines.next();
+            }
+            if !numbers.is_empty() {
+                out.push_str(&numbers.join(", "));
+                if let Some(close) = lines.next() {
+                    out.push_str(close.trim_start());
+                }
+            }
+        }
+        out.push('\n');
+    }
+    out
 }

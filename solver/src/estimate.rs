@@ -214,18 +214,29 @@ pub struct ResidualSummary {
     /// Area-weighted root mean square of the triangle residuals: an estimate of the RMS
     /// interpolation error.
     pub rms: f64,
-    /// Area-weighted mean of the vertex radiosity (channel mean), the scale errors are stated in.
+    /// Area-weighted mean of the vertex radiosity over every surface, emitters included
+    /// (channel mean).
     pub mean_radiosity: f64,
+    /// Area-weighted mean of the reflected radiosity (B − E) over the surfaces that reflect
+    /// (channel mean): the scale refinement tolerances are stated in, so that a bright light
+    /// does not loosen the tolerance on the dim surfaces it lights.
+    pub mean_reflected_radiosity: f64,
 }
 
-/// Summarises the residuals `residuals[s][t]` of every surface's triangles.
+/// Summarises the residuals `residuals[s][t]` of every surface's triangles, with `values` the
+/// vertex radiosities of `scene`'s surfaces.
 pub fn summarize(
+    scene: &Scene,
     meshes: &[SurfaceMesh],
     values: &[Vec<Rgb>],
     residuals: &[Vec<f64>],
 ) -> ResidualSummary {
     let (mut area, mut sum2, mut max, mut weighted) = (0.0, 0.0, 0.0f64, 0.0);
+    let (mut reflecting_area, mut reflected) = (0.0, 0.0);
     for ((mesh, r), vals) in meshes.iter().zip(residuals).zip(values) {
+        let surface = &scene.surfaces[mesh.surface];
+        let reflects = surface.reflectance.mean() > 0.0;
+        let emission = surface.emission.mean();
         for (t, &e) in r.iter().enumerate() {
             let a = mesh.triangle_area(t);
             area += a;
@@ -237,6 +248,10 @@ pub fn summarize(
                 .sum::<f64>()
                 / 3.0;
             weighted += a * mean;
+            if reflects {
+                reflecting_area += a;
+                reflected += a * (mean - emission).max(0.0);
+            }
         }
     }
     let area = area.max(f64::MIN_POSITIVE);
@@ -244,5 +259,6 @@ pub fn summarize(
         max,
         rms: (sum2 / area).sqrt(),
         mean_radiosity: weighted / area,
+        mean_reflected_radiosity: reflected / reflecting_area.max(f64::MIN_POSITIVE),
     }
 }

@@ -63,7 +63,16 @@ pub struct SolverOptions {
     pub link_tol: f64,
 }
 
+/// The default of [`SolverOptions::epsilon`].
 pub const DEFAULT_EPSILON: f64 = 1e-3;
+
+/// Most visibility rays per vertex–patch pair: stratified rays then resolve a visibility
+/// fraction to about 1/4096, beyond what the form factors' other errors allow; more only makes a
+/// run look hung.
+pub const MAX_VISIBILITY_RAYS: usize = 4096;
+
+/// Most Monte Carlo samples per vertex–patch pair, for the same reason.
+pub const MAX_FORM_FACTOR_SAMPLES: usize = 65_536;
 
 impl Default for SolverOptions {
     fn default() -> Self {
@@ -95,6 +104,7 @@ impl SolverOptions {
         None
     }
 
+    /// Checks every field's range; the error names the option in words.
     pub fn validate(&self) -> Result<(), SolveError> {
         let bad = |option: &'static str, reason: &'static str| {
             Err(SolveError::InvalidOption { option, reason })
@@ -105,14 +115,16 @@ impl SolverOptions {
         if !(self.link_tol > 0.0 && self.link_tol < 1.0) {
             return bad("link tolerance", "must be in (0, 1)");
         }
-        if self.visibility_rays == 0 {
-            return bad("visibility rays", "must be at least 1");
+        if !(1..=MAX_VISIBILITY_RAYS).contains(&self.visibility_rays) {
+            return bad("visibility rays", "must be from 1 to 4096");
         }
         if self.elements_per_patch == 0 {
             return bad("elements per patch", "must be at least 1");
         }
-        if self.form_factors == (FormFactorMethod::MonteCarlo { samples: 0 }) {
-            return bad("form-factor samples", "must be at least 1");
+        if let FormFactorMethod::MonteCarlo { samples } = self.form_factors
+            && !(1..=MAX_FORM_FACTOR_SAMPLES).contains(&samples)
+        {
+            return bad("form-factor samples", "must be from 1 to 65536");
         }
         if let FormFactorMethod::Hemicube { resolution } = self.form_factors {
             crate::hemicube::Hemicube::new(resolution)?;

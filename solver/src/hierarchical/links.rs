@@ -29,6 +29,7 @@ use super::transfer::{
     point_factor, triangle_mean,
 };
 use super::tree::{Hierarchy, Node};
+use crate::SolverOptions;
 use crate::lambert::ReceivingPoint;
 
 /// How light goes along a link.
@@ -132,9 +133,17 @@ pub(crate) struct Refiner<'a> {
     pub seed: u64,
     /// Distance under which a point counts as lying on a plane.
     pub tol: f64,
+    /// The run's options, whose deadline and interrupt end refinement early (the links then
+    /// stop where they are; the sweeps that follow stop at once too).
+    pub stop: Option<&'a SolverOptions>,
 }
 
 impl Refiner<'_> {
+    /// Whether the run must stop now.
+    fn must_stop(&self) -> bool {
+        self.stop.is_some_and(|o| o.stop_now().is_some())
+    }
+
     fn visibility(&self) -> &Visibility {
         self.shafts.visibility
     }
@@ -150,6 +159,9 @@ impl Refiner<'_> {
         out: &mut Vec<Link>,
         counts: &mut RefineCounts,
     ) {
+        if self.must_stop() {
+            return;
+        }
         let h = self.hierarchy;
         let (rn, sn) = (h.node(r), h.node(s));
         if r == s {

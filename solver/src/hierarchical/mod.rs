@@ -164,6 +164,7 @@ pub fn solve_hierarchical_refining(
         rays: options.visibility_rays,
         seed: options.seed,
         tol: visibility.contact_distance(),
+        stop: Some(options),
     };
     let mut stats = HierarchyStats {
         link_tol: options.link_tol,
@@ -783,6 +784,7 @@ mod tests {
             rays: options.visibility_rays,
             seed: options.seed,
             tol: vis.contact_distance(),
+            stop: None,
         };
         let mut stats = HierarchyStats::default();
         link_and_sweep(
@@ -843,6 +845,7 @@ mod tests {
             rays: options.visibility_rays,
             seed: options.seed,
             tol: vis.contact_distance(),
+            stop: None,
         };
         let leaves: Vec<u32> = (0..hierarchy.nodes.len() as u32)
             .filter(|&i| hierarchy.node(i).is_leaf())

@@ -1,0 +1,249 @@
+//! `penumbra run`.
+
+use std::process::ExitCode;
+
+use anyhow::Context;
+use penumbra::outputs::{Invocation, SvgSelection, write_outputs};
+use penumbra::progress_bar::Bars;
+use penumbra_solver::Interrupt;
+
+use crate::failure::{Command, Failure, invalid_option, run_failure, usage};
+use crate::run_args::RunArgs;
+use crate::signals::Signals;
+use crate::{load, obj_options};
+
+/// `--svg`: `auto`, `all`, `none`, or surface names of `scene`, comma-separated.
+fn svg_selection(spec: &str, scene: &penumbra_scenes::Scene) -> Result<SvgSelection, Failure> {
+    match spec.trim() {
+        "auto" => return Ok(SvgSelection::Auto),
+        "all" => return Ok(SvgSelection::All),
+        "none" => return Ok(SvgSelection::None),
+        _ => {}
+    }
+    let names: Vec<String> = spec.split(',').map(|n| n.trim().to_owned()).collect();
+    if names.iter().any(String::is_empty) {
+        return Err(usage(anyhow::anyhow!(
+            "--svg takes auto, all, none or surface names separated by commas, not {spec:?}"
+        )));
+    }
+    SvgSelection::named(scene, &names).map_err(|unknown| {
+        let shown: Vec<String> = unknown.iter().take(10).map(|n| format!("{n:?}")).collect();
+        let more = match unknown.len().saturating_sub(shown.len()) {
+            0 => String::new(),
+            n => format!(" and {n} more"),
+        };
+        usage(anyhow::anyhow!(
+            "--svg: the scene has no surface named {}{more} (names are exact; `penumbra check` \
+             counts the surfaces, report.json and solution.json list them)",
+            shown.join(", ")
+        ))
+    })
+}
+
+/// `--shard I/N`, checked against the other options of `run`.
+fn shard_of(text: &str, args: &RunArgs) -> Result<penumbra::shard::Shard, Failure> {
+    use penumbra::shard::{Shard, ShardError};
+    let shard = Shard::parse(text).map_err(|e| usage(anyhow::anyhow!("--shard: {e}")))?;
+    let refused = |flag: &str, e: ShardError| usage(anyhow::anyhow!("--shard with {flag}: {e}"));
+    if !args.direct_only {
+        return Err(usage(anyhow::anyhow!(
+            "--shard needs --direct-only: {}",
+            ShardError::NeedsDirectOnly
+        )));
+    }
+    if args.refine_tol.is_some() {
+        return Err(refused("--refine-tol", ShardError::Refinement));
+    }
+    if args.time_budget.is_some() {
+        return Err(refused("--time-budget", ShardError::TimeBudget));
+    }
+    if args.convergence {
+        return Err(usage(anyhow::anyhow!(
+            "--shard with --convergence: a direct-only run does not iterate, so there is no \
+             convergence to write"
+        )));
+    }
+    Ok(shard)
+}
+
+/// `penumbra run`, or `penumbra run --replay REPORT`.
+pub(crate) fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
+    match &args.replay {
+        Some(report) => {
+            let recorded = crate::replay::recorded(report, args)?;
+            run_with(&recorded.args, recorded.fingerprint.as_deref())
+        }
+        None => run_with(args, None),
+    }
+}
+
+/// A run; `fingerprint` is the scene's as a replayed report recorded it.
+fn run_with(args: &RunArgs, fingerprint: Option<&str>) -> Result<ExitCode, Failure> {
+    if let Some(n) = args.threads {
+        if n == 0 {
+            return Err(usage(anyhow::anyhow!("--threads must be at least 1")));
+        }
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global()
+            .context("cannot start the worker threads")?;
+    }
+    let interrupt = Interrupt::default();
+    let mut options = args.options(&interrupt);
+    options
+        .validate()
+        .map_err(|e| invalid_option(&e, Command::Run))?;
+    let shard = args
+        .shard
+        .as_deref()
+        .map(|text| shard_of(text, args))
+        .transpose()?;
+    options.shard = shard;
+    let spec = args.scene.as_deref().unwrap_or_default();
+    let mut loaded = load(spec, obj_options(args.no_merge))?;
+    if let Some(camera) = crate::camera::camera(args, &loaded.scene).map_err(|e| usage(anyhow::anyhow!(e)))? {
+        loaded.scene.camera = Some(camera);
+    }
+    if !args.quiet {
+        for w in &loaded.warnings {
+            eprintln!("warning: {w}");
+        }
+        if let Some(recorded) = fingerprint
+            && recorded != penumbra::shard::scene_fingerprint(&loaded)
+        {
+            eprintln!(
+                "warning: {spec} is not the scene the recorded run loaded (its fingerprint \
+                 differs): the results will differ"
+            );
+        }
+    }
+    let svgs = svg_selection(&args.svg, &loaded.scene)?;
+    let signals = Signals::catch(&interrupt, args.out.clone()).context("cannot catch Ctrl-C")?;
+    let bars = Bars::new(args.quiet);
+    let mut result = match penumbra::run(loaded, &options, &bars) {
+        Ok(result) => {
+            signals.writing();
+            result
+        }
+        Err(penumbra::RunError::Solve(penumbra_solver::SolveError::Interrupted)) => {
+            drop(bars);
+            eprintln!(
+                "interrupted before a solution existed: nothing written, {} left as it was",
+                args.out.display()
+            );
+            return Ok(signals.status());
+        }
+        Err(e) => return Err(run_failure(e, Command::Run)),
+    };
+    if !args.quiet {
+        let stats = &result.solution.stats;
+        let energy = penumbra::energy::EnergyBalance::of(stats).warning();
+        for w in energy
+            .into_iter()
+            .chain(penumbra::outputs::estimated_direct_warning(stats))
+        {
+            eprintln!("warning: {w}");
+        }
+    }
+    result.invocation = Some(invocation(args)?);
+    if let Some(shard) = shard {
+        let origin = penumbra::shard::SceneOrigin {
+            spec: spec.to_owned(),
+            no_merge: args.no_merge,
+            camera: camera_given(args).then_some(result.loaded.scene.camera).flatten(),
+        };
+        let written = penumbra::shard::write_shard(&result, shard, origin, &args.out, &svgs)?;
+        if !args.quiet {
+            let on = shard.surfaces(result.mesh.surfaces.len());
+            let lit = |count: fn(&penumbra_meshing::SurfaceMesh) -> usize| -> usize {
+                result
+                    .mesh
+                    .surfaces
+                    .iter()
+                    .zip(&on)
+                    .filter(|(_, on)| **on)
+                    .map(|(m, _)| count(m))
+                    .sum()
+            };
+            println!(
+                "{}: shard {shard}: {} of {} surfaces, {} triangles, {} vertices lit; direct light \
+                 {:.2} s, {:.2} s in all",
+                result.loaded.scene.name,
+                on.iter().filter(|&&b| b).count(),
+                on.len(),
+                lit(penumbra_meshing::SurfaceMesh::triangle_count),
+                lit(penumbra_meshing::SurfaceMesh::vertex_count),
+                result.times.direct,
+                result.times.total
+            );
+            println!(
+                "wrote {} files to {} (join the shards with `penumbra merge`)",
+                written.len(),
+                args.out.display()
+            );
+        }
+        if interrupt.is_set() {
+            return Ok(signals.status());
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
+    let extra = if args.convergence {
+        penumbra::outputs::convergence_files(&result)?
+    } else {
+        Vec::new()
+    };
+    let written = write_outputs(&result, &args.out, &svgs, extra)?;
+    if !args.quiet {
+        let stats = &result.solution.stats;
+        println!(
+            "{}: {} mesh, {} discontinuity segments, {} triangles, {} vertices, {} patches; {} iterations ({:?}), \
+             residual {:.2e}; {:.2} s",
+            result.loaded.scene.name,
+            if result.mesh.discontinuity_stats.is_some() {
+                "discontinuity"
+            } else {
+                "uniform"
+            },
+            result.mesh.segment_count(),
+            result.mesh.triangle_count(),
+            result.mesh.vertex_count(),
+            stats.patches,
+            stats.iterations,
+            stats.stop,
+            stats.residual,
+            result.times.total
+        );
+        println!("wrote {} files to {}", written.len(), args.out.display());
+    }
+    if interrupt.is_set() {
+        eprintln!(
+            "interrupted: wrote the solution so far to {}, marked partial in report.json",
+            args.out.display()
+        );
+        return Ok(signals.status());
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+
+/// Whether the arguments set the render's camera.
+fn camera_given(args: &RunArgs) -> bool {
+    args.camera.is_some()
+        || args.eye.is_some()
+        || args.target.is_some()
+        || args.up.is_some()
+        || args.fov.is_some()
+}
+
+/// The command line of this run, for `report.json`.
+fn invocation(args: &RunArgs) -> Result<Invocation, Failure> {
+    Ok(Invocation {
+        arguments: std::env::args_os()
+            .map(|a| a.to_string_lossy().into_owned())
+            .collect(),
+        working_directory: std::env::current_dir()
+            .map(|d| d.display().to_string())
+            .unwrap_or_default(),
+        options: serde_json::to_value(args)?,
+    })
+}

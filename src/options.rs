@@ -1,0 +1,240 @@
+//! The options of a run, their defaults, and the one place their ranges are checked, for the
+//! command line and library callers alike.
+
+use penumbra_meshing::ElementBudget;
+use penumbra_meshing::discontinuity::DiscontinuityOptions;
+use penumbra_meshing::DEFAULT_PENUMBRA_DENSITY;
+use penumbra_solver::estimate::IndirectEstimate;
+use penumbra_solver::{SolveError, SolverMethod, SolverOptions};
+use penumbra_viz::RenderOptions;
+use serde::Serialize;
+
+use crate::adaptive::RefineOptions;
+use crate::shard::Shard;
+
+/// How surfaces are meshed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MeshMethod {
+    /// Constrained Delaunay triangulation of each polygon, refined to a uniform size.
+    Uniform,
+    /// The same, with the discontinuities of the direct light as constraint edges.
+    Discontinuity,
+    /// Discontinuity meshing where the scene casts shadows, uniform meshing where it has none.
+    Auto,
+}
+
+/// Triangles for the whole scene by default: this many, or what the scene needs when that is
+/// more (its least mesh and [`penumbra_meshing::FIT_TRIANGLES_PER_SURFACE`] per surface; see
+/// [`ElementBudget::Fit`]).
+pub const DEFAULT_MAX_ELEMENTS: usize = 10_000;
+
+/// The element budget of a run when none is given.
+pub const DEFAULT_BUDGET: ElementBudget = ElementBudget::fit(DEFAULT_MAX_ELEMENTS);
+
+/// Triangles for the whole scene by default with the hierarchical solver: its cost grows about
+/// linearly with the vertices (each gathers along its own links), so a finer display mesh, which
+/// the exact direct light needs for 1 % on the Cornell box, costs it little.
+pub const HIERARCHICAL_MAX_ELEMENTS: usize = 25_000;
+
+/// The element budget of a run with `method` when none is given (direct-only runs, which do
+/// not use the solver, get [`DEFAULT_BUDGET`]).
+pub fn default_budget(method: SolverMethod, direct_only: bool) -> ElementBudget {
+    match method {
+        SolverMethod::Hierarchical if !direct_only => ElementBudget::fit(HIERARCHICAL_MAX_ELEMENTS),
+        _ => DEFAULT_BUDGET,
+    }
+}
+
+/// Penumbra densities accepted: 1 (no grading) up to this.
+pub const MAX_PENUMBRA_DENSITY: f64 = 1e6;
+
+/// Render sizes accepted, in pixels per side: a larger image would take gigabytes.
+pub const MAX_RENDER_SIZE: u32 = 16_384;
+
+/// Rounds of adaptive refinement accepted: each takes at most a third of the room left, so a
+/// budget is spent long before this.
+pub const MAX_REFINE_ROUNDS: usize = 1_000;
+
+/// Everything a run can be asked to do. [`RunOptions::default`] is the command line's default
+/// full run: a discontinuity mesh where the scene casts shadows, of 25,000 triangles (or what
+/// the scene needs), solved by hierarchical radiosity; [`default_budget`] gives the default
+/// budget for another solver or a direct-only run.
+#[derive(Clone, Debug)]
+pub struct RunOptions {
+    /// How surfaces are meshed.
+    pub mesh: MeshMethod,
+    /// Triangles for the whole scene: a cap, or fitted to the scene ([`default_budget`]).
+    pub max_elements: ElementBudget,
+    /// How many times smaller in area discontinuity-mesh triangles are in penumbrae (1: none).
+    pub penumbra_density: f64,
+    /// How discontinuities are found (EEE events on or off, tolerances).
+    pub discontinuity: DiscontinuityOptions,
+    /// Adaptive refinement from a coarser mesh up to `max_elements`, if asked for.
+    pub refine: Option<RefineOptions>,
+    /// Seconds after which refinement and shooting stop and the best solution so far is kept.
+    pub time_budget: Option<f64>,
+    /// The solver's own options (tolerances, rays, seed, interrupt).
+    pub solver: SolverOptions,
+    /// How the radiosity system is solved.
+    pub method: SolverMethod,
+    /// The size and exposure of `render.png`.
+    pub render: RenderOptions,
+    /// Bytes the run may use (default: what the machine has available when it starts).
+    pub memory_limit: Option<u64>,
+    /// Light only this shard's surfaces (direct light only; see [`crate::shard`]).
+    pub shard: Option<Shard>,
+}
+
+impl Default for RunOptions {
+    fn default() -> Self {
+        let method = SolverMethod::Hierarchical;
+        RunOptions {
+            mesh: MeshMethod::Auto,
+            max_elements: default_budget(method, false),
+            penumbra_density: DEFAULT_PENUMBRA_DENSITY,
+            discontinuity: DiscontinuityOptions::default(),
+            refine: None,
+            time_budget: None,
+            solver: SolverOptions::default(),
+            method,
+            render: RenderOptions::default(),
+            memory_limit: None,
+            shard: None,
+        }
+    }
+}
+
+/// An option outside its range, or options that do not go together. `option` names it in words
+/// (`"penumbra density"`); a front end maps that to its own spelling (a flag, an argument).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("invalid {option}: {reason}")]
+pub struct InvalidOption {
+    /// The option, in words.
+    pub option: &'static str,
+    /// What is wrong with its value, and what it may be.
+    pub reason: String,
+}
+
+impl InvalidOption {
+    fn new(option: &'static str, reason: impl Into<String>) -> InvalidOption {
+        InvalidOption {
+            option,
+            reason: reason.into(),
+        }
+    }
+}
+
+impl From<SolveError> for InvalidOption {
+    /// The solver's own option errors; any other solver error is not an option's.
+    fn from(e: SolveError) -> InvalidOption {
+        match e {
+            SolveError::InvalidOption { option, reason } => InvalidOption::new(option, reason),
+            e => InvalidOption::new("solver", e.to_string()),
+        }
+    }
+}
+
+impl RunOptions {
+    /// Checks every option's range and that the options go together. [`crate::run`] calls it
+    /// first; front ends call it to refuse bad input before loading a scene.
+    pub fn validate(&self) -> Result<(), InvalidOption> {
+        self.solver.validate()?;
+        if self.max_elements == ElementBudget::AtMost(0) {
+            return Err(InvalidOption::new(
+                "max elements",
+                "must be at least 1 triangle",
+            ));
+        }
+        if !(1.0..=MAX_PENUMBRA_DENSITY).contains(&self.penumbra_density) {
+            return Err(InvalidOption::new(
+                "penumbra density",
+                format!(
+                    "must be between 1 and {MAX_PENUMBRA_DENSITY:e}, not {}",
+                    self.penumbra_density
+                ),
+            ));
+        }
+        let event_tolerance = self.discontinuity.event_tolerance;
+        if !(0.0..=1.0).contains(&event_tolerance) {
+            return Err(InvalidOption::new(
+                "event tolerance",
+                format!("must be a fraction between 0 and 1, not {event_tolerance}"),
+            ));
+        }
+        if let Some(t) = self.time_budget
+            && !(t > 0.0 && t.is_finite())
+        {
+            return Err(InvalidOption::new(
+                "time budget",
+                format!("must be a positive number of seconds, not {t}"),
+            ));
+        }
+        if self.memory_limit == Some(0) {
+            return Err(InvalidOption::new("memory limit", "must be positive"));
+        }
+        let (width, height) = (self.render.width, self.render.height);
+        if !(1..=MAX_RENDER_SIZE).contains(&width) || !(1..=MAX_RENDER_SIZE).contains(&height) {
+            return Err(InvalidOption::new(
+                "render size",
+                format!("must be from 1 to {MAX_RENDER_SIZE} pixels a side, not {width} x {height}"),
+            ));
+        }
+        if let Some(refine) = &self.refine {
+            self.validate_refinement(refine)?;
+        }
+        Ok(())
+    }
+
+    fn validate_refinement(&self, refine: &RefineOptions) -> Result<(), InvalidOption> {
+        if !(refine.tolerance > 0.0 && refine.tolerance <= 1.0) {
+            return Err(InvalidOption::new(
+                "refine tolerance",
+                format!(
+                    "must be a fraction in (0, 1] of the mean reflected radiosity, not {}",
+                    refine.tolerance
+                ),
+            ));
+        }
+        if refine.initial_elements == 0 {
+            return Err(InvalidOption::new(
+                "initial elements",
+                "must be at least 1 triangle",
+            ));
+        }
+        if !(1..=MAX_REFINE_ROUNDS).contains(&refine.max_rounds) {
+            return Err(InvalidOption::new(
+                "refine rounds",
+                format!("must be from 1 to {MAX_REFINE_ROUNDS}, not {}", refine.max_rounds),
+            ));
+        }
+        let direct_only = self.solver.direct_only;
+        if !matches!(
+            self.method,
+            SolverMethod::Progressive | SolverMethod::Hierarchical
+        ) {
+            return Err(InvalidOption::new(
+                "solver",
+                "adaptive refinement feeds the progressive or the hierarchical solver",
+            ));
+        }
+        if self.method == SolverMethod::Hierarchical
+            && refine.indirect == IndirectEstimate::Gathered
+            && !direct_only
+        {
+            return Err(InvalidOption::new(
+                "refine indirect",
+                "the hierarchical solver estimates the indirect light's error from its \
+                 gradient's jumps; use gradient",
+            ));
+        }
+        if self.solver.form_factors.by_rows() && !direct_only {
+            return Err(InvalidOption::new(
+                "form factors",
+                "the hemicube gives the rows of a fixed mesh; adaptive refinement needs analytic \
+                 or monte-carlo",
+            ));
+        }
+        Ok(())
+    }
+}
