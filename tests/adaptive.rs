@@ -116,7 +116,7 @@ fn a_met_tolerance_stops_refinement() {
     .expect("refines");
     assert_eq!(report.stop, RefineStop::Tolerance, "{report:#?}");
     assert!(mesh.triangle_count() < 30_000);
-    assert!(report.residual.max <= 2e-3 * report.residual.mean_radiosity);
+    assert!(report.residual.max <= 2e-3 * report.residual.mean_reflected_radiosity);
     assert!(report.rounds.len() >= 2, "{report:#?}");
 }
 

@@ -8,6 +8,7 @@ use penumbra_solver::SolverOptions;
 use crate::failure::{Failure, usage};
 
 #[derive(clap::Args, Debug)]
+#[command(after_help = "Examples:\n  penumbra form-factors                         every method, the default ladders\n  penumbra form-factors --samples 64,1024 --resolutions 64,256 --out ff")]
 pub(crate) struct FormFactorArgs {
     /// Output directory (created if missing).
     #[arg(long, default_value = "out/form-factors")]

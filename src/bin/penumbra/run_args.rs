@@ -117,9 +117,6 @@ pub(crate) struct RunArgs {
     /// material are merged where the union is a simple polygon).
     #[arg(help_heading = INPUT, long)]
     pub(crate) no_merge: bool,
-    /// Output directory.
-    #[arg(help_heading = OUTPUT, long, default_value = "out")]
-    pub(crate) out: PathBuf,
     /// How surfaces are meshed (default: discontinuity where the scene casts shadows, else
     /// uniform).
     #[arg(help_heading = MESH, long, value_enum)]
@@ -135,9 +132,21 @@ pub(crate) struct RunArgs {
     /// refinement finds the penumbrae itself.
     #[arg(help_heading = MESH, long)]
     pub(crate) penumbra_density: Option<f64>,
+    /// Discontinuity meshes: leave out EEE events (emitter edge with two blocker edges).
+    #[arg(help_heading = MESH, long)]
+    pub(crate) no_eee: bool,
+    /// Discontinuity meshes: which EV and VE events become mesh edges.
+    #[arg(help_heading = MESH, long, value_enum, default_value_t = EventsArg::Complete)]
+    pub(crate) events: EventsArg,
+    /// Discontinuity meshes: blockers (flat patches of faces) that can hide less than this
+    /// fraction of a light from a receiver start no events there; adaptive refinement and the
+    /// penumbra grading mesh their shadows instead.
+    #[arg(help_heading = MESH, long, default_value_t = penumbra_meshing::discontinuity::DEFAULT_EVENT_TOLERANCE)]
+    pub(crate) event_tol: f64,
     /// Adaptive refinement: start from a coarser mesh and split, round after round, the triangles
     /// whose interpolation misses the exact direct light by more than this fraction of the
-    /// scene's mean radiosity, up to --max-elements.
+    /// mean reflected radiosity (B - E over the surfaces that reflect: a bright lamp does not
+    /// loosen it on the floor it lights), up to --max-elements.
     #[arg(help_heading = REFINE, long)]
     pub(crate) refine_tol: Option<f64>,
     /// With --refine-tol: triangles of the starting mesh (default: a tenth of --max-elements;
@@ -176,26 +185,6 @@ pub(crate) struct RunArgs {
     /// faces are half as tall).
     #[arg(help_heading = SOLVER, long, default_value_t = 128)]
     pub(crate) hemicube_resolution: usize,
-    /// Also write the solver's residual against iterations and against time: convergence.csv,
-    /// convergence-iterations.svg/.png and convergence-time.svg/.png.
-    #[arg(help_heading = OUTPUT, long)]
-    pub(crate) convergence: bool,
-    /// Stop after this many seconds (from the start of the run) and write the best solution so
-    /// far; report.json says so. The discontinuity search skips the pairs left, the direct light
-    /// estimates the vertices left by rays, and refinement and shooting stop.
-    #[arg(help_heading = LIMITS, long)]
-    pub(crate) time_budget: Option<f64>,
-    /// Discontinuity meshes: leave out EEE events (emitter edge with two blocker edges).
-    #[arg(help_heading = MESH, long)]
-    pub(crate) no_eee: bool,
-    /// Discontinuity meshes: which EV and VE events become mesh edges.
-    #[arg(help_heading = MESH, long, value_enum, default_value_t = EventsArg::Complete)]
-    pub(crate) events: EventsArg,
-    /// Discontinuity meshes: blockers (flat patches of faces) that can hide less than this
-    /// fraction of a light from a receiver start no events there; adaptive refinement and the
-    /// penumbra grading mesh their shadows instead.
-    #[arg(help_heading = MESH, long, default_value_t = penumbra_meshing::discontinuity::DEFAULT_EVENT_TOLERANCE)]
-    pub(crate) event_tol: f64,
     /// Stop shooting when the unshot power is below this fraction of the emitted power.
     #[arg(help_heading = SOLVER, long, default_value_t = DEFAULT_EPSILON)]
     pub(crate) epsilon: f64,
@@ -205,7 +194,7 @@ pub(crate) struct RunArgs {
     /// One exact bounce of direct light only: B = E + rho * H_direct.
     #[arg(help_heading = SOLVER, long)]
     pub(crate) direct_only: bool,
-    /// Visibility rays per vertex-patch pair.
+    /// Visibility rays per vertex-patch pair (1 to 4096).
     #[arg(help_heading = SOLVER, long, default_value_t = SolverOptions::default().visibility_rays)]
     pub(crate) rays: usize,
     /// Mesh elements grouped into one shooting patch.
@@ -214,13 +203,13 @@ pub(crate) struct RunArgs {
     /// Seed of the visibility sampling.
     #[arg(help_heading = SOLVER, long, default_value_t = SolverOptions::default().seed)]
     pub(crate) seed: u64,
-    /// Worker threads (default: one per core).
-    #[arg(help_heading = LIMITS, long)]
-    pub(crate) threads: Option<usize>,
-    /// Memory the run may use, in MiB (default: what the machine has available). A run that
-    /// would need more stops before it starts, with the largest --max-elements that fits.
-    #[arg(help_heading = LIMITS, long)]
-    pub(crate) memory_limit: Option<f64>,
+    /// Output directory.
+    #[arg(help_heading = OUTPUT, long, default_value = "out")]
+    pub(crate) out: PathBuf,
+    /// Also write the solver's residual against iterations and against time: convergence.csv,
+    /// convergence-iterations.svg/.png and convergence-time.svg/.png.
+    #[arg(help_heading = OUTPUT, long)]
+    pub(crate) convergence: bool,
     /// Render width in pixels.
     #[arg(help_heading = OUTPUT, long, default_value_t = 640)]
     pub(crate) width: u32,
@@ -254,6 +243,18 @@ pub(crate) struct RunArgs {
     /// No progress bars, no summary and no warnings.
     #[arg(help_heading = OUTPUT, long)]
     pub(crate) quiet: bool,
+    /// Stop after this many seconds (from the start of the run) and write the best solution so
+    /// far; report.json says so. The discontinuity search skips the pairs left, the direct light
+    /// estimates the vertices left by rays, and refinement and shooting stop.
+    #[arg(help_heading = LIMITS, long)]
+    pub(crate) time_budget: Option<f64>,
+    /// Worker threads (default: one per core).
+    #[arg(help_heading = LIMITS, long)]
+    pub(crate) threads: Option<usize>,
+    /// Memory the run may use, in MiB (default: what the machine has available). A run that
+    /// would need more stops before it starts, with the largest --max-elements that fits.
+    #[arg(help_heading = LIMITS, long)]
+    pub(crate) memory_limit: Option<f64>,
     /// With --direct-only: light only shard I of N (I from 0 to N - 1), the surfaces whose
     /// index is I modulo N, and write OUT/shard.json and their SVGs for `penumbra merge`. In a
     /// scene whose polygons need more than the budget's floor, with the fitted budget, the shard

@@ -80,7 +80,7 @@ fn watch(interrupt: &Interrupt, received: &AtomicUsize, writing: &AtomicBool, ou
         return;
     }
     eprintln!(
-        "interrupted: the run did not stop within a second; nothing written, {} left as it was",
+        "interrupted: the run did not stop within a second, so nothing written, {} left as it was",
         out.display()
     );
     std::process::exit(i32::from(status(received)));
