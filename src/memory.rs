@@ -14,7 +14,7 @@ use penumbra_solver::SolverMethod;
 use penumbra_solver::coupling::FormFactorMethod;
 use serde::Serialize;
 
-use crate::pipeline::RunOptions;
+use crate::options::RunOptions;
 
 /// The process itself, its buffers and the allocator's slack.
 const BASE_BYTES: u64 = 32 << 20;
