@@ -39,7 +39,12 @@ pub enum ElementBudget {
     /// What the scene needs: `at_least` triangles, or the scene's least mesh plus `per_surface`
     /// triangles per surface when that is more ([`ElementBudget::fit`]: the usual
     /// [`FIT_TRIANGLES_PER_SURFACE`]).
-    Fit { at_least: usize, per_surface: usize },
+    Fit {
+        /// The fewest triangles to give the scene.
+        at_least: usize,
+        /// Triangles per surface beyond the scene's least mesh.
+        per_surface: usize,
+    },
 }
 
 impl From<usize> for ElementBudget {
@@ -91,11 +96,11 @@ impl ElementBudget {
     /// For a fitted budget of a scene whose polygons alone need more than its floor (a large
     /// scene: `polygon_minimum` triangles over `surfaces` surfaces), the triangles it adds to the
     /// least mesh (`per_surface` for each surface). Each surface then gets its least mesh and
-    /// its share of these by area ([`crate::share_alone`]): the budget the fit resolves to, spread
+    /// its share of these by area: the budget the fit resolves to, spread
     /// so that each surface's part depends on nothing but the surface and the scene's polygons,
     /// and each surface can be meshed without the others' discontinuities (a sharded run).
-    /// `None` for a cap, or a scene within the floor: one budget is spread over all surfaces
-    /// ([`crate::spread_by_area`]).
+    /// `None` for a cap, or a scene within the floor: one budget is spread over all surfaces by
+    /// area.
     pub fn shared_extra(self, polygon_minimum: usize, surfaces: usize) -> Option<usize> {
         match self {
             ElementBudget::Fit {

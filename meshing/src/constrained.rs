@@ -58,7 +58,9 @@ pub(crate) fn quietly<T>(f: impl FnOnce() -> T) -> std::thread::Result<T> {
 /// A segment to be a chain of mesh edges, in the surface's plane-frame coordinates.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Constraint {
+    /// One end.
     pub from: DVec2,
+    /// The other end.
     pub to: DVec2,
     /// The light jumps across it: the two sides get separate vertices.
     pub splits: bool,
@@ -100,7 +102,8 @@ impl ConstrainedSurface {
     }
 
     /// [`Self::new`], with constraint ends within `join` (a length in the scene's units, when
-    /// larger than [`MERGE_DISTANCE`] of the mesh) of another end, or of another constraint, put
+    /// larger than the mesh's merge distance, 2^-30 of the polygon's extent) of another end, or
+    /// of another constraint, put
     /// on it: the precision to which the constraints were found (a line trimmed where a block
     /// hides it ends within a few contact distances of that block's foot).
     pub fn joining(
@@ -217,7 +220,8 @@ impl ConstrainedSurface {
     }
 
     /// Triangles of the least mesh whose angles are all at least
-    /// [`CONSTRAINED_MIN_ANGLE_DEG`] where the input does not force them, if it can be had with
+    /// [`FORCING_WEDGE_DEG`](crate::FORCING_WEDGE_DEG) where the input does not force them, if
+    /// it can be had with
     /// at most `target` triangles; meshes of this surface with at least as many then keep
     /// those angles ([`Self::into_refinable`]).
     pub fn quality_triangles(&mut self, target: usize) -> Option<usize> {
@@ -240,7 +244,8 @@ impl ConstrainedSurface {
     }
 
     /// Like [`Self::into_mesh`], with triangles `penumbra_density` times smaller in area where
-    /// `varies` says the light varies (see [`crate::grading`]).
+    /// `varies` says the light varies (see
+    /// [`DEFAULT_PENUMBRA_DENSITY`](crate::DEFAULT_PENUMBRA_DENSITY)).
     pub fn into_graded_mesh(
         self,
         surface: &Surface,
@@ -257,7 +262,7 @@ impl ConstrainedSurface {
     ///
     /// Refinement starts from the least quality mesh when that fits `target`
     /// ([`Self::quality_triangles`]), so that the angles the input does not force stay at
-    /// [`CONSTRAINED_MIN_ANGLE_DEG`] or more.
+    /// [`FORCING_WEDGE_DEG`](crate::FORCING_WEDGE_DEG) or more.
     pub fn into_refinable(
         mut self,
         target: usize,

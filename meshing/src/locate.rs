@@ -16,6 +16,7 @@ pub struct TriangleLocator {
 }
 
 impl TriangleLocator {
+    /// Buckets the triangles of `mesh`, about one per cell.
     pub fn new(mesh: &SurfaceMesh) -> TriangleLocator {
         let (lo, hi) = mesh
             .local

@@ -20,11 +20,16 @@ pub const ON_SEGMENT_TOLERANCE: f64 = 1e-12;
 /// `frame.to_3d(local[i] * scale) == points3[i]` up to rounding.
 #[derive(Clone, Debug)]
 pub struct SurfaceMesh {
+    /// The surface meshed.
     pub surface: SurfaceId,
+    /// The plane frame the mesh coordinates are measured in (it may start at another corner
+    /// than [`PlaneFrame::of_polygon`]'s).
     pub frame: PlaneFrame,
     /// Surface units per mesh unit.
     pub scale: f64,
+    /// Each vertex in mesh coordinates.
     pub local: Vec<DVec2>,
+    /// Each vertex in 3D, on the surface.
     pub points3: Vec<DVec3>,
     /// Counter-clockwise (seen from the surface's front) vertex index triples.
     pub triangles: Vec<[u32; 3]>,
@@ -40,18 +45,24 @@ pub struct SurfaceMesh {
 /// (circumradius over twice the inradius: 1 for an equilateral triangle).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct MeshQuality {
+    /// Triangles measured.
     pub triangles: usize,
+    /// The smallest angle of any triangle, in degrees.
     pub min_angle_deg: f64,
-    /// The smallest angle not forced by the input ([`crate::wedges`]): two input edges (polygon
-    /// edges and constraints) meeting at less than [`FORCING_WEDGE_DEG`] force the corners
-    /// between them at their meeting point, and those meeting at less than
-    /// [`crate::wedges::SHELL_ANGLE_DEG`] the triangles between them.
+    /// The smallest angle not forced by the input: two input edges (polygon edges and
+    /// constraints) meeting at less than [`FORCING_WEDGE_DEG`] force the corners between them
+    /// at their meeting point, and those meeting at less than 60 degrees the triangles between
+    /// them, which refinement lays out in shells around the meeting point (Ruppert 1995;
+    /// Shewchuk 2000).
     pub min_angle_unforced_deg: f64,
     /// Triangles with an angle under [`FORCING_WEDGE_DEG`] that the input does not force: none
     /// when the budget holds each surface's least mesh at that angle.
     pub triangles_below_min_angle: usize,
+    /// The median aspect ratio.
     pub aspect_ratio_median: f64,
+    /// The 95th percentile of the aspect ratios.
     pub aspect_ratio_p95: f64,
+    /// The largest aspect ratio.
     pub aspect_ratio_max: f64,
 }
 
@@ -76,10 +87,12 @@ impl SurfaceMesh {
         })
     }
 
+    /// Vertices of the mesh.
     pub fn vertex_count(&self) -> usize {
         self.local.len()
     }
 
+    /// Triangles of the mesh.
     pub fn triangle_count(&self) -> usize {
         self.triangles.len()
     }
@@ -89,6 +102,7 @@ impl SurfaceMesh {
         self.local[i] * self.scale
     }
 
+    /// The 3D corners of triangle `t`.
     pub fn triangle_points3(&self, t: usize) -> [DVec3; 3] {
         self.triangles[t].map(|i| self.points3[i as usize])
     }
@@ -99,6 +113,7 @@ impl SurfaceMesh {
         0.5 * (b - a).perp_dot(c - a) * self.scale * self.scale
     }
 
+    /// The triangles' total area in surface units squared.
     pub fn area(&self) -> f64 {
         (0..self.triangles.len())
             .map(|t| self.triangle_area(t))
@@ -174,7 +189,7 @@ impl SurfaceMesh {
     }
 
     /// Whether the segment `p -> q` is a chain of mesh edges from end to end. Split points may sit
-    /// off the segment by the rounding of their construction ([`ON_SEGMENT_TOLERANCE`]).
+    /// off the segment by the rounding of their construction (1e-12 mesh units).
     pub fn edge_is_covered(&self, p: DVec2, q: DVec2, edges: &[[u32; 2]]) -> bool {
         let d = q - p;
         let len2 = d.length_squared();
@@ -219,6 +234,7 @@ impl SurfaceMesh {
         dirs.into_iter().map(DVec3::normalize_or_zero).collect()
     }
 
+    /// The mesh's quality figures.
     pub fn quality(&self) -> MeshQuality {
         quality_of(std::iter::once(self))
     }

@@ -8,8 +8,11 @@ use std::sync::atomic::{AtomicBool, Ordering};
 /// Receives progress of a stage: `start` with the number of steps, `set` with the steps done.
 /// Called from worker threads, so implementations must be `Sync`.
 pub trait Progress: Sync {
+    /// A stage called `stage` begins, with `total` steps.
     fn start(&self, stage: &str, total: u64);
+    /// `done` of the stage's steps are done.
     fn set(&self, done: u64);
+    /// The stage is over.
     fn finish(&self);
 }
 
@@ -34,10 +37,12 @@ impl Interrupt {
         Arc::clone(&self.0)
     }
 
+    /// Asks the work to stop.
     pub fn set(&self) {
         self.0.store(true, Ordering::Relaxed);
     }
 
+    /// Whether stopping was asked for.
     pub fn is_set(&self) -> bool {
         self.0.load(Ordering::Relaxed)
     }

@@ -19,6 +19,7 @@ use crate::mesh::{MeshQuality, SurfaceMesh, quality_of};
 /// (none for uniform meshes).
 #[derive(Clone, Debug)]
 pub struct SceneMesh {
+    /// Each surface's mesh.
     pub surfaces: Vec<SurfaceMesh>,
     /// Each surface's triangulation, kept for adaptive refinement.
     pub refinable: Vec<RefinableSurface>,
@@ -26,6 +27,7 @@ pub struct SceneMesh {
     pub discontinuities: Vec<Vec<DiscontinuitySegment>>,
     /// Each surface's contact lines under hovering faces, with their gaps (3D ends, gap).
     pub hovering: Vec<Vec<(DVec3, DVec3, f64)>>,
+    /// What the discontinuity search did (`None` for uniform meshes).
     pub discontinuity_stats: Option<DiscontinuityStats>,
     /// The element budget the mesh was built to, resolved (see [`ElementBudget`]).
     pub budget: usize,
@@ -35,22 +37,27 @@ pub struct SceneMesh {
 }
 
 impl SceneMesh {
+    /// Triangles of all the surfaces.
     pub fn triangle_count(&self) -> usize {
         self.surfaces.iter().map(SurfaceMesh::triangle_count).sum()
     }
 
+    /// Vertices of all the surfaces (a vertex where surfaces meet counts once per surface).
     pub fn vertex_count(&self) -> usize {
         self.surfaces.iter().map(SurfaceMesh::vertex_count).sum()
     }
 
+    /// Quality figures over every surface's mesh.
     pub fn quality(&self) -> MeshQuality {
         quality_of(&self.surfaces)
     }
 
+    /// [`SurfaceMesh::sanity_check`] of every surface.
     pub fn sanity_check(&self) -> Result<(), MeshError> {
         self.surfaces.iter().try_for_each(SurfaceMesh::sanity_check)
     }
 
+    /// Discontinuity segments of all the surfaces.
     pub fn segment_count(&self) -> usize {
         self.discontinuities.iter().map(Vec::len).sum()
     }
@@ -165,7 +172,7 @@ pub fn mesh_scene_uniform(
 /// Discontinuity meshes: each surface's discontinuity segments become constraint edges, then the
 /// surfaces are refined to about `budget` triangles in all, spread by area, with triangles
 /// `penumbra_density` times smaller in area where the light varies (1: no grading; see
-/// [`crate::grading`]).
+/// [`DEFAULT_PENUMBRA_DENSITY`](crate::DEFAULT_PENUMBRA_DENSITY)).
 pub fn mesh_scene_discontinuity(
     scene: &Scene,
     visibility: &Visibility,

@@ -229,9 +229,9 @@ pub fn cornell() -> Scene {
     }
 }
 
-/// Section 3 of the analytic notes: a unit square light (exitance 1) at height 3 facing down, a unit
-/// square blocker at height 1, and a 6 x 6 floor. On the floor the umbra is |x|, |y| <= 0.5 and
-/// the penumbra reaches |x|, |y| = 1.
+/// `docs/closed-forms.md`, "The textbook scene": a unit square light (exitance 1) at height 3
+/// facing down, a unit square blocker at height 1, and a 6 x 6 floor. On the floor the umbra is
+/// |x|, |y| <= 0.5 and the penumbra reaches |x|, |y| = 1.
 pub fn textbook() -> Scene {
     let square = |h: f64, s: f64| vec![v(-s, -s, h), v(s, -s, h), v(s, s, h), v(-s, s, h)];
     let mut light = square(3.0, 0.5);

@@ -22,14 +22,17 @@ use crate::model::{Camera, Scene, Surface};
 
 /// The rooms of 5.3 and 5.6: x and y in [0, 4], z in [0, 3].
 pub const ROOM: DVec3 = DVec3::new(4.0, 4.0, 3.0);
-/// 5.3: the source's side and its exitance (π × 1000 cd/m²).
+/// 5.3: the side of the square source, in metres.
 pub const SOURCE_SIDE: f64 = 1.0;
+/// 5.3: the source's exitance in lm/m² (a luminance of 1000 cd/m², times π).
 pub const SOURCE_EXITANCE: f64 = std::f64::consts::PI * 1000.0;
 /// 5.6: the floor's exitance ρ E: reflectance 0.5 under a uniform 1,000 lux.
 pub const FLOOR_EXITANCE: f64 = 500.0;
-/// 5.8: the cube's side, the source's flux and the side of the box that models it.
+/// 5.8: the cube's side, in metres.
 pub const CUBE_SIDE: f64 = 4.0;
+/// 5.8: the point source's flux in lumens.
 pub const CUBE_FLUX: f64 = 10_000.0;
+/// 5.8: the side of the small emitting box that stands in for the point source, in metres.
 pub const SOURCE_BOX: f64 = 0.02;
 
 fn v(x: f64, y: f64, z: f64) -> DVec3 {

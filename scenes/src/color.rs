@@ -8,22 +8,29 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(from = "[f64; 3]", into = "[f64; 3]")]
 pub struct Rgb {
+    /// Red.
     pub r: f64,
+    /// Green.
     pub g: f64,
+    /// Blue.
     pub b: f64,
 }
 
 impl Rgb {
+    /// Zero in every channel: black, no light.
     pub const ZERO: Rgb = Rgb::splat(0.0);
 
+    /// The triple `(r, g, b)`.
     pub const fn new(r: f64, g: f64, b: f64) -> Self {
         Rgb { r, g, b }
     }
 
+    /// The same value in every channel: a grey.
     pub const fn splat(v: f64) -> Self {
         Rgb { r: v, g: v, b: v }
     }
 
+    /// `[r, g, b]`.
     pub fn to_array(self) -> [f64; 3] {
         [self.r, self.g, self.b]
     }
@@ -33,18 +40,22 @@ impl Rgb {
         (self.r + self.g + self.b) / 3.0
     }
 
+    /// The largest channel.
     pub fn max_channel(self) -> f64 {
         self.r.max(self.g).max(self.b)
     }
 
+    /// The smallest channel.
     pub fn min_channel(self) -> f64 {
         self.r.min(self.g).min(self.b)
     }
 
+    /// Whether every channel is finite (neither NaN nor infinite).
     pub fn is_finite(self) -> bool {
         self.r.is_finite() && self.g.is_finite() && self.b.is_finite()
     }
 
+    /// Whether every channel is exactly zero.
     pub fn is_zero(&self) -> bool {
         self.r == 0.0 && self.g == 0.0 && self.b == 0.0
     }
@@ -54,6 +65,7 @@ impl Rgb {
         Rgb::new(self.r * o.r, self.g * o.g, self.b * o.b)
     }
 
+    /// `f` applied to each channel.
     pub fn map(self, f: impl Fn(f64) -> f64) -> Rgb {
         Rgb::new(f(self.r), f(self.g), f(self.b))
     }

@@ -104,11 +104,11 @@ pub fn tiny_light(side: f64) -> Scene {
     )
 }
 
-/// Every blocker edge parallel to a light edge: a unit light at height 3 over a square blocker
-/// of side `side` at height 1 and a floor (section 3 of the analytic notes). Each light edge and
-/// the parallel blocker edge span one plane, so the EV wedges of both ends of an edge coincide
-/// with its EE wedge (degenerate wedges); they must merge into one line each, on which the light
-/// is D1 (its slope jumps). With `side` 1.2 the umbra ends at |x| = 0.65 and the penumbra at
+/// Every blocker edge parallel to a light edge: a unit light at height 3 over a square blocker of
+/// side `side` at height 1 and a floor (`docs/closed-forms.md`, "The textbook scene"). Each light
+/// edge and the parallel blocker edge span one plane, so the EV wedges of both ends of an edge
+/// coincide with its EE wedge (degenerate wedges); they must merge into one line each, on which the
+/// light is D1 (its slope jumps). With `side` 1.2 the umbra ends at |x| = 0.65 and the penumbra at
 /// 1.15.
 pub fn parallel_edges(side: f64) -> Scene {
     scene(

@@ -13,9 +13,13 @@ use crate::polygon;
 /// An orthonormal frame of a plane: `to_3d(to_2d(p)) == p` for points on the plane.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PlaneFrame {
+    /// The point with 2D coordinates (0, 0).
     pub origin: DVec3,
+    /// The unit direction of the first 2D axis.
     pub u: DVec3,
+    /// The unit direction of the second 2D axis, `normal × u`.
     pub v: DVec3,
+    /// The unit normal of the plane: its front side.
     pub normal: DVec3,
 }
 
@@ -49,11 +53,13 @@ impl PlaneFrame {
         })
     }
 
+    /// The 2D coordinates of `p`'s projection onto the plane.
     pub fn to_2d(&self, p: DVec3) -> DVec2 {
         let d = p - self.origin;
         DVec2::new(d.dot(self.u), d.dot(self.v))
     }
 
+    /// The point of the plane with 2D coordinates `q`.
     pub fn to_3d(&self, q: DVec2) -> DVec3 {
         self.origin + self.u * q.x + self.v * q.y
     }
@@ -63,6 +69,7 @@ impl PlaneFrame {
         (p - self.origin).dot(self.normal)
     }
 
+    /// The 3D direction of the 2D vector `d` (no origin added).
     pub fn vector_to_3d(&self, d: DVec2) -> DVec3 {
         self.u * d.x + self.v * d.y
     }

@@ -15,10 +15,13 @@ pub type SurfaceId = usize;
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Scene {
+    /// The scene's name; a scene file without one is named after the file.
     #[serde(default)]
     pub name: String,
+    /// The view to render; without one, a default camera frames the scene.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub camera: Option<Camera>,
+    /// The polygons, in the order their [`SurfaceId`]s count.
     pub surfaces: Vec<Surface>,
 }
 
@@ -27,7 +30,9 @@ pub struct Scene {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Surface {
+    /// The surface's name in messages and outputs.
     pub name: String,
+    /// The vertices, counter-clockwise seen from the front, without repeating the first.
     pub polygon: Vec<DVec3>,
     /// The surface's own exitance E in W/m^2 per channel.
     #[serde(default, skip_serializing_if = "Rgb::is_zero")]
@@ -40,31 +45,40 @@ pub struct Surface {
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Camera {
+    /// Where the camera stands.
     pub eye: DVec3,
+    /// A point it looks at, in the middle of the image.
     pub target: DVec3,
+    /// The direction that is up in the image (need not be at right angles to the view).
     pub up: DVec3,
+    /// The vertical field of view in degrees, in (0, 180).
     pub fov_deg: f64,
 }
 
 /// An axis-aligned box.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Bounds {
+    /// The least coordinate on each axis.
     pub min: DVec3,
+    /// The greatest coordinate on each axis.
     pub max: DVec3,
 }
 
 impl Bounds {
+    /// The box of no points: `min` is +∞ and `max` −∞, so a union with it changes nothing.
     pub const EMPTY: Bounds = Bounds {
         min: DVec3::splat(f64::INFINITY),
         max: DVec3::splat(f64::NEG_INFINITY),
     };
 
+    /// The smallest box holding `points` ([`Bounds::EMPTY`] for none).
     pub fn from_points<'a>(points: impl IntoIterator<Item = &'a DVec3>) -> Bounds {
         points
             .into_iter()
             .fold(Bounds::EMPTY, |b, &p| b.including(p))
     }
 
+    /// This box grown to hold `p`.
     pub fn including(self, p: DVec3) -> Bounds {
         Bounds {
             min: self.min.min(p),
@@ -72,6 +86,7 @@ impl Bounds {
         }
     }
 
+    /// The smallest box holding both boxes.
     pub fn union(self, o: Bounds) -> Bounds {
         Bounds {
             min: self.min.min(o.min),
@@ -79,14 +94,17 @@ impl Bounds {
         }
     }
 
+    /// Whether the box holds no point (it is [`Bounds::EMPTY`], or has NaN corners).
     pub fn is_empty(&self) -> bool {
         !(self.min.cmple(self.max).all())
     }
 
+    /// The box's centre.
     pub fn center(&self) -> DVec3 {
         0.5 * (self.min + self.max)
     }
 
+    /// The length of the box's diagonal; 0 for an empty box.
     pub fn diagonal(&self) -> f64 {
         if self.is_empty() {
             0.0
@@ -95,12 +113,14 @@ impl Bounds {
         }
     }
 
+    /// Whether the boxes share a point (touching counts).
     pub fn overlaps(&self, o: &Bounds) -> bool {
         self.min.cmple(o.max).all() && o.min.cmple(self.max).all()
     }
 }
 
 impl Surface {
+    /// A surface that reflects but does not emit.
     pub fn new(name: impl Into<String>, polygon: Vec<DVec3>, reflectance: Rgb) -> Surface {
         Surface {
             name: name.into(),
@@ -110,6 +130,7 @@ impl Surface {
         }
     }
 
+    /// The same surface emitting the exitance `emission` (W/m² per channel).
     pub fn with_emission(mut self, emission: Rgb) -> Surface {
         self.emission = emission;
         self
@@ -125,6 +146,7 @@ impl Surface {
         polygon::newell_normal(&self.polygon).normalize_or_zero()
     }
 
+    /// The polygon's area.
     pub fn area(&self) -> f64 {
         0.5 * polygon::newell_normal(&self.polygon).length()
     }
@@ -134,12 +156,14 @@ impl Surface {
         self.emission * self.area()
     }
 
+    /// The polygon's bounding box.
     pub fn bounds(&self) -> Bounds {
         Bounds::from_points(&self.polygon)
     }
 }
 
 impl Scene {
+    /// The bounding box of every surface.
     pub fn bounds(&self) -> Bounds {
         self.surfaces
             .iter()
@@ -151,6 +175,7 @@ impl Scene {
         self.bounds().diagonal()
     }
 
+    /// The surfaces that emit, with their ids.
     pub fn emitters(&self) -> impl Iterator<Item = (SurfaceId, &Surface)> {
         self.surfaces
             .iter()
@@ -158,14 +183,17 @@ impl Scene {
             .filter(|(_, s)| s.is_emitter())
     }
 
+    /// The power all emitters give out per channel (exitance times area, summed).
     pub fn emitted_power(&self) -> Rgb {
         self.surfaces.iter().map(Surface::emitted_power).sum()
     }
 
+    /// The sum of the surfaces' areas.
     pub fn total_area(&self) -> f64 {
         self.surfaces.iter().map(Surface::area).sum()
     }
 
+    /// The id of the first surface called `name`.
     pub fn surface_id(&self, name: &str) -> Option<SurfaceId> {
         self.surfaces.iter().position(|s| s.name == name)
     }

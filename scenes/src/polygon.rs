@@ -94,6 +94,7 @@ pub fn diameter(points: &[DVec3]) -> f64 {
     d2.sqrt()
 }
 
+/// The mean of the vertices (not the area centroid); the origin for no vertices.
 pub fn centroid(points: &[DVec3]) -> DVec3 {
     points.iter().copied().sum::<DVec3>() / points.len().max(1) as f64
 }

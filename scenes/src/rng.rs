@@ -8,6 +8,7 @@
 pub struct SplitMix64(u64);
 
 impl SplitMix64 {
+    /// The stream that starts from `seed`.
     pub fn new(seed: u64) -> Self {
         SplitMix64(seed)
     }
@@ -22,6 +23,7 @@ impl SplitMix64 {
         s
     }
 
+    /// The next 64 uniformly distributed bits.
     pub fn next_u64(&mut self) -> u64 {
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = self.0;

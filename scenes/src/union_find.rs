@@ -6,6 +6,7 @@
 pub struct UnionFind(Vec<usize>);
 
 impl UnionFind {
+    /// `n` sets of one index each.
     pub fn new(n: usize) -> UnionFind {
         UnionFind((0..n).collect())
     }
@@ -19,6 +20,7 @@ impl UnionFind {
         i
     }
 
+    /// Merges the sets of `a` and `b`; the merged set's root is the smaller of their roots.
     pub fn join(&mut self, a: usize, b: usize) {
         let (a, b) = (self.find(a), self.find(b));
         self.0[a.max(b)] = a.min(b);

@@ -27,52 +27,89 @@ pub const PLANARITY_TOLERANCE: f64 = 1e-6;
 pub struct Problem {
     /// The surface concerned, or `None` for scene-wide problems.
     pub surface: Option<String>,
+    /// What is wrong.
     pub kind: ProblemKind,
 }
 
+/// What is wrong with a scene or one of its surfaces. Its `Display` (through [`Problem`]) says
+/// what to change.
 #[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
 pub enum ProblemKind {
+    /// The scene has no surfaces.
     NoSurfaces,
+    /// A surface's name is empty.
     EmptyName,
+    /// A number is NaN or infinite.
     NonFinite {
+        /// The field that holds it: `polygon`, `emission` or `reflectance`.
         field: &'static str,
     },
+    /// The polygon has fewer than 3 distinct vertices ([`SAME_POINT_TOLERANCE`]).
     TooFewVertices {
+        /// How many distinct vertices it has.
         distinct: usize,
     },
+    /// Two vertices coincide ([`SAME_POINT_TOLERANCE`]): the polygon touches itself.
     RepeatedVertex {
+        /// The first vertex's index.
         first: usize,
+        /// The second vertex's index.
         second: usize,
     },
+    /// The polygon is negligibly small against the scene ([`MIN_RELATIVE_SIZE`]) or a sliver
+    /// ([`MIN_THINNESS`]).
     TinyArea {
+        /// The polygon's area.
         area: f64,
+        /// Its largest vertex distance.
         diameter: f64,
+        /// The scene's bounding-box diagonal.
         scene_diagonal: f64,
     },
+    /// A vertex lies off the polygon's plane by more than [`PLANARITY_TOLERANCE`] of its
+    /// diameter.
     NonPlanar {
+        /// The vertex's distance from the plane through the centroid.
         deviation: f64,
+        /// The vertex farthest from the plane.
         vertex: usize,
+        /// The distance allowed.
         tolerance: f64,
     },
+    /// Two edges of the polygon touch (edge `i` runs from vertex `i` to `i + 1`).
     SelfIntersecting {
+        /// One edge.
         edge_a: usize,
+        /// The other.
         edge_b: usize,
     },
+    /// A reflectance channel is outside [0, 1).
     ReflectanceOutOfRange {
+        /// `r`, `g` or `b`.
         channel: &'static str,
+        /// The value given.
         value: f64,
     },
+    /// An emission channel is negative.
     NegativeEmission {
+        /// `r`, `g` or `b`.
         channel: &'static str,
+        /// The value given.
         value: f64,
     },
+    /// Two surfaces have the same name.
     DuplicateName {
+        /// The first surface's index.
         first: usize,
+        /// The second surface's index.
         second: usize,
     },
+    /// No surface emits.
     NoEmitter,
+    /// The camera cannot give a picture.
     BadCamera {
+        /// Why, and what to change.
         reason: &'static str,
     },
 }

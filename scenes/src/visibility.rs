@@ -55,17 +55,22 @@ pub const RAY_LEAD: f64 = 2.0 * TRAVERSAL_BOX_START;
 /// One triangle of a scene surface, with the surface's own (unrounded) vertices.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SceneTriangle {
+    /// The corners, counter-clockwise seen from the surface's front.
     pub vertices: [DVec3; 3],
+    /// The surface the triangle is part of.
     pub surface: SurfaceId,
 }
 
 /// The closest surface along a ray.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Hit {
+    /// The surface hit.
     pub surface: SurfaceId,
+    /// The triangle hit, an index into [`Visibility::triangles`].
     pub triangle: usize,
     /// Ray parameter: the hit point is `origin + t * direction`.
     pub t: f64,
+    /// The hit point.
     pub point: DVec3,
 }
 
@@ -156,10 +161,13 @@ pub fn triangulate_scene(scene: &Scene) -> Vec<SceneTriangle> {
 }
 
 impl Visibility {
+    /// The index of every surface of `scene`, each triangulated.
     pub fn build(scene: &Scene) -> Visibility {
         Visibility::from_triangles(triangulate_scene(scene), scene.bounds())
     }
 
+    /// The index of any triangles; `bounds` (grown to hold them) sets the scale that the
+    /// tolerances are relative to, normally the scene's box.
     pub fn from_triangles(triangles: Vec<SceneTriangle>, bounds: Bounds) -> Visibility {
         let extent = triangles.iter().fold(Bounds::EMPTY, |b, t| {
             b.union(Bounds::from_points(&t.vertices))
@@ -231,6 +239,7 @@ impl Visibility {
         }
     }
 
+    /// The indexed triangles; [`Hit::triangle`] and the box queries refer to them by index.
     pub fn triangles(&self) -> &[SceneTriangle] {
         &self.triangles
     }
@@ -521,7 +530,7 @@ impl Visibility {
     /// Calls `visit` with every triangle whose box overlaps the shaft between two boxes, the
     /// convex hull of `from` and `to` (a triangle may come more than once). Every point of the
     /// hull is `(1 - t) a + t b` for some `a` in `from` and `b` in `to`, so the boxes between
-    /// the sections at the ends of [`SHAFT_SLICES`] ranges of `t` cover it; one box around a
+    /// the sections at the ends of a few (eight) ranges of `t` cover it; one box around a
     /// long shaft would hold most of a large scene.
     pub fn triangles_overlapping_between(
         &self,

@@ -31,6 +31,7 @@ pub enum ProbeKind {
 }
 
 impl ProbeKind {
+    /// Every kind, in the order the `visibility_leaks` example reports them.
     pub const ALL: [ProbeKind; 4] = [
         ProbeKind::FromVertex,
         ProbeKind::NearVertex,
@@ -46,9 +47,13 @@ pub const NEAR_VERTEX_OFFSET: f64 = 1e-3;
 /// A sampled segment query: `occluded(from, to, ignore)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ProbeSegment {
+    /// The segment's start.
     pub from: DVec3,
+    /// The segment's end.
     pub to: DVec3,
+    /// The surfaces of the two triangles it joins, which the query ignores.
     pub ignore: [SurfaceId; 2],
+    /// How the endpoints were drawn.
     pub kind: ProbeKind,
 }
 

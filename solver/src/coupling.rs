@@ -29,10 +29,16 @@ pub enum FormFactorMethod {
     Analytic,
     /// Monte Carlo over the patch's area: cos cos / (π r²) at stratified points, each seen or
     /// not by a ray; unbiased, with an error that falls as one over the square root of samples.
-    MonteCarlo { samples: usize },
+    MonteCarlo {
+        /// Sample points per point–patch pair.
+        samples: usize,
+    },
     /// A hemicube of `resolution` pixels across at each receiver: every patch's form factor
     /// from that point at once, occlusion by z-buffer (see [`crate::hemicube`]).
-    Hemicube { resolution: usize },
+    Hemicube {
+        /// Pixels across the top face.
+        resolution: usize,
+    },
 }
 
 impl FormFactorMethod {
@@ -56,10 +62,13 @@ impl FormFactorMethod {
 /// Carlo over the patch.
 #[derive(Clone, Copy, Debug)]
 pub struct Coupler<'a> {
+    /// The scene's visibility index, for the rays.
     pub visibility: &'a Visibility,
     /// Rays per point–patch pair for the visibility fraction.
     pub rays: usize,
+    /// Seeds every pair's own random stream.
     pub seed: u64,
+    /// How the form factors are computed.
     pub method: FormFactorMethod,
 }
 
@@ -216,11 +225,15 @@ pub type Columns = Vec<Vec<(u32, f32)>>;
 /// Form factors from the receivers (mesh vertices) of a discretization to its patches.
 #[derive(Debug)]
 pub struct PatchCoupling<'a> {
+    /// The receivers and patches.
     pub disc: &'a Discretization,
+    /// The scene's visibility index.
     pub visibility: &'a Visibility,
     /// Rays per vertex–patch pair for the visibility fraction.
     pub rays: usize,
+    /// Seeds every pair's own random stream.
     pub seed: u64,
+    /// How the form factors are computed.
     pub method: FormFactorMethod,
     /// Computing columns stops early, with [`SolveError::Interrupted`], once this is set.
     pub interrupt: Option<Interrupt>,

@@ -34,8 +34,9 @@ const SLIVER_ULPS: f64 = 64.0;
 /// Projected occluder vertices closer than this fraction of the emitter's diameter are merged.
 const MERGE_FRACTION: f64 = 1e-12;
 /// Up to this many occluders in a shaft are subtracted from the emitter one by one, as convex
-/// polygons; more are subtracted at once by one polygon difference ([`ShadowUnion`]), whose cost
-/// grows with their outline rather than with the product of their counts.
+/// polygons; more are subtracted at once by one polygon difference (Clipper2 on an integer
+/// grid), whose cost grows with their outline rather than with the product of their counts. The
+/// default of [`DirectLight::with_sequential_shadows`].
 pub const SEQUENTIAL_SHADOWS: usize = 16;
 /// Occluder faces whose corners are all at least this fraction of x's height from x (towards
 /// the emitter) project within this many times the shaft's width, and go whole into the union.
@@ -212,6 +213,7 @@ impl std::fmt::Debug for DirectLight<'_> {
 }
 
 impl<'a> DirectLight<'a> {
+    /// The evaluator of `scene`'s emitters, with `visibility` the scene's index.
     pub fn new(scene: &Scene, visibility: &'a Visibility) -> DirectLight<'a> {
         let emitters = scene
             .emitters()
@@ -325,6 +327,7 @@ impl<'a> DirectLight<'a> {
         self.tol / penumbra_scenes::CONTACT_TOLERANCE
     }
 
+    /// The emitters evaluated; `k` in the per-emitter methods counts them in scene order.
     pub fn emitter_count(&self) -> usize {
         self.emitters.len()
     }
@@ -1185,7 +1188,7 @@ mod tests {
         ReceivingPoint::interior(DVec3::new(x, y, 0.0), DVec3::Z)
     }
 
-    /// Section 3.2 of the analytic notes: the exact penumbra profile on the textbook floor.
+    /// `docs/closed-forms.md`, "The profile": the exact penumbra profile on the textbook floor.
     #[test]
     fn textbook_penumbra_profile() {
         let scene = builtin::textbook();
@@ -1220,8 +1223,8 @@ mod tests {
         }
     }
 
-    /// Section 5, case 2 of the analytic notes: a 0.5 box standing on the floor under the light.
-    /// On the contact line the light jumps; each side's limit is exact.
+    /// `docs/closed-forms.md`, "A box standing on the floor": a 0.5 box standing on the floor under
+    /// the light. On the contact line the light jumps; each side's limit is exact.
     #[test]
     fn limits_on_both_sides_of_a_contact_line() {
         use penumbra_scenes::{Rgb, Surface};
@@ -1305,7 +1308,7 @@ mod tests {
     }
 
     /// The estimate by rays: exact where the light is wholly seen or wholly hidden, and close
-    /// to the exact value across the penumbra (section 3.2 of the analytic notes).
+    /// to the exact value across the penumbra (`docs/closed-forms.md`, "The profile").
     #[test]
     fn the_estimate_by_rays_follows_the_exact_light() {
         let scene = builtin::textbook();

@@ -12,11 +12,15 @@ use crate::lambert::ReceivingPoint;
 /// One mesh triangle.
 #[derive(Clone, Debug)]
 pub struct Element {
+    /// The surface it is part of.
     pub surface: SurfaceId,
     /// Global receiver (vertex) indices.
     pub vertices: [usize; 3],
+    /// Its corners.
     pub points: [DVec3; 3],
+    /// Its area.
     pub area: f64,
+    /// The patch it belongs to.
     pub patch: usize,
     /// Index of the triangle in its surface's mesh.
     pub triangle: usize,
@@ -25,9 +29,13 @@ pub struct Element {
 /// Neighbouring elements of one surface that shoot their unshot power together.
 #[derive(Clone, Debug)]
 pub struct Patch {
+    /// The surface it is part of.
     pub surface: SurfaceId,
+    /// Its elements (indices into [`Discretization::elements`]).
     pub elements: Vec<usize>,
+    /// Its area.
     pub area: f64,
+    /// The unit normal of its surface.
     pub normal: DVec3,
     /// A point of the patch's plane.
     pub origin: DVec3,
@@ -36,6 +44,7 @@ pub struct Patch {
     /// The patch outline as directed edges, counter-clockwise about the normal: the contour of
     /// Lambert's formula (edges inside the patch cancel, so they are left out).
     pub outline: Vec<[DVec3; 2]>,
+    /// Its bounding box.
     pub bounds: Bounds,
     /// The elements' corners, in the order of `elements`: the patch's geometry on its own, so
     /// that it can still be shot from (or gathered from) after the mesh has changed.
@@ -49,15 +58,23 @@ pub struct Patch {
 pub struct Discretization {
     /// First global receiver index of each surface's mesh.
     pub offsets: Vec<usize>,
+    /// Every mesh vertex, as a point receiving light.
     pub receivers: Vec<ReceivingPoint>,
+    /// The surface of each receiver.
     pub receiver_surface: Vec<SurfaceId>,
+    /// Every mesh triangle.
     pub elements: Vec<Element>,
+    /// Groups of neighbouring elements that shoot together.
     pub patches: Vec<Patch>,
+    /// The reflectance at each receiver (its surface's).
     pub reflectance: Vec<Rgb>,
+    /// The emission at each receiver (its surface's).
     pub emission: Vec<Rgb>,
 }
 
 impl Discretization {
+    /// The receivers, elements and patches of `mesh`, with about `elements_per_patch`
+    /// neighbouring elements of a surface in each patch.
     pub fn new(scene: &Scene, mesh: &SceneMesh, elements_per_patch: usize) -> Discretization {
         let mut offsets = Vec::with_capacity(mesh.surfaces.len());
         let mut receivers = Vec::new();
@@ -157,6 +174,7 @@ impl Discretization {
         }
     }
 
+    /// Receivers (mesh vertices) of every surface.
     pub fn receiver_count(&self) -> usize {
         self.receivers.len()
     }

@@ -62,14 +62,18 @@ impl SolverMethod {
 /// the iteration stopped.
 #[derive(Clone, Debug)]
 pub struct SystemSolution {
+    /// B̄ per channel, per patch.
     pub patch_radiosity: [Vec<f64>; 3],
+    /// The residual after each sweep.
     pub history: Vec<ConvergencePoint>,
+    /// Why the iteration stopped.
     pub stop: StopReason,
 }
 
 /// The assembled system of a meshed scene.
 #[derive(Debug)]
 pub struct PatchSystem {
+    /// The receivers, elements and patches.
     pub disc: Discretization,
     /// Direct irradiance at every vertex.
     pub direct: Vec<Rgb>,
@@ -77,17 +81,22 @@ pub struct PatchSystem {
     pub columns: crate::coupling::Columns,
     /// c and K, one per channel: `k[channel][p * patches + q]`.
     pub c: [Vec<f64>; 3],
+    /// See `c`.
     pub k: [Vec<f64>; 3],
+    /// Visibility rays cast for the form factors.
     pub rays_cast: u64,
     /// Seconds spent on the direct light, and on the form factors and K.
     pub direct_seconds: f64,
     /// Vertices whose direct light is an estimate by rays (their view of a light was beyond the
     /// exact evaluator's overlay cap).
     pub direct_beyond_cap: usize,
+    /// See `direct_seconds`.
     pub assembly_seconds: f64,
 }
 
 impl PatchSystem {
+    /// Assembles the system of `mesh`: the exact direct light at every vertex, the
+    /// vertex-to-patch form factors by `options.form_factors`, then c and K.
     pub fn assemble(
         scene: &Scene,
         mesh: &SceneMesh,
@@ -151,6 +160,7 @@ impl PatchSystem {
         })
     }
 
+    /// Patches of the system: its unknowns per channel.
     pub fn patches(&self) -> usize {
         self.disc.patches.len()
     }

@@ -79,6 +79,7 @@ impl Hemicube {
         })
     }
 
+    /// Pixels across the top face.
     pub fn resolution(&self) -> usize {
         self.resolution
     }
@@ -313,7 +314,7 @@ mod tests {
 
     #[test]
     fn parallel_unit_square_corner_on_the_normal() {
-        // analytic.md 1.1: a = b = c = 1.
+        // `docs/closed-forms.md`, "Rectangles by superposition": a = b = c = 1.
         let exact = 0.138531605994893;
         let errors: Vec<f64> = [32, 128, 512]
             .map(|n| {

@@ -18,6 +18,7 @@ use crate::clip::clip_polygon_3d;
 /// A point receiving light: where it is, which way it faces, and which way its surface lies.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ReceivingPoint {
+    /// Where it is.
     pub point: DVec3,
     /// Unit normal of the receiving surface.
     pub normal: DVec3,
@@ -237,7 +238,8 @@ mod tests {
         );
     }
 
-    /// Section 1.1: differential area to a parallel rectangle, corner on the normal.
+    /// `docs/closed-forms.md`, "Rectangles by superposition": differential area to a parallel
+    /// rectangle, corner on the normal.
     #[test]
     fn parallel_rectangle_corner_on_normal() {
         for (a, b, c, f) in [
@@ -251,8 +253,8 @@ mod tests {
         }
     }
 
-    /// Section 1.2: differential area to a perpendicular rectangle whose bottom edge lies in the
-    /// point's tangent plane.
+    /// `docs/closed-forms.md`, "Rectangles by superposition": differential area to a perpendicular
+    /// rectangle whose bottom edge lies in the point's tangent plane.
     #[test]
     fn perpendicular_rectangle() {
         for (a, b, c, f) in [
@@ -266,7 +268,8 @@ mod tests {
         }
     }
 
-    /// Section 1.6 cases A-D, including the square that straddles the tangent plane.
+    /// `docs/closed-forms.md`, "A point and a polygon", cases A-D, including the square that
+    /// straddles the tangent plane.
     #[test]
     fn arbitrary_polygons_and_clipping() {
         let o = up_at(DVec3::ZERO);

@@ -13,8 +13,11 @@ use crate::lambert::ReceivingPoint;
 /// Errors of an interpolated radiosity over one surface, in radiosity units (channel means).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct InterpolationError {
+    /// Points sampled.
     pub samples: usize,
+    /// Root mean square of the errors at the samples.
     pub rms: f64,
+    /// The largest error at a sample.
     pub max: f64,
     /// Mean of the exact values at the samples, to state errors relative to it.
     pub mean_exact: f64,

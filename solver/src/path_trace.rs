@@ -36,6 +36,7 @@ pub const REPLICATES: usize = 16;
 pub struct PathTraceOptions {
     /// Paths per point, rounded up to [`REPLICATES`] square grids.
     pub paths: usize,
+    /// Seeds every point's own random stream.
     pub seed: u64,
 }
 
@@ -51,7 +52,9 @@ impl Default for PathTraceOptions {
 /// A point's radiosity and the standard error of its estimate (channel means).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, serde::Deserialize)]
 pub struct ReferenceValue {
+    /// The estimated radiosity.
     pub radiosity: Rgb,
+    /// The standard error of its channel mean, from the spread of the replicates.
     pub standard_error: f64,
 }
 
@@ -75,6 +78,7 @@ impl std::fmt::Debug for PathTracer<'_> {
 }
 
 impl<'a> PathTracer<'a> {
+    /// A tracer of `scene`, with `visibility` its index.
     pub fn new(scene: &'a Scene, visibility: &'a Visibility) -> PathTracer<'a> {
         PathTracer {
             scene,

@@ -48,6 +48,7 @@ pub struct SolverOptions {
     pub elements_per_patch: usize,
     /// One bounce only: B = E + ρ H_direct, exact.
     pub direct_only: bool,
+    /// Seeds every random stream of the solve (visibility rays, Monte Carlo samples).
     pub seed: u64,
     /// Memory allowed for caching vertex–patch form factors, in bytes.
     pub cache_bytes: usize,
@@ -152,10 +153,15 @@ pub enum StopReason {
 /// Figures of a solve. Powers are in W per channel (radiosity times area in scene units).
 #[derive(Clone, Debug, Serialize)]
 pub struct SolveStats {
+    /// Why the solver stopped.
     pub stop: StopReason,
+    /// Patches shot (progressive refinement).
     pub shots: usize,
+    /// Patches of the discretization.
     pub patches: usize,
+    /// Receivers (mesh vertices) of the discretization.
     pub receivers: usize,
+    /// Visibility rays cast.
     pub rays_cast: u64,
     /// Power leaving the emitters by their own emission.
     pub emitted: Rgb,
@@ -169,22 +175,28 @@ pub struct SolveStats {
     /// Unshot power over emitted power (channel means; patch by patch in absolute value, since
     /// after a remesh a patch may owe negative power).
     pub unshot_fraction: f64,
+    /// Seconds spent on the direct light.
     pub direct_seconds: f64,
     /// Vertices whose direct light was estimated by rays, not computed exactly: the deadline
     /// came first, or (`direct_beyond_cap` of them) their view of a light needed a polygon
     /// difference beyond the evaluator's cap.
     pub direct_estimated: usize,
+    /// See `direct_estimated`.
     pub direct_beyond_cap: usize,
+    /// Seconds spent shooting (or gathering, or solving the system).
     pub shooting_seconds: f64,
     /// Iterations of the solver (shots for progressive refinement, sweeps for gathering) and
     /// its final residual relative to the light put in: the unshot fraction for progressive
     /// refinement, ‖c + K B − B‖ / ‖c‖ for gathering and direct solves.
     pub iterations: usize,
+    /// See `iterations`.
     pub residual: f64,
     /// Times the mesh was replaced by a refined one, and the vertices that then gathered the
     /// light shot so far.
     pub remeshes: usize,
+    /// See `remeshes`.
     pub gathered: usize,
+    /// Seconds those vertices spent gathering.
     pub gather_seconds: f64,
     /// The hierarchical solver's own figures.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -195,19 +207,25 @@ pub struct SolveStats {
 /// the unshot fraction, for gathering ‖c + K B̄ − B̄‖ / ‖c‖) and the seconds since it began.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct ConvergencePoint {
+    /// Steps done (0: the start, before any).
     pub iteration: usize,
+    /// The residual after it.
     pub residual: f64,
+    /// Seconds since the solver began.
     pub seconds: f64,
 }
 
 /// Radiosity and irradiance at every mesh vertex, per surface.
 #[derive(Clone, Debug)]
 pub struct Solution {
+    /// Radiosity B at each vertex, per surface (W/m² per channel).
     pub radiosity: Vec<Vec<Rgb>>,
+    /// Irradiance H at each vertex, per surface: B = E + ρ H.
     pub irradiance: Vec<Vec<Rgb>>,
     /// Cohen et al.'s ambient term for display: an estimate of the light not yet shot, spread
     /// evenly. Never part of the radiosity.
     pub ambient: Rgb,
+    /// Figures of the solve.
     pub stats: SolveStats,
     /// The residual after each iteration (each shot, each sweep).
     pub convergence: Vec<ConvergencePoint>,

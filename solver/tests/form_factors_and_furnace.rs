@@ -48,8 +48,8 @@ fn closed_cube_patch_rows_sum_to_one() {
     assert!(worst_row < 1e-3, "row sums off by {worst_row}");
 }
 
-/// Section 2.1 of the analytic notes: the 1 x 2 x 3 box's face-to-face form factors, their row
-/// sums and their reciprocity, from the solver's vertex quadrature.
+/// `docs/closed-forms.md`, "The 1 × 2 × 3 box": the 1 x 2 x 3 box's face-to-face form factors,
+/// their row sums and their reciprocity, from the solver's vertex quadrature.
 #[test]
 fn box_face_factors_match_closed_forms_sum_to_one_and_are_reciprocal() {
     let scene = builtin::closed_box(glam::DVec3::new(1.0, 2.0, 3.0), 1.0, 0.5);
@@ -152,8 +152,8 @@ fn furnace_gives_e_over_one_minus_rho() {
     }
 }
 
-/// Section 2.1 of the analytic notes: the form factor between faces `i` and `j` of the closed
-/// 1 x 2 x 3 box.
+/// `docs/closed-forms.md`, "The 1 × 2 × 3 box": the form factor between faces `i` and `j` of the
+/// closed 1 x 2 x 3 box.
 fn box_closed_form(scene: &penumbra_scenes::Scene, i: usize, j: usize) -> f64 {
     // Closed forms by face size (dimensions of the emitting face, then of the receiving face).
     let dims = |s: usize| {

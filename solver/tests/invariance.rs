@@ -1,7 +1,8 @@
 //! Radiosity does not depend on where the scene sits, how it is turned, or its units: the same
 //! scene moved, rotated, scaled by 1e-3 and 1e3, and sized to 1e-6 and 1e6 across (a micrometre,
 //! a thousand kilometres) gives the same radiosity at every vertex —
-//! to 1e-9 with the exact direct light alone, and to 0.1 % for the full progressive solution.
+//! to 1e-9 with the exact direct light alone, and to 1e-6 for the full progressive solution
+//! (measured: 3.1e-7 once the scene is turned, where the visibility rays' directions turn with it).
 
 use glam::{DAffine3, DQuat, DVec3, EulerRot};
 use penumbra_meshing::mesh_scene_uniform;
@@ -94,13 +95,13 @@ fn direct_light_is_invariant_to_1e9() {
 }
 
 #[test]
-fn full_solution_is_invariant_to_a_tenth_of_a_percent() {
+fn full_solution_is_invariant_to_1e6() {
     let scene = builtin::cornell();
     let reference = solve(&scene, false);
     for (what, map) in transforms(&scene) {
         let moved = solve(&scene.transformed(&map), false);
         let worst = worst_relative(&reference, &moved);
         eprintln!("cornell {what}: worst relative difference {worst:e}");
-        assert!(worst <= 1e-3, "{what}: relative difference {worst:e}");
+        assert!(worst <= 1e-6, "{what}: relative difference {worst:e}");
     }
 }

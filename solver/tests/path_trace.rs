@@ -67,23 +67,27 @@ fn where_nothing_reflects_the_reference_is_the_direct_light() {
     }
 }
 
-/// The same seed gives the same numbers.
+/// The same seed gives the same numbers whatever the thread count (each sample draws from its
+/// own stream), and another seed other numbers.
 #[test]
 fn references_are_deterministic() {
     let scene = builtin::cornell();
     let vis = Visibility::build(&scene);
     let tracer = PathTracer::new(&scene, &vis);
     let floor = scene.surface_id("floor").expect("floor");
-    let points = vec![
-        (DVec3::new(100.0, 0.0, 400.0), floor),
-        (DVec3::new(400.0, 0.0, 100.0), floor),
-    ];
-    let options = PathTraceOptions {
-        paths: 200,
-        seed: 9,
+    let points: Vec<_> = (0..16)
+        .map(|i| (DVec3::new(30.0 + 30.0 * f64::from(i), 0.0, 400.0), floor))
+        .collect();
+    let options = |seed| PathTraceOptions { paths: 200, seed };
+    let with_threads = |threads: usize, seed: u64| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("a thread pool")
+            .install(|| tracer.radiosity(&points, &options(seed)))
     };
-    assert_eq!(
-        tracer.radiosity(&points, &options),
-        tracer.radiosity(&points, &options)
-    );
+    let one = with_threads(1, 9);
+    assert_eq!(one, with_threads(2, 9));
+    assert_eq!(one, with_threads(3, 9));
+    assert_ne!(one, with_threads(2, 10));
 }

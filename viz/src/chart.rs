@@ -44,16 +44,22 @@ const INK: [u8; 3] = [40, 40, 40];
 /// One line of a chart: its name in the legend and its points (x, y), drawn in the given order.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Series {
+    /// The name in the legend.
     pub name: String,
+    /// The points (x, y).
     pub points: Vec<(f64, f64)>,
 }
 
 /// A chart with logarithmic axes. Points that are not positive and finite are left out.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LogLogChart {
+    /// The title above the plot.
     pub title: String,
+    /// The label of the horizontal axis.
     pub x_label: String,
+    /// The label of the vertical axis.
     pub y_label: String,
+    /// The lines, in legend order.
     pub series: Vec<Series>,
 }
 

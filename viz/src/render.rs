@@ -30,11 +30,13 @@ const BAND_ROWS: u32 = 16;
 /// How to render: the image size, the exposure and a display-only ambient term.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RenderOptions {
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
     /// Multiplies radiosity (W/m^2) into display values in `[0, 1]` before the sRGB curve.
-    /// `None` chooses it from the image (see [`crate::tonemap::auto_exposure`]): the bright end
-    /// of the lit surfaces maps to 0.8, emitters left out.
+    /// `None` chooses it from the image: the 95th percentile of the luminance of the lit
+    /// surfaces' pixels maps to 0.8, emitters left out.
     pub exposure: Option<f64>,
     /// Added to every surface's radiosity, front and back, for display only: it shows shapes in
     /// regions that receive no light. It takes part in automatic exposure.
@@ -55,7 +57,9 @@ impl Default for RenderOptions {
 /// A rendered image and the exposure it was made with.
 #[derive(Clone, Debug)]
 pub struct Render {
+    /// The image, sRGB.
     pub image: RgbImage,
+    /// The exposure used: display value per unit of radiosity.
     pub exposure: f64,
 }
 

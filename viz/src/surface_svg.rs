@@ -13,8 +13,8 @@ use crate::tonemap::{auto_exposure, luminance, to_srgb8};
 /// title with the surface's name and counts, and a scale bar in scene units.
 ///
 /// With `radiosity` (one value per mesh vertex), each triangle is filled with the mean of its
-/// corners' radiosity, exposed so that the surface's own 95th percentile maps to 0.8 (see
-/// [`crate::tonemap::auto_exposure`]). Values that do not match the mesh are left out, and the
+/// corners' radiosity, exposed so that the 95th percentile of the surface's own luminance maps
+/// to 0.8. Values that do not match the mesh are left out, and the
 /// figure says so.
 ///
 /// `segments` (the surface's discontinuities, in 3D) are drawn over the mesh, coloured by the

@@ -34,7 +34,7 @@ use serde::Serialize;
 use crate::progress::{Interrupt, NoProgress, Progress};
 use merge::{FlatSegment, merge_collinear};
 use shaft::{PairEvents, SearchContext};
-pub use wedge::{Event, Wedge};
+pub use wedge::Event;
 
 /// What a discontinuity line bounds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -48,6 +48,7 @@ pub enum Boundary {
 }
 
 impl Boundary {
+    /// The boundary's name in outputs: `umbra`, `penumbra` or `inner`.
     pub fn name(self) -> &'static str {
         match self {
             Boundary::Umbra => "umbra",
@@ -60,11 +61,17 @@ impl Boundary {
 /// A segment on a receiver across which the direct light from `emitter` is not smooth.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DiscontinuitySegment {
+    /// The receiver the segment lies on.
     pub surface: SurfaceId,
+    /// The emitter whose light changes across it.
     pub emitter: SurfaceId,
+    /// One end, on the receiver.
     pub from: DVec3,
+    /// The other end.
     pub to: DVec3,
+    /// The visual event that makes it.
     pub event: Event,
+    /// What it bounds.
     pub boundary: Boundary,
     /// 0: the value jumps; 1: the slope jumps; 2: the curvature jumps.
     pub order: u8,
@@ -77,7 +84,7 @@ pub enum EventSet {
     /// Every one: an emitter edge with each blocker vertex on the blocker's outline as seen from
     /// the edge, each emitter vertex with each blocker edge on the outline as seen from it, and
     /// each blocker vertex with an edge of another blocker in a plane that cuts the emitter
-    /// ([`between`]). The visible area's second derivative jumps across each.
+    /// (events between blockers). The visible area's second derivative jumps across each.
     #[default]
     Complete,
     /// Only EV and VE events whose plane is tangent to both the emitter and the blocker: the
@@ -98,8 +105,8 @@ pub struct DiscontinuityOptions {
     pub events: EventSet,
     /// EEE curves become polylines within this fraction of the receiver's diameter.
     pub eee_tolerance: f64,
-    /// Blocker patches that can hide less than this fraction of an emitter from a receiver start
-    /// no events there ([`strength`]).
+    /// Blocker patches (a blocker's connected coplanar faces) that can hide less than this
+    /// fraction of an emitter from a receiver start no events there.
     pub event_tolerance: f64,
     /// The area of a typical element of the mesh to come, if known: receivers smaller than
     /// [`MIN_RECEIVER_ELEMENTS`] such elements get no events, and blocker patches whose shadow
@@ -171,12 +178,14 @@ pub struct DiscontinuityStats {
     pub receivers_too_small: usize,
     /// Blocker surfaces found in shafts, summed over pairs.
     pub blockers_in_shafts: usize,
-    /// Of those, surfaces of patches too weak for events ([`strength`]), and the largest share
+    /// Of those, surfaces of patches too weak for events (see
+    /// [`DiscontinuityOptions::event_tolerance`]), and the largest share
     /// of an emitter such a patch could hide: the most any dropped event changes the light by.
     pub blockers_weak: usize,
+    /// See `blockers_weak`.
     pub weak_share_max: f64,
     /// Receivers cut by their emitter's plane within one element of their edge, which get no
-    /// line there ([`horizon`]).
+    /// line there.
     pub horizons_within_an_element: usize,
     /// Shafts whose EEE search was skipped for their many blocker edges ([`EEE_MAX_EDGES`]).
     pub eee_shafts_skipped: usize,
@@ -193,6 +202,7 @@ pub struct DiscontinuityStats {
     pub wedges_kept: usize,
     /// Wedge segments shortened or split by trimming, and removed by it entirely.
     pub segments_trimmed: usize,
+    /// See `segments_trimmed`.
     pub segments_hidden: usize,
     /// Contact lines where blockers touch receivers (those along a receiver's own edge are
     /// found too, then dropped: they are mesh edges already).
@@ -200,22 +210,30 @@ pub struct DiscontinuityStats {
     /// Emitter edge–blocker edge–blocker edge triples examined for EEE events (after silhouette
     /// and spatial culling), and those that left a curve on their receiver.
     pub eee_considered: usize,
+    /// See `eee_considered`.
     pub eee_events: usize,
     /// Segments after merging coincident ones.
     pub segments: usize,
-    /// Of those, by event (coincident events of several kinds count as the merged line's).
+    /// Of those, by event (coincident events of several kinds count as the merged line's): EV.
     pub ev_segments: usize,
+    /// VE segments.
     pub ve_segments: usize,
+    /// EEE segments.
     pub eee_segments: usize,
     /// Segments of events between two blockers (complete events only).
     pub blocker_ev_segments: usize,
-    /// Segments where an emitter's own plane cuts its receiver ([`horizon`]).
+    /// Segments where an emitter's own plane cuts its receiver: only the part of the receiver
+    /// in front of the emitter is lit.
     pub horizon_segments: usize,
+    /// Contact lines (blockers touching or hovering over receivers).
     pub contact_lines: usize,
-    /// Of those, by order: where the value (0), the slope (1) or the curvature (2) jumps.
+    /// The segments by order: where the value jumps (0).
     pub order_0_segments: usize,
+    /// Where the slope jumps (1).
     pub order_1_segments: usize,
+    /// Where the curvature jumps (2).
     pub order_2_segments: usize,
+    /// Wall time of the search in seconds.
     pub seconds: f64,
 }
 
@@ -267,10 +285,13 @@ impl DiscontinuityStats {
 /// Every receiver's discontinuity segments (indexed by surface), and the figures of the search.
 #[derive(Clone, Debug, Default)]
 pub struct Discontinuities {
+    /// Each surface's segments.
     pub segments: Vec<Vec<DiscontinuitySegment>>,
-    /// Per surface, the contact lines cast by faces hovering over it, with their gaps: values
-    /// at these lines are taken a few gaps off them (see [`contact::HOVER`]).
-    pub hovering: Vec<Vec<contact::ContactLine>>,
+    /// Per surface, the contact lines cast by faces hovering over it (3D ends and the gap under
+    /// the face): values at these lines are taken a few gaps off them. A face hovers when it
+    /// is parallel to the receiver and closer than a thousandth of its own size.
+    pub hovering: Vec<Vec<(DVec3, DVec3, f64)>>,
+    /// What the search did.
     pub stats: DiscontinuityStats,
 }
 
@@ -483,6 +504,8 @@ pub struct EmitterProbe {
 }
 
 impl EmitterProbe {
+    /// Samples spread over emitter `emitter` of `scene`: its centroid, points near its vertices
+    /// and edges, and points halfway to its vertices.
     pub fn new(scene: &Scene, emitter: SurfaceId) -> EmitterProbe {
         let polygon = &scene.surfaces[emitter].polygon;
         EmitterProbe {

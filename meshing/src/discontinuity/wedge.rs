@@ -25,6 +25,7 @@ pub enum Event {
 }
 
 impl Event {
+    /// The event's name in outputs: `EV`, `VE`, `EEE`, `contact`, `blocker-EV` or `horizon`.
     pub fn name(self) -> &'static str {
         match self {
             Event::Ev => "EV",
@@ -51,17 +52,6 @@ pub struct Wedge {
 }
 
 impl Wedge {
-    /// Unit normal of the wedge's plane.
-    pub fn normal(&self) -> DVec3 {
-        let n = match self.event {
-            Event::Ev | Event::BlockerEv => {
-                (self.source[1] - self.source[0]).cross(self.through[0] - self.source[0])
-            }
-            _ => (self.through[0] - self.source[0]).cross(self.through[1] - self.source[0]),
-        };
-        n.normalize_or_zero()
-    }
-
     /// The wedge cut off at `reach` from its blocker feature: a convex fan polygon in its plane.
     pub fn polygon(&self, reach: f64) -> Vec<DVec3> {
         // Directions of the rays at a few parameters along the moving feature: a fan covers the

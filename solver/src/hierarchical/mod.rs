@@ -80,14 +80,19 @@ pub fn estimated_bytes(triangles: u64, link_tol: f64) -> u64 {
 /// Figures of a hierarchical solve, under `solver.hierarchy` in `report.json`.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct HierarchyStats {
+    /// The link tolerance the solve refined to.
     pub link_tol: f64,
     /// Element nodes (parts of surfaces), of which leaves (the mesh's triangles).
     pub elements: usize,
+    /// See `elements`.
     pub leaves: usize,
+    /// Cluster nodes (groups of surfaces).
     pub clusters: usize,
+    /// Links in the final hierarchy.
     pub links: usize,
     /// Links by visibility: open (no blocker in the shaft), partial (rays decide).
     pub links_open: usize,
+    /// See `links_open`.
     pub links_partial: usize,
     /// Links from or to a cluster.
     pub links_with_clusters: usize,
@@ -95,13 +100,17 @@ pub struct HierarchyStats {
     pub links_by_depth: Vec<usize>,
     /// Pairs of nodes found hidden by one polygon, and not linked.
     pub hidden_pairs: u64,
+    /// Passes of link refinement, each followed by sweeps.
     pub refinement_passes: usize,
     /// Rays for the links' visibility, and for the final gather's partial links.
     pub link_rays: u64,
+    /// See `link_rays`.
     pub gather_rays: u64,
     /// Jacobi sweeps, over all passes.
     pub sweeps: usize,
+    /// Seconds spent making and refining links.
     pub link_seconds: f64,
+    /// Seconds spent sweeping.
     pub sweep_seconds: f64,
     /// Bytes held by the links.
     pub link_bytes: u64,
@@ -127,9 +136,13 @@ pub fn solve_hierarchical(
 /// their vertices, and the exact direct light.
 #[derive(Debug)]
 pub struct Round<'r> {
+    /// The round's meshes, one per surface.
     pub meshes: &'r [SurfaceMesh],
+    /// The radiosity at each mesh vertex, per surface.
     pub radiosity: Vec<Vec<Rgb>>,
+    /// The direct part of that radiosity, E + ρ H_direct, per surface.
     pub direct: Vec<Vec<Rgb>>,
+    /// The exact direct light, for new vertices.
     pub direct_light: &'r DirectLight<'r>,
 }
 
@@ -761,7 +774,7 @@ mod tests {
     use penumbra_scenes::builtin;
 
     /// The links between two faces of the unit cube carry its face-to-face form factors
-    /// (`../shared/analytic.md` §1.3 and §1.4): Σ area × form factor over the links from one
+    /// (`docs/closed-forms.md`, "Two rectangles"): Σ area × form factor over the links from one
     /// face's elements to the other's, over the first face's area.
     #[test]
     fn links_carry_the_unit_cubes_face_factors() {
