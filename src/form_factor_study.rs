@@ -1,8 +1,9 @@
-//! The form-factor methods measured against closed forms: error against cost, point by point
-//! (the cases of the analytic notes, sections 1 and 3), the hemicube's aliasing on patches
-//! about a pixel in size, the face-to-face factors of the 1 × 2 × 3 box (section 2.1), and whole
-//! solutions of the unit cube with one emitting face (section 2.4), solved densely so that the
-//! form factors are the only approximation besides the mesh.
+//! The form-factor methods measured against closed forms: error against cost, point by point (the
+//! cases of `docs/closed-forms.md`, "A point and a polygon", "Rectangles by superposition" and "The
+//! textbook scene"), the hemicube's aliasing on patches about a pixel in size, the face-to-face
+//! factors of the 1 × 2 × 3 box ("The 1 × 2 × 3 box"), and whole solutions of the unit cube with
+//! one emitting face ("The unit cube with one emitting face"), solved densely so that the form
+//! factors are the only approximation besides the mesh.
 
 use std::time::Instant;
 
@@ -82,7 +83,7 @@ impl MethodConfig {
 #[derive(Clone, Debug, Serialize)]
 pub struct PointCase {
     pub name: &'static str,
-    /// Where the closed form comes from (the analytic notes' section).
+    /// Where the closed form comes from (its case in `docs/closed-forms.md`).
     pub source: &'static str,
     pub exact: f64,
 }
@@ -130,7 +131,8 @@ pub struct CubeRow {
     pub triangles: usize,
     /// Face-mean radiosities: the emitter, the mean of the four adjacent faces, the opposite.
     pub faces: [f64; 3],
-    /// Their relative errors against the continuous limit of the analytic notes.
+    /// Their relative errors against the continuous limit (`docs/closed-forms.md`, "The unit cube
+    /// with one emitting face").
     pub errors: [f64; 3],
     /// Form factors and solve.
     pub seconds: f64,
@@ -563,8 +565,8 @@ fn box_factors(config: &MethodConfig, rays: usize) -> Result<BoxRow, StudyError>
     })
 }
 
-/// Section 2.1 of the analytic notes: the closed-form factor from face `i` to face `j` of the
-/// 1 × 2 × 3 box, told apart by the faces' side lengths.
+/// `docs/closed-forms.md`, "The 1 × 2 × 3 box": the closed-form factor from face `i` to face `j` of
+/// the 1 × 2 × 3 box, told apart by the faces' side lengths.
 fn box_closed_form(scene: &Scene, i: usize, j: usize) -> f64 {
     let sides = |s: usize| {
         let b = scene.surfaces[s].bounds();
@@ -602,8 +604,8 @@ fn box_closed_form(scene: &Scene, i: usize, j: usize) -> f64 {
 
 /// Reflectance of the unit cube in the whole-solution comparison.
 const CUBE_RHO: f64 = 0.9;
-/// Section 2.4 of the analytic notes at ρ = 0.9: the continuous limit of the face means
-/// (emitter, adjacent, opposite), an Aitken estimate good to 4–5 digits.
+/// `docs/closed-forms.md`, "The unit cube with one emitting face", at ρ = 0.9: the continuous limit
+/// of the face means (emitter, adjacent, opposite), an Aitken estimate good to 4–5 digits.
 const CUBE_LIMIT: [f64; 3] = [2.41938, 1.52318, 1.48788];
 
 /// The unit cube with its floor emitting (E = 1) and every face reflecting 0.9, meshed uniformly

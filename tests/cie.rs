@@ -1,9 +1,9 @@
-//! The CIE 171:2006 analytic test cases that fit diffuse polygon scenes (5.3, 5.6, 5.8; the
-//! scenes are `penumbra_scenes::cie`), held to the CIE's pass criteria: every point within 5 %
-//! of the reference and the points' mean error within 10 %. The references are closed forms: the
-//! corner-rectangle form factors of the analytic notes (1.1, 1.2), combined by superposition, and
-//! for 5.8 the flux balance of the enclosure. penumbra is far inside the criteria, so each test
-//! also holds it to its own measured accuracy.
+//! The CIE 171:2006 analytic test cases that fit diffuse polygon scenes (5.3, 5.6, 5.8; the scenes
+//! are `penumbra_scenes::cie`), held to the CIE's pass criteria: every point within 5 % of the
+//! reference and the points' mean error within 10 %. The references are closed forms: the
+//! corner-rectangle form factors of `docs/closed-forms.md`, "Rectangles by superposition", combined
+//! by superposition, and for 5.8 the flux balance of the enclosure ("An enclosure lit inside").
+//! penumbra is far inside the criteria, so each test also holds it to its own measured accuracy.
 
 use std::f64::consts::PI;
 
@@ -17,16 +17,17 @@ use penumbra_solver::{
     NoProgress, SolverMethod, SolverOptions, solve_hierarchical, solve_progressive,
 };
 
-/// Analytic notes 1.1: a point under the corner of an a × b rectangle in a parallel plane at
-/// distance c.
+/// `docs/closed-forms.md`, "Rectangles by superposition": a point under the corner of an a × b
+/// rectangle in a parallel plane at distance c.
 fn parallel_corner(a: f64, b: f64, c: f64) -> f64 {
     let (x, y) = (a / c, b / c);
     let (sx, sy) = ((1.0 + x * x).sqrt(), (1.0 + y * y).sqrt());
     (x / sx * (y / sx).atan() + y / sy * (x / sy).atan()) / (2.0 * PI)
 }
 
-/// Analytic notes 1.2: a point whose plane holds one edge (of width b, starting at the foot of
-/// the perpendicular) of an a (height) × b rectangle at distance c.
+/// `docs/closed-forms.md`, "Rectangles by superposition": a point whose plane holds one edge
+/// (of width b, starting at the foot of the perpendicular) of an a (height) × b rectangle at
+/// distance c.
 fn perpendicular_corner(a: f64, b: f64, c: f64) -> f64 {
     if a <= 0.0 || b <= 0.0 {
         return 0.0;

@@ -18,8 +18,8 @@ fn loaded(scene: Scene) -> LoadedScene {
     }
 }
 
-/// Section 3.1 of the analytic notes: on the textbook floor, 8 segments of order 1 at x, y = ±0.5
-/// (umbra) and ±1 (outer penumbra), each running |other coordinate| <= 1.
+/// `docs/closed-forms.md`, "Boundary lines": on the textbook floor, 8 segments of order 1 at
+/// x, y = ±0.5 (umbra) and ±1 (outer penumbra), each running |other coordinate| <= 1.
 #[test]
 fn textbook_lines_are_the_analytic_ones() {
     let scene = builtin::textbook();

@@ -334,11 +334,11 @@ fn wedge_lines_a_billionth_apart_mesh_sanely() {
     }
 }
 
-/// Light edges parallel to blocker edges (the analytic notes' section 3, blocker side 1.2): the
-/// EV wedges of an edge's two ends coincide with its EE wedge. They merge into one line each,
-/// no line drawn twice: the floor gets exactly the eight lines |x| or |y| = 0.65 (umbra) and
-/// 1.15 (penumbra), each from -1.15 to 1.15, all D1. The direct light is D1 there in fact: zero
-/// at x_u with slope 0 inside and 0.0691146221 outside (the notes' closed form).
+/// Light edges parallel to blocker edges (`docs/closed-forms.md`, "Boundary lines", blocker side
+/// 1.2): the EV wedges of an edge's two ends coincide with its EE wedge. They merge into one line
+/// each, no line drawn twice: the floor gets exactly the eight lines |x| or |y| = 0.65 (umbra) and
+/// 1.15 (penumbra), each from -1.15 to 1.15, all D1. The direct light is D1 there in fact: zero at
+/// x_u with slope 0 inside and 0.0691146221 outside (the closed form there).
 #[test]
 fn parallel_edges_give_single_d1_lines() {
     let scene = extremes::parallel_edges(1.2);

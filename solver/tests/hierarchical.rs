@@ -73,9 +73,9 @@ fn furnace_gives_e_over_one_minus_rho() {
     }
 }
 
-/// The unit cube with one emitting face (`docs/closed-forms.md`, "The unit cube with one emitting
-/// face"): face means against the continuous limit, no further off than the dense solve of the same
-/// mesh.
+/// The unit cube with one emitting face (`docs/closed-forms.md`, "The unit cube with one
+/// emitting face"): face means against the continuous limit, no further off than the dense solve
+/// of the same mesh.
 #[test]
 fn unit_cube_face_means_match_the_continuous_limit() {
     // The continuous limit's face means: emitter, adjacent, opposite.
