@@ -636,6 +636,8 @@ pub fn merge(
     let vertices = surfaces.iter().map(|s| s.vertices.len()).sum();
     if let Some(r) = report.as_object_mut() {
         r.insert("partial".to_owned(), false.into());
+        // The first shard's command line would replay that shard alone.
+        r.remove("invocation");
         if first_meshed_alone {
             let quality = quality_of(&mesh.surfaces);
             r.insert(
