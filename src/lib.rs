@@ -6,7 +6,7 @@
 
 pub mod adaptive;
 pub mod energy;
-pub mod form_factor_study;
+pub mod experiments;
 pub mod fuzzing;
 pub mod memory;
 pub mod options;
@@ -14,7 +14,6 @@ pub mod outputs;
 pub mod pipeline;
 pub mod progress_bar;
 pub mod shard;
-pub mod sweep;
 
 pub use options::{
     DEFAULT_BUDGET, DEFAULT_MAX_ELEMENTS, HIERARCHICAL_MAX_ELEMENTS, InvalidOption, MeshMethod,

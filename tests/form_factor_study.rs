@@ -1,7 +1,7 @@
 //! The form-factor study measures what it claims: exact methods come out exact, sampled ones
 //! improve as they are given more, and the hemicube aliases on patches about a pixel in size.
 
-use penumbra::form_factor_study::{ALIASING_SIDES, StudyOptions, run_study};
+use penumbra::experiments::form_factors::{ALIASING_SIDES, StudyOptions, run_study};
 
 #[test]
 fn the_study_tells_the_methods_apart() {

@@ -1,7 +1,7 @@
 //! The hierarchical solver's full solution of the Cornell box against the project's own
 //! path-traced reference.
 
-use penumbra::sweep::sample_points;
+use penumbra::experiments::sweep::sample_points;
 use penumbra::{RunOptions, run};
 use penumbra_meshing::TriangleLocator;
 use penumbra_scenes::{Visibility, load_scene};

@@ -31,14 +31,14 @@ pub(crate) struct FormFactorArgs {
 }
 
 pub(crate) fn form_factors(args: &FormFactorArgs) -> Result<(), Failure> {
-    let options = penumbra::form_factor_study::StudyOptions {
+    let options = penumbra::experiments::form_factors::StudyOptions {
         rays: args.rays,
         samples: args.samples.clone(),
         resolutions: args.resolutions.clone(),
         streams: args.streams,
         cube_elements: args.cube_elements,
     };
-    let study = penumbra::form_factor_study::run_study(&options).map_err(usage)?;
+    let study = penumbra::experiments::form_factors::run_study(&options).map_err(usage)?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
     let path = args.out.join("form-factors.json");

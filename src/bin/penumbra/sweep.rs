@@ -77,13 +77,13 @@ pub(crate) fn sweep(args: &SweepArgs) -> Result<(), Failure> {
         .samples
         .unwrap_or(if args.direct_only { 4000 } else { 1000 });
     let methods = match args.methods.is_empty() {
-        true => penumbra::sweep::SweepMethod::DEFAULT.to_vec(),
-        false => penumbra::sweep::SweepMethod::ALL
+        true => penumbra::experiments::sweep::SweepMethod::DEFAULT.to_vec(),
+        false => penumbra::experiments::sweep::SweepMethod::ALL
             .into_iter()
             .filter(|m| args.methods.iter().any(|n| n == m.name()))
             .collect(),
     };
-    let options = penumbra::sweep::SweepOptions {
+    let options = penumbra::experiments::sweep::SweepOptions {
         budgets: args.budgets.clone(),
         methods,
         surfaces: args.surfaces.clone(),
@@ -120,16 +120,16 @@ pub(crate) fn sweep(args: &SweepArgs) -> Result<(), Failure> {
     let scene = &loaded.scene;
     let visibility = penumbra_scenes::Visibility::build(scene);
     let samples =
-        penumbra::sweep::sample_points(scene, &visibility, &surfaces, sample_count, args.seed);
+        penumbra::experiments::sweep::sample_points(scene, &visibility, &surfaces, sample_count, args.seed);
     if samples.is_empty() {
         return Err(usage(anyhow::anyhow!(
             "no sample points: the surfaces scored must not all be emitters"
         )));
     }
     let reference = if args.direct_only {
-        penumbra::sweep::Reference::ExactDirect
+        penumbra::experiments::sweep::Reference::ExactDirect
     } else {
-        penumbra::sweep::Reference::PathTraced(traced_reference(
+        penumbra::experiments::sweep::Reference::PathTraced(traced_reference(
             args,
             &loaded,
             &visibility,
@@ -137,15 +137,15 @@ pub(crate) fn sweep(args: &SweepArgs) -> Result<(), Failure> {
         )?)
     };
     let bars = Bars::new(args.quiet);
-    let result = penumbra::sweep::sweep(&loaded, &options, &samples, &reference, &bars)
+    let result = penumbra::experiments::sweep::sweep(&loaded, &options, &samples, &reference, &bars)
         .map_err(|e| run_failure(e, Command::Sweep))?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
-    let csv = penumbra::sweep::sweep_csv(&result);
+    let csv = penumbra::experiments::sweep::sweep_csv(&result);
     penumbra::outputs::write_atomic(&args.out.join("sweep.csv"), csv.as_bytes())?;
     let json = serde_json::to_string_pretty(&result)?;
     penumbra::outputs::write_atomic(&args.out.join("sweep.json"), json.as_bytes())?;
-    for (stem, chart) in penumbra::sweep::sweep_charts(&result) {
+    for (stem, chart) in penumbra::experiments::sweep::sweep_charts(&result) {
         penumbra::outputs::write_atomic(
             &args.out.join(format!("{stem}.svg")),
             chart.svg().as_bytes(),
@@ -194,7 +194,7 @@ fn traced_reference(
     args: &SweepArgs,
     loaded: &penumbra_scenes::LoadedScene,
     visibility: &penumbra_scenes::Visibility,
-    samples: &[penumbra::sweep::Sample],
+    samples: &[penumbra::experiments::sweep::Sample],
 ) -> Result<Vec<penumbra_solver::path_trace::ReferenceValue>, Failure> {
     #[derive(serde::Serialize, serde::Deserialize)]
     struct Cached {
