@@ -1,3 +1,4 @@
+#![warn(missing_docs)]
 //! # penumbra
 //!
 //! The pipeline that turns a scene into a radiosity solution — mesh, visibility, exact direct
@@ -7,12 +8,12 @@
 pub mod adaptive;
 pub mod energy;
 pub mod experiments;
+#[doc(hidden)] // Support for the fuzz targets and their tests, not an API.
 pub mod fuzzing;
 pub mod memory;
 pub mod options;
 pub mod outputs;
 pub mod pipeline;
-pub mod progress_bar;
 pub mod shard;
 
 pub use options::{

@@ -7,6 +7,7 @@ mod camera;
 mod failure;
 mod form_factors;
 mod merge;
+mod progress_bar;
 mod replay;
 mod run;
 mod run_args;

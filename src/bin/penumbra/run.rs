@@ -4,7 +4,7 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use penumbra::outputs::{Invocation, SvgSelection, write_outputs};
-use penumbra::progress_bar::Bars;
+use crate::progress_bar::Bars;
 use penumbra_solver::Interrupt;
 
 use crate::failure::{Command, Failure, invalid_option, run_failure, usage};

@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use anyhow::Context;
-use penumbra::progress_bar::Bars;
+use crate::progress_bar::Bars;
 use penumbra_scenes::ObjOptions;
 use penumbra_solver::SolverOptions;
 
