@@ -125,7 +125,7 @@ impl ElementBudget {
 
 /// Triangles a polygon of `vertices` corners needs at least: `vertices - 2` (and one for a
 /// degenerate polygon, which validation refuses anyway).
-pub fn polygon_triangles(vertices: usize) -> usize {
+pub(crate) fn polygon_triangles(vertices: usize) -> usize {
     vertices.saturating_sub(2).max(1)
 }
 

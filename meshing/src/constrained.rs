@@ -24,12 +24,12 @@ use spade::Triangulation as _;
 
 /// Constraint endpoints closer than this (in mesh units, where the polygon's extent is 1) are
 /// one vertex: 2^-30, about 1e-9.
-pub const MERGE_DISTANCE: f64 = 1.0 / (1u64 << 30) as f64;
+pub(crate) const MERGE_DISTANCE: f64 = 1.0 / (1u64 << 30) as f64;
 /// Margin of the frame around a constrained polygon, relative to its extent.
 const FRAME_MARGIN: f64 = 0.05;
 /// Smallest angle the refinement of constrained meshes aims for: constraints may meet at any
 /// angle, and 20 degrees keeps Ruppert's refinement from cascading around them.
-pub const CONSTRAINED_MIN_ANGLE_DEG: f64 = 20.0;
+pub(crate) const CONSTRAINED_MIN_ANGLE_DEG: f64 = 20.0;
 
 thread_local! {
     /// Set while a panic would be caught and turned into an error ([`quietly`]).

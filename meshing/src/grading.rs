@@ -31,7 +31,7 @@ const CORNER_PULL: f64 = 0.1;
 /// A piecewise constant density over a surface: how many times smaller in area its triangles
 /// should be than the base size.
 #[derive(Clone)]
-pub struct Density {
+pub(crate) struct Density {
     pilot: Cdt,
     /// By pilot face index.
     factors: Vec<f64>,
@@ -104,7 +104,7 @@ impl Density {
     }
 
     /// The density at `p` (mesh coordinates); on a pilot edge or vertex, the largest around it.
-    pub fn at(&self, p: DVec2) -> f64 {
+    pub(crate) fn at(&self, p: DVec2) -> f64 {
         let of_face =
             |f: spade::handles::FixedFaceHandle<spade::handles::InnerTag>| self.factors[f.index()];
         match self.pilot.locate(spade::Point2::new(p.x, p.y)) {
@@ -127,7 +127,7 @@ impl Density {
     }
 
     /// The largest density anywhere.
-    pub fn max_factor(&self) -> f64 {
+    pub(crate) fn max_factor(&self) -> f64 {
         self.max_factor
     }
 }

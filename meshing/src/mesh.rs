@@ -8,10 +8,10 @@ use serde::Serialize;
 use crate::error::MeshError;
 
 /// Relative agreement required between the triangles' total area and the meshed polygon's.
-pub const AREA_CHECK_TOLERANCE: f64 = 1e-12;
+pub(crate) const AREA_CHECK_TOLERANCE: f64 = 1e-12;
 /// How far (in mesh units, where the polygon's extent is 1) a vertex that splits a boundary or
 /// constraint edge may sit off the exact segment: the rounding of the split point.
-pub const ON_SEGMENT_TOLERANCE: f64 = 1e-12;
+pub(crate) const ON_SEGMENT_TOLERANCE: f64 = 1e-12;
 
 /// The mesh of one surface. Values live at vertices and are interpolated linearly over triangles.
 ///

@@ -103,7 +103,7 @@ impl SceneMesh {
 /// (it only words the error). A fitted budget is resolved from the minima
 /// ([`ElementBudget::resolve_for`]). Returns the resolved budget and the targets, which never
 /// sum to more than it.
-pub fn spread_by_area(
+pub(crate) fn spread_by_area(
     areas: &[f64],
     minimum: &[usize],
     budget: impl Into<ElementBudget>,
@@ -186,7 +186,7 @@ pub fn mesh_scene_discontinuity(
 /// Discontinuity segment ends within this many contact distances of another end or segment are
 /// joined to it in the mesh: the search places a trimmed end to within a contact distance (where
 /// hits stop counting) plus its trimming tolerance (at most one more).
-pub const JOIN_CONTACT_DISTANCES: f64 = 4.0;
+pub(crate) const JOIN_CONTACT_DISTANCES: f64 = 4.0;
 
 /// [`mesh_scene_discontinuity`] of the surfaces `on` holds (all when `None`), when each
 /// surface's share of the budget depends on it alone ([`ElementBudget::shared_extra`]): the
@@ -327,13 +327,13 @@ pub fn mesh_scene_discontinuity_on(
 /// At most this share of a budget goes to surfaces beyond their share by area, so that their
 /// least meshes at the quality refinement's angle fit: a small face crossed by lines at a small
 /// angle (a block's side in the Cornell box) needs a few hundred triangles for that.
-pub const QUALITY_EXTRA_SHARE: f64 = 0.125;
+pub(crate) const QUALITY_EXTRA_SHARE: f64 = 0.125;
 
 /// The least meshes to spread a budget over: each surface's least quality mesh (`quality[s]`)
 /// instead of its least mesh (`minimum[s]`) where that is within its share `targets[s]`, and
 /// for as many others as [`QUALITY_EXTRA_SHARE`] of `budget` holds (and the least meshes
 /// together fit it), those that need the fewest triangles beyond their share first.
-pub fn quality_minima(
+pub(crate) fn quality_minima(
     minimum: &[usize],
     targets: &[usize],
     quality: &[Option<usize>],
@@ -368,7 +368,7 @@ pub fn quality_minima(
 /// Each surface's least mesh (`minimum[s]`) and its share of `extra` triangles by area: a
 /// target that depends on the surface alone, and targets that sum to the least mesh and at most
 /// `extra`. Surfaces not `meshed` get none. Returns the targets' sum and the targets.
-pub fn share_alone(
+pub(crate) fn share_alone(
     areas: &[f64],
     minimum: &[usize],
     meshed: &[bool],

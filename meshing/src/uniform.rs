@@ -21,19 +21,19 @@ use crate::grading::Density;
 use crate::mesh::SurfaceMesh;
 
 /// Grid of mesh coordinates: 2^-36 of a polygon's extent (about 1.5e-11).
-pub const SNAP_BITS: i32 = 36;
+pub(crate) const SNAP_BITS: i32 = 36;
 /// Marks (see [`MeshCoordinates::of_surface_marked`]) are compared on a grid of 2^-24 of the
 /// polygon's diameter (about 6e-8): coarse against rounding, so that the frame a mark is seen
 /// from does not change what is compared.
-pub const MARK_QUANTUM: f64 = 1.0 / (1u64 << 24) as f64;
+pub(crate) const MARK_QUANTUM: f64 = 1.0 / (1u64 << 24) as f64;
 /// Smallest angle the refinement aims for.
-pub const MIN_ANGLE_DEG: f64 = 25.0;
+pub(crate) const MIN_ANGLE_DEG: f64 = 25.0;
 /// Triangles smaller than this (mesh units, where the polygon's extent is 1: (2^-24)^2, about
 /// (6e-8)^2) are left as they are by the search for the least quality mesh (the least mesh at
 /// the angle, with no area bound). Only features a few hundred merge distances apart
 /// ([`crate::constrained::MERGE_DISTANCE`], 2^-30) make triangles that small; the floor keeps the
 /// refinement from chasing them down to rounding.
-pub const QUALITY_FLOOR_AREA: f64 = 1.0 / (1u64 << 48) as f64;
+pub(crate) const QUALITY_FLOOR_AREA: f64 = 1.0 / (1u64 << 48) as f64;
 
 /// Rounds of graded refinement: each halves the triangles still too large, so a density of
 /// 2^8 is reached.
@@ -71,7 +71,7 @@ const CAPPED_ROUNDS: usize = 8;
 /// The triangulation type. It keeps spade's default hint generator: with
 /// `HierarchyHintGenerator`, `add_constraint_and_split` panics on random crossing segments
 /// (spade 2.15.1: 125 of 2,000 random sets of up to 60 segments), and the default one does not.
-pub type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
+pub(crate) type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
 
 pub(crate) fn snap(x: f64) -> f64 {
     let grid = 2f64.powi(SNAP_BITS);
@@ -80,14 +80,17 @@ pub(crate) fn snap(x: f64) -> f64 {
 
 /// A surface's polygon in mesh coordinates, with the frame and scale that map it back.
 #[derive(Clone, Debug)]
-pub struct MeshCoordinates {
+pub(crate) struct MeshCoordinates {
     pub frame: PlaneFrame,
     pub scale: f64,
     pub boundary: Vec<DVec2>,
 }
 
 impl MeshCoordinates {
-    pub fn of_surface(id: SurfaceId, surface: &Surface) -> Result<MeshCoordinates, MeshError> {
+    pub(crate) fn of_surface(
+        id: SurfaceId,
+        surface: &Surface,
+    ) -> Result<MeshCoordinates, MeshError> {
         MeshCoordinates::of_surface_marked(id, surface, &[])
     }
 
@@ -96,7 +99,7 @@ impl MeshCoordinates {
     /// [`canonical_starts`]: a polygon with a rotational symmetry has several, from which it
     /// looks the same, and of those the one from which the marks look greatest is taken, so that
     /// the mesh follows the marks, not the polygon's list.
-    pub fn of_surface_marked(
+    pub(crate) fn of_surface_marked(
         id: SurfaceId,
         surface: &Surface,
         marks: &[DVec3],
@@ -248,7 +251,10 @@ pub(crate) struct SurfaceTriangulation {
 
 impl SurfaceTriangulation {
     /// The polygon's own constrained Delaunay triangulation, unrefined.
-    pub fn of_surface(id: SurfaceId, surface: &Surface) -> Result<SurfaceTriangulation, MeshError> {
+    pub(crate) fn of_surface(
+        id: SurfaceId,
+        surface: &Surface,
+    ) -> Result<SurfaceTriangulation, MeshError> {
         let coords = MeshCoordinates::of_surface(id, surface)?;
         let cdt = boundary_cdt(id, &coords)?;
         Ok(SurfaceTriangulation::new(coords, cdt, true))
@@ -256,7 +262,11 @@ impl SurfaceTriangulation {
 
     /// A triangulation of the polygon of `coords`; `boundary_only` when its only constraint
     /// edges are the polygon's.
-    pub fn new(coords: MeshCoordinates, cdt: Cdt, boundary_only: bool) -> SurfaceTriangulation {
+    pub(crate) fn new(
+        coords: MeshCoordinates,
+        cdt: Cdt,
+        boundary_only: bool,
+    ) -> SurfaceTriangulation {
         let mut t = SurfaceTriangulation {
             coords,
             cdt,
@@ -269,7 +279,7 @@ impl SurfaceTriangulation {
     }
 
     /// Recomputes the faces outside the polygon after the triangulation changed.
-    pub fn find_outside(&mut self) {
+    pub(crate) fn find_outside(&mut self) {
         self.outside = if self.boundary_only {
             outside_faces(&mut self.cdt)
         } else {
@@ -278,14 +288,14 @@ impl SurfaceTriangulation {
     }
 
     /// Triangles inside the polygon.
-    pub fn count(&self) -> usize {
+    pub(crate) fn count(&self) -> usize {
         self.cdt.num_inner_faces() - self.outside.len()
     }
 
     /// The least refinement in which every angle the input does not force is at least
     /// `min_angle_deg` (Ruppert's refinement with no area bound), if it takes at most
     /// `most_added` more vertices; refinements of it to a budget keep those angles.
-    pub fn quality_least(
+    pub(crate) fn quality_least(
         &self,
         min_angle_deg: f64,
         most_added: usize,
@@ -307,7 +317,7 @@ impl SurfaceTriangulation {
 
     /// A refinement with about `target` triangles (never more, unless the triangulation already
     /// has more) and angles of at least `min_angle_deg` where the budget allows.
-    pub fn refined(&self, target: usize, min_angle_deg: f64) -> SurfaceTriangulation {
+    pub(crate) fn refined(&self, target: usize, min_angle_deg: f64) -> SurfaceTriangulation {
         self.calibrated(target, min_angle_deg, |max_area| {
             self.refined_to_area(max_area, min_angle_deg, target)
         })
@@ -317,7 +327,7 @@ impl SurfaceTriangulation {
     /// density asks for it: uniform refinement to a base size, then rounds that split the
     /// triangles still too large for their place (at the midpoint of their longest edge, or at
     /// their centroid when that edge is fixed), each followed by quality refinement.
-    pub fn refined_graded(
+    pub(crate) fn refined_graded(
         &self,
         target: usize,
         min_angle_deg: f64,
@@ -351,7 +361,7 @@ impl SurfaceTriangulation {
     /// Splits the triangles that hold one of `points` (each once), then refines for quality
     /// (angles of at least `min_angle_deg`, nothing refined below a thousandth of the smallest
     /// split triangle). Returns how many vertices were added.
-    pub fn split_triangles_at(&mut self, points: &[DVec2], min_angle_deg: f64) -> usize {
+    pub(crate) fn split_triangles_at(&mut self, points: &[DVec2], min_angle_deg: f64) -> usize {
         self.split_and_repair(points, min_angle_deg).0
     }
 
@@ -613,7 +623,7 @@ impl SurfaceTriangulation {
         refined
     }
 
-    pub fn into_mesh(self, id: SurfaceId, surface: &Surface) -> SurfaceMesh {
+    pub(crate) fn into_mesh(self, id: SurfaceId, surface: &Surface) -> SurfaceMesh {
         extract(id, surface, self.coords, &self.cdt, &self.outside)
     }
 }

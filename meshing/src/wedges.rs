@@ -16,11 +16,11 @@ use crate::mesh::{ON_SEGMENT_TOLERANCE, SurfaceMesh};
 /// end: it lays them out in shells around the meeting point and leaves them (Ruppert 1995;
 /// Shewchuk 2000, "Mesh generation for domains with small angles": the angle guarantee holds
 /// only away from input angles under 60 degrees).
-pub const SHELL_ANGLE_DEG: f64 = 60.0;
+pub(crate) const SHELL_ANGLE_DEG: f64 = 60.0;
 
 /// Per vertex, the directions of the input edges that leave it and the input edges it is on.
 #[derive(Clone, Debug)]
-pub struct InputWedges {
+pub(crate) struct InputWedges {
     /// Each vertex's place: copies of a vertex split along a value discontinuity share one.
     place_of: Vec<u32>,
     /// Per place, the angles of the input edges leaving it, sorted, in `[-pi, pi]`.
@@ -32,7 +32,7 @@ pub struct InputWedges {
 }
 
 impl InputWedges {
-    pub fn of(m: &SurfaceMesh) -> InputWedges {
+    pub(crate) fn of(m: &SurfaceMesh) -> InputWedges {
         let mut places: HashMap<(u64, u64), u32> = HashMap::new();
         let place_of: Vec<u32> = m
             .local
@@ -95,7 +95,7 @@ impl InputWedges {
     /// Whether the input forces the corner of triangle `tri` at its `k`-th vertex below
     /// `limit` (radians): the corner lies in a narrower wedge of input edges, or the triangle
     /// lies between two input edges that meet at less than [`SHELL_ANGLE_DEG`].
-    pub fn forces(&self, local: &[DVec2], tri: [u32; 3], k: usize, limit: f64) -> bool {
+    pub(crate) fn forces(&self, local: &[DVec2], tri: [u32; 3], k: usize, limit: f64) -> bool {
         let [v, a, b] = [tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]].map(|i| i as usize);
         let (da, db) = (
             (local[a] - local[v]).normalize(),
@@ -125,7 +125,7 @@ impl InputWedges {
     /// The angle (radians) of the wedge between input edges at vertex `v` that holds the corner
     /// turning counter-clockwise from direction `from` to direction `to`; a full turn where fewer
     /// than two input edges leave `v`.
-    pub fn around(&self, v: usize, from: DVec2, to: DVec2) -> f64 {
+    pub(crate) fn around(&self, v: usize, from: DVec2, to: DVec2) -> f64 {
         let dirs = &self.directions[self.place_of[v] as usize];
         if dirs.len() < 2 {
             return TAU;

@@ -34,7 +34,7 @@ const NO_TWIN: u32 = u32::MAX;
 
 /// Faces that become one surface, and its polygon. A piece of one face keeps the face's polygon.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Piece {
+pub(crate) struct Piece {
     /// Indices of the faces, ascending.
     pub faces: Vec<usize>,
     pub polygon: Vec<DVec3>,
@@ -42,7 +42,7 @@ pub struct Piece {
 
 /// What merging did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct MergeSummary {
+pub(crate) struct MergeSummary {
     /// Faces that are now part of a larger surface.
     pub merged_faces: usize,
     /// The surfaces they became.
@@ -55,7 +55,7 @@ pub struct MergeSummary {
 /// Merges coplanar adjacent faces of the same group. `polygons[i]` is face `i`, in the group
 /// `groups[i]`; `scene_diagonal` scales the tolerances, as in validation. Returns pieces covering
 /// every face once, in the order of their first faces.
-pub fn merge_coplanar(
+pub(crate) fn merge_coplanar(
     polygons: &[Vec<DVec3>],
     groups: &[usize],
     scene_diagonal: f64,

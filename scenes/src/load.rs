@@ -73,7 +73,7 @@ pub fn read_scene_file(path: &Path) -> Result<(Scene, Vec<String>), SceneError> 
 }
 
 /// Reads a scene file without validating it, with choices for OBJ files.
-pub fn read_scene_file_with(
+pub(crate) fn read_scene_file_with(
     path: &Path,
     options: &ObjOptions,
 ) -> Result<(Scene, Vec<String>), SceneError> {
@@ -128,7 +128,7 @@ fn strip_position(message: &str) -> String {
 
 /// Removes vertices exactly equal to their predecessor, and a closing vertex equal to the first:
 /// both are common ways of writing a polygon and neither changes its shape.
-pub fn drop_repeated_vertices(polygon: &mut Vec<DVec3>) {
+pub(crate) fn drop_repeated_vertices(polygon: &mut Vec<DVec3>) {
     polygon.dedup();
     while polygon.len() > 1 && polygon.first() == polygon.last() {
         polygon.pop();

@@ -32,7 +32,7 @@ use source_lines::SourceLines;
 use tally::{FaceSource, Tally, thousands};
 
 /// Reflectance of faces without a material.
-pub const DEFAULT_REFLECTANCE: f64 = 0.5;
+pub(crate) const DEFAULT_REFLECTANCE: f64 = 0.5;
 
 /// The highest reflectance an OBJ material gets: `Kd` channels at or above 1 are clamped to it.
 /// A reflectance of 1 keeps all the light a surface receives, which the radiosity equation
@@ -58,7 +58,7 @@ impl Default for ObjOptions {
 }
 
 /// Reads an OBJ file and the MTL files it names, looked for beside it.
-pub fn read_obj_with(
+pub(crate) fn read_obj_with(
     path: &Path,
     options: &ObjOptions,
 ) -> Result<(Scene, Vec<String>), SceneError> {

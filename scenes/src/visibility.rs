@@ -43,14 +43,14 @@ pub const JUNCTION_OFFSET: f64 = 1e-7;
 /// scene, and obvhs's slab test rounds three terms under 2 in size: together under 5e-7. The
 /// slab test also replaces direction components under `f32::EPSILON` by `f32::EPSILON`, which
 /// moves the ray by under 1.2e-7 over that length. Boxes themselves are rounded outward.
-pub const BOX_PADDING: f64 = 1e-6;
+pub(crate) const BOX_PADDING: f64 = 1e-6;
 /// The ray parameter at which obvhs starts every box of its ray traversal (`cwbvh::node::EPSILON`,
 /// in f32-world units: scene diagonals). Its slab test ignores the ray's own `tmin`, so a box that
 /// the ray leaves before this parameter is never entered.
-pub const TRAVERSAL_BOX_START: f64 = 1e-4;
+pub(crate) const TRAVERSAL_BOX_START: f64 = 1e-4;
 /// How far before the start of a query the f32 ray starts, in scene diagonals: everything the
 /// query can meet then lies past [`TRAVERSAL_BOX_START`] along the f32 ray, with room to spare.
-pub const RAY_LEAD: f64 = 2.0 * TRAVERSAL_BOX_START;
+pub(crate) const RAY_LEAD: f64 = 2.0 * TRAVERSAL_BOX_START;
 
 /// One triangle of a scene surface, with the surface's own (unrounded) vertices.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -143,7 +143,7 @@ impl std::fmt::Debug for Visibility {
 }
 
 /// Triangulates every surface of a scene, keeping each surface's own vertices.
-pub fn triangulate_scene(scene: &Scene) -> Vec<SceneTriangle> {
+pub(crate) fn triangulate_scene(scene: &Scene) -> Vec<SceneTriangle> {
     let mut out = Vec::new();
     for (surface, s) in scene.surfaces.iter().enumerate() {
         let Some(frame) = PlaneFrame::of_polygon(&s.polygon) else {
@@ -601,7 +601,7 @@ fn round_down(x: f64) -> f32 {
 
 /// Watertight ray–triangle intersection (Woop, Benthin & Wald 2013) in f64; no back-face culling.
 /// Returns the ray parameter of the hit. Points on an edge or a vertex count as hits.
-pub fn intersect_watertight(origin: DVec3, direction: DVec3, v: &[DVec3; 3]) -> Option<f64> {
+pub(crate) fn intersect_watertight(origin: DVec3, direction: DVec3, v: &[DVec3; 3]) -> Option<f64> {
     let d = direction.to_array();
     let abs = direction.abs();
     let kz = if abs.x >= abs.y && abs.x >= abs.z {

@@ -5,7 +5,7 @@ use glam::{DVec2, DVec3};
 use penumbra_scenes::polygon::orient;
 
 /// The part of a polygon where `height(p) >= 0` (Sutherland–Hodgman). Convex in, convex out.
-pub fn clip_polygon_3d(polygon: &[DVec3], height: impl Fn(DVec3) -> f64) -> Vec<DVec3> {
+pub(crate) fn clip_polygon_3d(polygon: &[DVec3], height: impl Fn(DVec3) -> f64) -> Vec<DVec3> {
     let n = polygon.len();
     let mut out = Vec::with_capacity(n + 2);
     for i in 0..n {
@@ -23,7 +23,7 @@ pub fn clip_polygon_3d(polygon: &[DVec3], height: impl Fn(DVec3) -> f64) -> Vec<
 
 /// The part of a convex polygon left of (or on) the directed line `a -> b`. The side of each
 /// vertex is decided exactly; only the new crossing points are rounded.
-pub fn clip_left_of(polygon: &[DVec2], a: DVec2, b: DVec2) -> Vec<DVec2> {
+pub(crate) fn clip_left_of(polygon: &[DVec2], a: DVec2, b: DVec2) -> Vec<DVec2> {
     let n = polygon.len();
     let sides: Vec<f64> = polygon.iter().map(|&p| orient(a, b, p)).collect();
     if sides.iter().all(|&s| s >= 0.0) {
@@ -50,7 +50,7 @@ pub fn clip_left_of(polygon: &[DVec2], a: DVec2, b: DVec2) -> Vec<DVec2> {
     out
 }
 
-pub fn area_2d(polygon: &[DVec2]) -> f64 {
+pub(crate) fn area_2d(polygon: &[DVec2]) -> f64 {
     penumbra_scenes::polygon::signed_area_2d(polygon)
 }
 
@@ -64,7 +64,7 @@ fn bounds_2d(polygon: &[DVec2]) -> (DVec2, DVec2) {
 
 /// Removes vertices within `tol` of the vertex before them (clipping makes such near-duplicates;
 /// the line through two of them has no reliable direction).
-pub fn merge_close_vertices(polygon: &mut Vec<DVec2>, tol: f64) {
+pub(crate) fn merge_close_vertices(polygon: &mut Vec<DVec2>, tol: f64) {
     let mut out: Vec<DVec2> = Vec::with_capacity(polygon.len());
     for &p in polygon.iter() {
         if out.last().is_none_or(|&q| q.distance(p) > tol) {
@@ -78,7 +78,7 @@ pub fn merge_close_vertices(polygon: &mut Vec<DVec2>, tol: f64) {
 }
 
 /// Largest distance between two vertices.
-pub fn diameter_2d(polygon: &[DVec2]) -> f64 {
+pub(crate) fn diameter_2d(polygon: &[DVec2]) -> f64 {
     let mut d2: f64 = 0.0;
     for (i, &a) in polygon.iter().enumerate() {
         for &b in &polygon[i + 1..] {
@@ -89,14 +89,19 @@ pub fn diameter_2d(polygon: &[DVec2]) -> f64 {
 }
 
 /// Whether a convex polygon is wider than `min_width` (area over diameter estimates the width).
-pub fn wider_than(polygon: &[DVec2], min_width: f64) -> bool {
+pub(crate) fn wider_than(polygon: &[DVec2], min_width: f64) -> bool {
     polygon.len() >= 3 && area_2d(polygon) > min_width * diameter_2d(polygon)
 }
 
 /// `piece - hole` for convex counter-clockwise polygons, as convex pieces. Pieces no wider than
 /// `min_width` (slivers left by rounding) are dropped. The hole must not have repeated vertices
 /// ([`merge_close_vertices`]).
-pub fn subtract_convex(piece: &[DVec2], hole: &[DVec2], min_width: f64, out: &mut Vec<Vec<DVec2>>) {
+pub(crate) fn subtract_convex(
+    piece: &[DVec2],
+    hole: &[DVec2],
+    min_width: f64,
+    out: &mut Vec<Vec<DVec2>>,
+) {
     let (plo, phi) = bounds_2d(piece);
     let (hlo, hhi) = bounds_2d(hole);
     if plo.cmpgt(hhi).any() || hlo.cmpgt(phi).any() {
@@ -124,7 +129,7 @@ pub fn subtract_convex(piece: &[DVec2], hole: &[DVec2], min_width: f64, out: &mu
 
 /// The convex hull of `points`, counter-clockwise, without collinear corners (Andrew's monotone
 /// chain, turns decided exactly).
-pub fn convex_hull_2d(mut points: Vec<DVec2>) -> Vec<DVec2> {
+pub(crate) fn convex_hull_2d(mut points: Vec<DVec2>) -> Vec<DVec2> {
     points.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
     points.dedup();
     if points.len() < 3 {
@@ -149,14 +154,14 @@ pub fn convex_hull_2d(mut points: Vec<DVec2>) -> Vec<DVec2> {
 }
 
 /// Whether `p` lies inside or on a convex counter-clockwise polygon.
-pub fn inside_convex(p: DVec2, polygon: &[DVec2]) -> bool {
+pub(crate) fn inside_convex(p: DVec2, polygon: &[DVec2]) -> bool {
     let n = polygon.len();
     (0..n).all(|i| orient(polygon[i], polygon[(i + 1) % n], p) >= 0.0)
 }
 
 /// A half-plane `{c : normal . c + offset >= 0}`.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct HalfPlane {
+pub(crate) struct HalfPlane {
     pub normal: DVec2,
     pub offset: f64,
 }
@@ -175,7 +180,7 @@ impl HalfPlane {
 }
 
 /// The part of a convex polygon inside a half-plane.
-pub fn clip_half_plane(polygon: &[DVec2], h: &HalfPlane) -> Vec<DVec2> {
+pub(crate) fn clip_half_plane(polygon: &[DVec2], h: &HalfPlane) -> Vec<DVec2> {
     let n = polygon.len();
     let values: Vec<f64> = polygon.iter().map(|&p| h.value(p)).collect();
     if values.iter().all(|&v| v >= 0.0) {
@@ -204,7 +209,7 @@ const DEGENERATE_EDGE: f64 = 1e-9;
 
 /// The part of a closed contour inside a convex counter-clockwise polygon (Sutherland–Hodgman,
 /// which keeps the contour's winding inside), or `None` when none is.
-pub fn clip_to_convex(contour: &[DVec2], convex: &[DVec2]) -> Option<Vec<DVec2>> {
+pub(crate) fn clip_to_convex(contour: &[DVec2], convex: &[DVec2]) -> Option<Vec<DVec2>> {
     let ((lo, hi), (convex_lo, convex_hi)) = (bounds_2d(contour), bounds_2d(convex));
     if lo.cmpgt(convex_hi).any() || convex_lo.cmpgt(hi).any() {
         return None;
@@ -238,7 +243,7 @@ pub fn clip_to_convex(contour: &[DVec2], convex: &[DVec2]) -> Option<Vec<DVec2>>
 
 /// `piece` minus the convex region where every half-plane holds, as convex pieces no narrower
 /// than `min_width`.
-pub fn subtract_half_planes(
+pub(crate) fn subtract_half_planes(
     piece: &[DVec2],
     region: &[HalfPlane],
     min_width: f64,

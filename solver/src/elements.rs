@@ -279,7 +279,7 @@ impl Discretization {
 /// How many gaps off a hovering face's contact line its vertices are evaluated: the face's blur
 /// fades over a few gaps (to under 0.3 % of the light at 10 for light from all directions), so the
 /// value there stands for the element, where the value right at the line would not.
-pub const HOVER_LIFT: f64 = 10.0;
+pub(crate) const HOVER_LIFT: f64 = 10.0;
 
 /// Per vertex of `m`, how far to move it into its own triangles before evaluating it: a
 /// [`HOVER_LIFT`] of gaps for vertices on the contact line of a hovering face, at most a quarter

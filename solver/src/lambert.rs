@@ -57,7 +57,7 @@ impl ReceivingPoint {
 
 /// Θ (n · Γ) for the directed edge `a -> b` seen from `x`: the edge's contribution to the contour
 /// sum. `tol` is the distance under which x counts as lying on a vertex or on the edge's line.
-pub fn edge_term(x: &ReceivingPoint, a: DVec3, b: DVec3, tol: f64) -> f64 {
+pub(crate) fn edge_term(x: &ReceivingPoint, a: DVec3, b: DVec3, tol: f64) -> f64 {
     let ra = a - x.point;
     let rb = b - x.point;
     let (la, lb) = (ra.length(), rb.length());
@@ -108,7 +108,7 @@ pub fn edge_term(x: &ReceivingPoint, a: DVec3, b: DVec3, tol: f64) -> f64 {
 /// plane, 6 units away, half of them). When the terms are more than [`CANCELLATION_LIMIT`] times
 /// their sum, the form factor is integrated directly instead ([`quadrature_sum`]), where the
 /// cosines are computed from the coordinates and keep all their digits.
-pub fn contour_sum(x: &ReceivingPoint, polygon: &[DVec3], tol: f64) -> f64 {
+pub(crate) fn contour_sum(x: &ReceivingPoint, polygon: &[DVec3], tol: f64) -> f64 {
     let n = polygon.len();
     let (mut sum, mut magnitude) = (0.0, 0.0);
     for i in 0..n {
@@ -133,13 +133,13 @@ fn far_from(x: DVec3, polygon: &[DVec3]) -> bool {
 }
 
 /// Edge terms this many times larger than their sum leave fewer than 10 good digits.
-pub const CANCELLATION_LIMIT: f64 = 1e6;
+pub(crate) const CANCELLATION_LIMIT: f64 = 1e6;
 
 /// 2π times the form factor from x to a planar polygon lying wholly in front of it, integrated
 /// directly: the polygon is fanned into triangles, each split until it is smaller than a fiftieth
 /// of its distance from x, and each piece is integrated with the 7-point degree-5 rule
 /// (relative error about (size / distance)^6, 10⁻¹⁰ at a fiftieth).
-pub fn quadrature_sum(x: &ReceivingPoint, polygon: &[DVec3]) -> f64 {
+pub(crate) fn quadrature_sum(x: &ReceivingPoint, polygon: &[DVec3]) -> f64 {
     let normal = penumbra_scenes::polygon::newell_normal(polygon).normalize_or_zero();
     let kernel = |y: DVec3| {
         let d = y - x.point;

@@ -133,7 +133,7 @@ pub(crate) struct OccluderTree {
 }
 
 impl OccluderTree {
-    pub fn build(faces: &[TreeFace]) -> OccluderTree {
+    pub(crate) fn build(faces: &[TreeFace]) -> OccluderTree {
         let mut tree = OccluderTree {
             nodes: Vec::new(),
             items: (0..faces.len()).collect(),
@@ -221,7 +221,7 @@ impl OccluderTree {
     }
 
     /// The faces of sheet `sheet` (as [`Reached::Outline`] gives it).
-    pub fn faces_of(&self, sheet: usize) -> &[usize] {
+    pub(crate) fn faces_of(&self, sheet: usize) -> &[usize] {
         match &self.sheets[sheet].faces {
             Members::Listed(faces) => faces,
             Members::Node(node) => {
@@ -232,13 +232,13 @@ impl OccluderTree {
     }
 
     /// The outline of sheet `sheet`.
-    pub fn outline(&self, sheet: usize) -> &[OutlineEdge] {
+    pub(crate) fn outline(&self, sheet: usize) -> &[OutlineEdge] {
         &self.sheets[sheet].outline
     }
 
     /// Visits what the shaft may hold: whole nodes by their outline where that is exact, else
     /// faces, in a fixed order.
-    pub fn walk(&self, shaft: &ShaftTest, visit: &mut impl FnMut(Reached)) {
+    pub(crate) fn walk(&self, shaft: &ShaftTest, visit: &mut impl FnMut(Reached)) {
         if !self.nodes.is_empty() {
             self.walk_from(0, shaft, visit);
         }

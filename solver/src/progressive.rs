@@ -32,7 +32,7 @@ use crate::direct::DirectLight;
 use crate::elements::{Discretization, Patch};
 use crate::error::SolveError;
 use crate::lambert::ReceivingPoint;
-pub use crate::progress::Interrupt;
+pub(crate) use crate::progress::Interrupt;
 use crate::progress::Progress;
 
 /// Options of the progressive solver; every field is checked by [`SolverOptions::validate`].
@@ -70,10 +70,10 @@ pub const DEFAULT_EPSILON: f64 = 1e-3;
 /// Most visibility rays per vertex–patch pair: stratified rays then resolve a visibility
 /// fraction to about 1/4096, beyond what the form factors' other errors allow; more only makes a
 /// run look hung.
-pub const MAX_VISIBILITY_RAYS: usize = 4096;
+pub(crate) const MAX_VISIBILITY_RAYS: usize = 4096;
 
 /// Most Monte Carlo samples per vertex–patch pair, for the same reason.
-pub const MAX_FORM_FACTOR_SAMPLES: usize = 65_536;
+pub(crate) const MAX_FORM_FACTOR_SAMPLES: usize = 65_536;
 
 impl Default for SolverOptions {
     fn default() -> Self {
@@ -235,7 +235,7 @@ pub struct Solution {
 /// estimated by rays because their view of a light needed a polygon difference beyond the
 /// evaluator's cap; stops early, with [`SolveError::Interrupted`], once `options.interrupt` is
 /// set.
-pub fn direct_irradiance(
+pub(crate) fn direct_irradiance(
     scene: &Scene,
     disc: &Discretization,
     visibility: &Visibility,

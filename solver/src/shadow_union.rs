@@ -65,7 +65,7 @@ pub(crate) type VisibleShape = Vec<Vec<DVec2>>;
 
 impl ShadowUnion {
     /// Room for this many sheet edges.
-    pub fn with_capacity(edges: usize) -> Self {
+    pub(crate) fn with_capacity(edges: usize) -> Self {
         ShadowUnion {
             sheet: Vec::with_capacity(edges),
             contours: Vec::new(),
@@ -74,7 +74,7 @@ impl ShadowUnion {
     }
 
     /// Adds the shadow of a face wholly inside the shaft: its corners' keys and projections.
-    pub fn add_face(&mut self, keys: &[CornerKey], corners: &[DVec2]) {
+    pub(crate) fn add_face(&mut self, keys: &[CornerKey], corners: &[DVec2]) {
         let n = corners.len();
         let reversed = area_2d(corners) < 0.0;
         for i in 0..n {
@@ -96,7 +96,7 @@ impl ShadowUnion {
     /// Adds edges of shadows already fused (a node's outline): corner keys, and the projection
     /// of the first corner. They are one shadow: a rim and the holes in it have no edge between
     /// them, and the rim alone would cover the holes.
-    pub fn add_edges(&mut self, edges: &[(CornerKey, CornerKey, DVec2)]) {
+    pub(crate) fn add_edges(&mut self, edges: &[(CornerKey, CornerKey, DVec2)]) {
         self.sheet.extend(
             edges
                 .iter()
@@ -109,13 +109,13 @@ impl ShadowUnion {
     }
 
     /// Adds a shadow given as a counter-clockwise contour.
-    pub fn add_contour(&mut self, contour: Vec<DVec2>) {
+    pub(crate) fn add_contour(&mut self, contour: Vec<DVec2>) {
         self.contours.push(contour);
     }
 
     /// `piece` (convex, counter-clockwise) minus every shadow, unless the overlay cannot
     /// represent the coordinates (not finite) or the work goes past `limit`.
-    pub fn subtract_from(
+    pub(crate) fn subtract_from(
         self,
         piece: &[DVec2],
         limit: &OverlayLimit,
@@ -125,7 +125,7 @@ impl ShadowUnion {
 
     /// `start` (shapes lying in the convex `bound`) minus every shadow, as
     /// [`Self::subtract_from`].
-    pub fn subtract_within(
+    pub(crate) fn subtract_within(
         self,
         start: Vec<VisibleShape>,
         bound: &[DVec2],
@@ -213,7 +213,7 @@ pub(crate) struct OverlayLimit {
 }
 
 impl OverlayLimit {
-    pub const NONE: OverlayLimit = OverlayLimit {
+    pub(crate) const NONE: OverlayLimit = OverlayLimit {
         edges: usize::MAX,
         deadline: None,
     };

@@ -16,7 +16,7 @@ fn key(p: DVec3) -> [u64; 3] {
 
 /// For each surface, `Some(sign)` when it is a face of a closed, consistently oriented solid:
 /// its outward normal is `sign` times its own normal. `None` for every other surface.
-pub fn closed_solid_orientation(scene: &Scene) -> Vec<Option<f64>> {
+pub(crate) fn closed_solid_orientation(scene: &Scene) -> Vec<Option<f64>> {
     let surfaces = &scene.surfaces;
     // Directed edges by their corners, and the faces that hold them.
     let mut edges: HashMap<([u64; 3], [u64; 3]), Vec<usize>> = HashMap::new();

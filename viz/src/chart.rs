@@ -26,7 +26,7 @@ const FONT: f64 = 8.0;
 /// Series with more points than this are drawn as lines without markers.
 const MAX_MARKERS: usize = 60;
 /// PNG pixels per chart point.
-pub const PNG_SCALE: u32 = 2;
+pub(crate) const PNG_SCALE: u32 = 2;
 
 /// Line colours of successive series (colour-blind safe, after Okabe & Ito).
 const PALETTE: [[u8; 3]; 7] = [

@@ -3,13 +3,13 @@
 use penumbra_scenes::Rgb;
 
 /// Which luminance percentile of the lit (non-emitting) pixels automatic exposure looks at.
-pub const AUTO_EXPOSURE_PERCENTILE: f64 = 0.95;
+pub(crate) const AUTO_EXPOSURE_PERCENTILE: f64 = 0.95;
 /// The display value, before the sRGB curve, that automatic exposure maps that percentile to:
 /// bright but short of clipping.
-pub const AUTO_EXPOSURE_TARGET: f64 = 0.8;
+pub(crate) const AUTO_EXPOSURE_TARGET: f64 = 0.8;
 
 /// Relative luminance of a linear RGB colour (Rec. 709 / sRGB primaries).
-pub fn luminance(c: Rgb) -> f64 {
+pub(crate) fn luminance(c: Rgb) -> f64 {
     0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b
 }
 
@@ -30,7 +30,7 @@ pub fn srgb_encode(linear: f64) -> f64 {
 }
 
 /// An 8-bit sRGB pixel of `linear * exposure`. NaN displays as black.
-pub fn to_srgb8(linear: Rgb, exposure: f64) -> [u8; 3] {
+pub(crate) fn to_srgb8(linear: Rgb, exposure: f64) -> [u8; 3] {
     // In [0, 255] after the clamp in `srgb_encode`, so the cast is exact.
     let encode = |v: f64| (srgb_encode(v * exposure) * 255.0).round() as u8;
     [encode(linear.r), encode(linear.g), encode(linear.b)]
@@ -39,7 +39,7 @@ pub fn to_srgb8(linear: Rgb, exposure: f64) -> [u8; 3] {
 /// The exposure that maps the [`AUTO_EXPOSURE_PERCENTILE`] of `luminances` to
 /// [`AUTO_EXPOSURE_TARGET`]; `None` when there are no values or that percentile is not
 /// positive. The slice is reordered.
-pub fn auto_exposure(luminances: &mut [f64]) -> Option<f64> {
+pub(crate) fn auto_exposure(luminances: &mut [f64]) -> Option<f64> {
     let reference = percentile(luminances, AUTO_EXPOSURE_PERCENTILE)?;
     let exposure = AUTO_EXPOSURE_TARGET / reference;
     (reference > 0.0 && exposure.is_finite()).then_some(exposure)

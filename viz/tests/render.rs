@@ -282,7 +282,8 @@ fn png_files_hold_the_render_as_8_bit_rgb() {
     assert!(bytes.starts_with(&[0x89, b'P', b'N', b'G', 0x0d, 0x0a, 0x1a, 0x0a]));
     // The IHDR chunk: length, "IHDR", width and height (big-endian), bit depth, colour type.
     assert_eq!(&bytes[12..16], b"IHDR");
-    let word = |at: usize| u32::from_be_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]]);
+    let word =
+        |at: usize| u32::from_be_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]]);
     assert_eq!((word(16), word(20)), (image.width(), image.height()));
     assert_eq!((bytes[24], bytes[25]), (8, 2), "8 bits per channel, RGB");
     assert!(matches!(

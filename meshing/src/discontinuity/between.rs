@@ -49,7 +49,7 @@ pub(crate) struct BetweenCount {
 impl BetweenSearch<'_> {
     /// The wedges of the blocker vertices `vertices` with the blocker edges `edges` of the
     /// surfaces `blockers`.
-    pub fn wedges(
+    pub(super) fn wedges(
         &self,
         vertices: &BTreeSet<usize>,
         edges: &BTreeSet<(usize, usize)>,

@@ -14,11 +14,11 @@ use super::clip_to_polygon;
 
 /// A contact line on a receiver: its ends (3D, on the receiver) and the gap under the face that
 /// casts it (zero where the face touches the receiver, positive where it hovers).
-pub type ContactLine = (DVec3, DVec3, f64);
+pub(super) type ContactLine = (DVec3, DVec3, f64);
 
 /// For each receiver with contacts, the segments where other surfaces stand on it, pass through
 /// it from its front side, or hover over it.
-pub fn contact_lines(
+pub(super) fn contact_lines(
     scene: &Scene,
     frames: &[Option<PlaneFrame>],
     visibility: &Visibility,
@@ -100,7 +100,7 @@ fn receiver_contacts(
 /// How close, relative to its diameter, a parallel face must hover over a receiver for its
 /// shadow to count as a contact: the shadow's edge is then blurred over at most this fraction of
 /// the face's size, whatever the light's direction (up to 45 degrees off the normal).
-pub const HOVER: f64 = 1e-3;
+pub(super) const HOVER: f64 = 1e-3;
 
 /// The gap under a polygon lying parallel to the plane, given its vertices' heights, if it hovers
 /// within [`HOVER`] of its diameter.

@@ -31,7 +31,7 @@ const MAX_DEPTH: u32 = 14;
 
 /// A polyline on a receiver where an EEE event meets it.
 #[derive(Clone, Debug, PartialEq)]
-pub struct EeeCurve {
+pub(super) struct EeeCurve {
     pub points: Vec<DVec3>,
     /// The emitter edge, the blocker edge nearer the emitter, and the one nearer the receiver.
     pub edges: [[DVec3; 2]; 3],
@@ -41,7 +41,7 @@ pub struct EeeCurve {
 
 /// What the search over edge triples did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct EeeCount {
+pub(super) struct EeeCount {
     /// Edge triples examined (after silhouette and spatial culling).
     pub considered: usize,
     /// Triples that left a curve.
@@ -124,7 +124,7 @@ impl NearBlockers {
     /// How a shaft with blockers `blockers` finds those near a region: one by one when they are
     /// few, else through the visibility index (`surface_leaves`: [`Visibility::leaf_boxes`] by
     /// surface, when the index has them).
-    pub fn new(
+    pub(super) fn new(
         topology: &Topology,
         blockers: &[SurfaceId],
         surface_leaves: Option<&[Vec<IndexBox>]>,
@@ -157,7 +157,7 @@ impl NearBlockers {
     /// Finds blockers near small regions through the visibility index's box query, whatever
     /// their number: for regions that hold few of the shaft's blockers, walking the leaves of
     /// all of them ([`NearBlockers::Leaves`]) would cost more than the query.
-    pub fn indexed(topology: &Topology, blockers: &[SurfaceId]) -> NearBlockers {
+    pub(super) fn indexed(topology: &Topology, blockers: &[SurfaceId]) -> NearBlockers {
         if blockers.len() <= FEW_BLOCKERS {
             NearBlockers::new(topology, blockers, None)
         } else {
@@ -166,7 +166,7 @@ impl NearBlockers {
     }
 
     /// Calls `found` with each blocker near the box `region` (some maybe more than once).
-    pub fn find(
+    pub(super) fn find(
         &self,
         visibility: &Visibility,
         region: Bounds,
@@ -205,7 +205,7 @@ impl NearBlockers {
 impl EeeSearch<'_> {
     /// The EEE curves of emitter edges `emitter_edges` with the blocker edges `edges` (welded
     /// vertex pairs) of the surfaces `blockers`, and what it took.
-    pub fn curves(
+    pub(super) fn curves(
         &self,
         emitter_edges: &[(usize, usize)],
         edges: &BTreeSet<(usize, usize)>,

@@ -22,7 +22,7 @@ pub(crate) struct Horizon<'a> {
 
 impl Horizon<'_> {
     /// The segments where the emitter's plane cuts the receiver and the emitter is seen.
-    pub fn segments(&self) -> Vec<[DVec3; 2]> {
+    pub(super) fn segments(&self) -> Vec<[DVec3; 2]> {
         let ef = &self.pair.emitter_frame;
         let p = self.receiver_polygon;
         let heights: Vec<f64> = p.iter().map(|&q| ef.height(q)).collect();

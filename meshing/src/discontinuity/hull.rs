@@ -6,7 +6,7 @@ use glam::DVec3;
 /// The outward planes (normal, point) of the convex hull of `points`: every plane through three
 /// of them with all the others on one side (within `tol`). Quartic in the count, for the handful
 /// of corners of two polygons.
-pub fn hull_planes(points: &[DVec3], tol: f64) -> Vec<(DVec3, DVec3)> {
+pub(super) fn hull_planes(points: &[DVec3], tol: f64) -> Vec<(DVec3, DVec3)> {
     let n = points.len();
     let mut planes = Vec::new();
     for i in 0..n {
@@ -35,7 +35,7 @@ pub fn hull_planes(points: &[DVec3], tol: f64) -> Vec<(DVec3, DVec3)> {
 
 /// Whether all of `points` lie more than `tol` beyond one of the `planes`: then nothing spanned by
 /// them meets the hull.
-pub fn beyond_a_face(planes: &[(DVec3, DVec3)], points: &[DVec3], tol: f64) -> bool {
+pub(super) fn beyond_a_face(planes: &[(DVec3, DVec3)], points: &[DVec3], tol: f64) -> bool {
     planes
         .iter()
         .any(|&(n, o)| points.iter().all(|&x| n.dot(x - o) > tol))
@@ -56,7 +56,7 @@ const GROUP_SPREAD: f64 = 1e-3;
 /// beyond every member, and one clearly not beyond it (by less than `tol - spread`) is beyond
 /// none; only in between are the members asked one by one.
 #[derive(Clone, Debug)]
-pub struct HullPlanes {
+pub(super) struct HullPlanes {
     groups: Vec<PlaneGroup>,
 }
 
@@ -71,7 +71,7 @@ struct PlaneGroup {
 impl HullPlanes {
     /// The hull planes of `points` ([`hull_planes`]), grouped for points tested later that lie
     /// within `extent` of every one of `points`.
-    pub fn new(points: &[DVec3], tol: f64, extent: f64) -> HullPlanes {
+    pub(super) fn new(points: &[DVec3], tol: f64, extent: f64) -> HullPlanes {
         // Rounding of one height `n . (x - o)` with |n| = 1 and |x - o| <= extent is below 5 units
         // in the last place of `extent`; four times that for both evaluations and the sums here.
         let rounding = 20.0 * f64::EPSILON * extent;
@@ -103,7 +103,7 @@ impl HullPlanes {
     }
 
     /// [`beyond_a_face`] over every plane.
-    pub fn beyond_a_face(&self, points: &[DVec3], tol: f64) -> bool {
+    pub(super) fn beyond_a_face(&self, points: &[DVec3], tol: f64) -> bool {
         self.groups.iter().any(|g| {
             let (mut clearly_beyond, mut clearly_not) = (true, false);
             for &x in points {

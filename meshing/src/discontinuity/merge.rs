@@ -6,7 +6,7 @@ use penumbra_scenes::UnionFind;
 
 /// A segment on a receiver in its plane-frame coordinates, with what generated it.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct FlatSegment<T> {
+pub(super) struct FlatSegment<T> {
     pub from: DVec2,
     pub to: DVec2,
     pub tag: T,
@@ -17,7 +17,7 @@ pub struct FlatSegment<T> {
 /// combine with `combine`; neighbouring pieces of the union join when `joins` says their tags
 /// may (their tags combining too), and stay apart otherwise. The result is in a deterministic
 /// order.
-pub fn merge_collinear<T: Copy>(
+pub(super) fn merge_collinear<T: Copy>(
     segments: &[FlatSegment<T>],
     tol: f64,
     combine: impl Fn(T, T) -> T,

@@ -22,12 +22,12 @@ pub(crate) struct PairGeometry<'a> {
 
 impl PairGeometry<'_> {
     /// Whether `p` is in front of both the emitter and the receiver.
-    pub fn in_front(&self, p: DVec3) -> bool {
+    pub(super) fn in_front(&self, p: DVec3) -> bool {
         self.emitter_frame.height(p) > self.tol && self.receiver_frame.height(p) > self.tol
     }
 
     /// Surfaces other than the emitter and the receiver: the faces whose outlines count.
-    pub fn not_pair(&self) -> impl Fn(SurfaceId) -> bool + use<> {
+    pub(super) fn not_pair(&self) -> impl Fn(SurfaceId) -> bool + use<> {
         let (e, r) = (self.emitter, self.receiver);
         move |s| s != e && s != r
     }

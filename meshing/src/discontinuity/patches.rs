@@ -19,13 +19,13 @@ const FEW_FACES: usize = 8;
 
 /// Each surface's flat patch, and the points each patch's outline turns at.
 #[derive(Clone, Debug)]
-pub struct Patches {
+pub(super) struct Patches {
     pub of_surface: Vec<usize>,
     pub corners: Vec<Vec<DVec3>>,
 }
 
 impl Patches {
-    pub fn new(topology: &Topology) -> Patches {
+    pub(super) fn new(topology: &Topology) -> Patches {
         let count = topology.loops.len();
         let mut sets = UnionFind::new(count);
         for faces in topology.edges.values() {
@@ -86,7 +86,7 @@ impl Topology {
     /// Whether vertex `v` lies inside a straight stretch of edges with every face around it
     /// holding that line (a vertex splitting one edge of a tessellated solid, or inside a flat
     /// patch): the outline has no corner there, so it starts no EV event.
-    pub fn is_straight(&self, v: usize) -> bool {
+    pub(super) fn is_straight(&self, v: usize) -> bool {
         let here = self.points[v];
         let mut directions: Vec<DVec3> = Vec::new();
         for c in &self.corners[v] {

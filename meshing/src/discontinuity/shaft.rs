@@ -75,7 +75,7 @@ struct Shaft<'a> {
 }
 
 impl<'a> SearchContext<'a> {
-    pub fn new(
+    pub(super) fn new(
         scene: &'a Scene,
         visibility: &'a Visibility,
         options: &'a DiscontinuityOptions,
@@ -103,7 +103,7 @@ impl<'a> SearchContext<'a> {
     }
 
     /// Emitter–receiver pairs that face each other, emitters outermost.
-    pub fn facing_pairs(&self) -> Vec<(SurfaceId, SurfaceId)> {
+    pub(super) fn facing_pairs(&self) -> Vec<(SurfaceId, SurfaceId)> {
         let mut pairs = Vec::new();
         for (e, emitter) in self.scene.emitters() {
             let Some(ef) = self.frames[e] else { continue };
@@ -121,7 +121,7 @@ impl<'a> SearchContext<'a> {
     }
 
     /// Every event of the pair `(e, r)` on `r`.
-    pub fn pair_events(&self, e: SurfaceId, r: SurfaceId) -> PairEvents {
+    pub(super) fn pair_events(&self, e: SurfaceId, r: SurfaceId) -> PairEvents {
         let mut out = PairEvents::default();
         if self
             .options

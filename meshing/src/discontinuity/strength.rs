@@ -20,7 +20,7 @@ use penumbra_scenes::polygon::closest_point_in_polygon;
 
 /// What a blocker patch can do on a receiver.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PatchStrength {
+pub(super) struct PatchStrength {
     /// Largest fraction of the emitter's area the patch can hide (1 when it cannot be bounded:
     /// the patch reaches the receiver's side of the point or beyond the emitter's plane).
     pub share: f64,
@@ -31,7 +31,7 @@ pub struct PatchStrength {
 
 /// A receiver and an emitter that face each other, in their own frames.
 #[derive(Clone, Copy, Debug)]
-pub struct Pair<'a> {
+pub(super) struct Pair<'a> {
     pub scene: &'a Scene,
     pub emitter: SurfaceId,
     pub emitter_frame: &'a PlaneFrame,
@@ -42,7 +42,7 @@ pub struct Pair<'a> {
 impl Pair<'_> {
     /// The strength of a patch with these corners (the points its outline turns at) on this
     /// pair's receiver.
-    pub fn strength(&self, corners: &[DVec3]) -> PatchStrength {
+    pub(super) fn strength(&self, corners: &[DVec3]) -> PatchStrength {
         PatchStrength {
             share: self.share(corners),
             footprint: self.footprint(corners),

@@ -12,7 +12,7 @@ use penumbra_scenes::{Scene, SurfaceId};
 
 /// One corner of one face: the face, and the welded ids of the corner and its two neighbours.
 #[derive(Clone, Copy, Debug)]
-pub struct Corner {
+pub(super) struct Corner {
     pub surface: SurfaceId,
     pub prev: usize,
     pub next: usize,
@@ -20,7 +20,7 @@ pub struct Corner {
 
 /// The welded vertices and edges of a scene.
 #[derive(Clone, Debug)]
-pub struct Topology {
+pub(super) struct Topology {
     /// Welded vertex positions.
     pub points: Vec<DVec3>,
     /// Each surface's polygon as welded vertex ids.
@@ -36,7 +36,7 @@ pub struct Topology {
 }
 
 impl Topology {
-    pub fn new(scene: &Scene, weld: f64) -> Topology {
+    pub(super) fn new(scene: &Scene, weld: f64) -> Topology {
         let mut points: Vec<DVec3> = Vec::new();
         let mut grid: HashMap<(i64, i64, i64), Vec<usize>> = HashMap::new();
         let cell = (4.0 * weld).max(f64::MIN_POSITIVE);
@@ -112,7 +112,7 @@ impl Topology {
 
     /// Whether every face around vertex `v` for which `include` holds lies on one side of the
     /// plane through `v` with unit normal `n`.
-    pub fn vertex_is_tangent(
+    pub(super) fn vertex_is_tangent(
         &self,
         v: usize,
         n: DVec3,
@@ -141,7 +141,7 @@ impl Topology {
     /// Whether vertex `v` lies on the rim of an open sheet of the faces for which `include`
     /// holds: an edge at `v` with one such face (every corner of a single polygon). Such a
     /// vertex is on the outline from everywhere.
-    pub fn on_rim(&self, v: usize, include: impl Fn(SurfaceId) -> bool) -> bool {
+    pub(super) fn on_rim(&self, v: usize, include: impl Fn(SurfaceId) -> bool) -> bool {
         let faces_on = |a: usize, b: usize| {
             self.edges
                 .get(&(a.min(b), a.max(b)))
@@ -159,7 +159,7 @@ impl Topology {
     /// single polygon), else where some of its faces turn towards the viewpoint and some away (a
     /// silhouette vertex of a solid). Each face's side changes at most once along the segment,
     /// where it crosses the face's plane; between those crossings the answer is the same.
-    pub fn outline_runs(
+    pub(super) fn outline_runs(
         &self,
         v: usize,
         viewpoints: [DVec3; 2],
@@ -201,7 +201,7 @@ impl Topology {
 
     /// Whether every face along the edge `(a, b)` for which `include` holds lies on one side of
     /// the plane through the edge with unit normal `n`.
-    pub fn edge_is_tangent(
+    pub(super) fn edge_is_tangent(
         &self,
         a: usize,
         b: usize,
@@ -216,7 +216,7 @@ impl Topology {
     /// The faces along the edge `(a, b)` for which `include` holds, each as the vector from the
     /// edge into the face, at right angles to the edge and as long as it: what
     /// [`Self::faces_are_tangent`] compares with a plane through the edge.
-    pub fn edge_faces(
+    pub(super) fn edge_faces(
         &self,
         a: usize,
         b: usize,
@@ -250,7 +250,7 @@ impl Topology {
 
     /// Whether the faces of an edge ([`Self::edge_faces`]) lie on one side of the plane through
     /// the edge with unit normal `n`.
-    pub fn faces_are_tangent(&self, faces: &[DVec3], n: DVec3) -> bool {
+    pub(super) fn faces_are_tangent(&self, faces: &[DVec3], n: DVec3) -> bool {
         let mut seen = 0i8;
         faces
             .iter()
@@ -259,7 +259,7 @@ impl Topology {
 
     /// Whether the plane through vertex `v` with unit normal `n` contains one of the edges of the
     /// faces at `v`: the visual event is then degenerate (edge–edge) and of order 1.
-    pub fn plane_holds_an_edge_at(
+    pub(super) fn plane_holds_an_edge_at(
         &self,
         v: usize,
         n: DVec3,

@@ -8,7 +8,7 @@ use penumbra_scenes::{SurfaceId, Visibility};
 use super::wedge::Wedge;
 
 /// Whether the generating ray of `wedge` through the receiver point `x` is unobstructed.
-pub fn generator_visible(
+pub(super) fn generator_visible(
     visibility: &Visibility,
     wedge: &Wedge,
     x: DVec3,
@@ -23,7 +23,7 @@ pub fn generator_visible(
 /// Whether the generating ray of `wedge` through the receiver point `x` is unobstructed when it
 /// also passes the blocker edge `edge` (a wedge between two blockers): piece by piece, from `x`
 /// to the vertex and the edge's point in the order the ray meets them, to the emitter.
-pub fn generator_visible_past(
+pub(super) fn generator_visible_past(
     visibility: &Visibility,
     wedge: &Wedge,
     x: DVec3,
@@ -44,7 +44,7 @@ pub fn generator_visible_past(
 
 /// The runs of `from -> to` where `holds`, with ends located to `tol` (a length) by bisection.
 /// `samples` points along the segment find the runs.
-pub fn runs_where(
+pub(super) fn runs_where(
     from: DVec3,
     to: DVec3,
     samples: usize,

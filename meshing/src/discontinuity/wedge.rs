@@ -41,7 +41,7 @@ impl Event {
 /// A planar critical surface: rays from `source` (an emitter edge, or a vertex repeated) through
 /// `through` (a blocker vertex repeated, or a blocker edge).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Wedge {
+pub(super) struct Wedge {
     pub emitter: SurfaceId,
     pub event: Event,
     pub source: [DVec3; 2],
@@ -53,7 +53,7 @@ pub struct Wedge {
 
 impl Wedge {
     /// The wedge cut off at `reach` from its blocker feature: a convex fan polygon in its plane.
-    pub fn polygon(&self, reach: f64) -> Vec<DVec3> {
+    pub(super) fn polygon(&self, reach: f64) -> Vec<DVec3> {
         // Directions of the rays at a few parameters along the moving feature: a fan covers the
         // wedge up to `reach * cos(pi / 8)` however wide it opens.
         const FAN: usize = 4;
@@ -85,7 +85,7 @@ impl Wedge {
 
     /// The segment where the wedge meets the plane through `origin` with unit normal `n`, if it
     /// crosses it. `reach` bounds the wedge (a few scene diagonals).
-    pub fn meet_plane(&self, origin: DVec3, n: DVec3, reach: f64) -> Option<[DVec3; 2]> {
+    pub(super) fn meet_plane(&self, origin: DVec3, n: DVec3, reach: f64) -> Option<[DVec3; 2]> {
         let poly = self.polygon(reach);
         let h: Vec<f64> = poly.iter().map(|&p| n.dot(p - origin)).collect();
         let mut points = Vec::with_capacity(2);
@@ -102,7 +102,7 @@ impl Wedge {
 
     /// For a point `x` on the wedge beyond its blocker feature, the ray that generates it: the
     /// point where it grazes the blocker, and the point of the emitter it comes from.
-    pub fn generator(&self, x: DVec3) -> (DVec3, DVec3) {
+    pub(super) fn generator(&self, x: DVec3) -> (DVec3, DVec3) {
         match self.event {
             Event::Ev | Event::BlockerEv => {
                 let v = self.through[0];

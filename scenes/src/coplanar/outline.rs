@@ -13,11 +13,11 @@ use crate::validate::{PLANARITY_TOLERANCE, polygon_problem};
 /// the line is at most this many units of the last place of the largest coordinate involved:
 /// parsing and subtraction round each coordinate by half a unit, so points exactly on the line in
 /// the file's decimals land within a few units of it, and points visibly off it do not.
-pub const COLLINEAR_ROUNDING: f64 = 8.0 * f64::EPSILON;
+pub(super) const COLLINEAR_ROUNDING: f64 = 8.0 * f64::EPSILON;
 
 /// Merged polygons must have the area of their faces to this relative accuracy. Rounding makes
 /// differences near 1e-15; this only guards against a merge that would change the geometry.
-pub const AREA_TOLERANCE: f64 = 1e-9;
+pub(super) const AREA_TOLERANCE: f64 = 1e-9;
 
 /// The boundary of `faces` as one loop of corner ids, counter-clockwise like the faces; `None`
 /// when it is several loops (holes) or touches itself (a corner visited twice). An edge is
@@ -113,7 +113,7 @@ fn holds_corners<'a>(candidate: &[DVec3], mut faces: impl Iterator<Item = &'a [D
 /// corners kept around them. Each run of straight-angle corners is checked against the line
 /// between the corners at its ends, so rounding cannot accumulate along a long edge; a run that
 /// fails keeps all its corners.
-pub fn without_straight_corners(points: &[DVec3]) -> Vec<DVec3> {
+pub(super) fn without_straight_corners(points: &[DVec3]) -> Vec<DVec3> {
     let n = points.len();
     let straight: Vec<bool> = (0..n)
         .map(|i| between(points[(i + n - 1) % n], points[i], points[(i + 1) % n]))

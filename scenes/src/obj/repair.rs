@@ -41,7 +41,7 @@ pub(crate) struct Repairs {
 }
 
 impl Repairs {
-    pub fn warnings(&self) -> Vec<String> {
+    pub(super) fn warnings(&self) -> Vec<String> {
         [
             self.repeated_corners
                 .describe("removed repeated corners from", "faces"),

@@ -30,7 +30,7 @@ pub(crate) struct SourceLines {
 }
 
 impl SourceLines {
-    pub fn scan(text: &str) -> SourceLines {
+    pub(super) fn scan(text: &str) -> SourceLines {
         let mut lines = SourceLines::default();
         let mut seen_materials: HashMap<&str, usize> = HashMap::new();
         let mut material = None;
@@ -69,7 +69,7 @@ impl SourceLines {
     }
 
     /// The line of tobj's face number `index`, when the scan agrees with tobj's count.
-    pub fn face(&self, index: usize) -> Option<FaceLine> {
+    pub(super) fn face(&self, index: usize) -> Option<FaceLine> {
         self.faces.get(index).copied()
     }
 }

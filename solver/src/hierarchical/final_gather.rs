@@ -62,7 +62,7 @@ impl FinalGather<'_> {
     /// radiosity at every vertex, and what the first gather at `x` found of it), near leaves
     /// are linear over their triangles and only they are gathered (`far` is left zero). `key`
     /// picks the point's random streams.
-    pub fn irradiance(
+    pub(super) fn irradiance(
         &self,
         x: &ReceivingPoint,
         surface: SurfaceId,

@@ -54,7 +54,7 @@ pub(crate) struct System<'a> {
 
 impl<'a> System<'a> {
     /// `leaf_direct` is each leaf's reflected direct radiosity (by node; anything elsewhere).
-    pub fn new(hierarchy: &'a Hierarchy, leaf_direct: Vec<Rgb>) -> System<'a> {
+    pub(super) fn new(hierarchy: &'a Hierarchy, leaf_direct: Vec<Rgb>) -> System<'a> {
         let mut slot = vec![NONE; hierarchy.nodes.len()];
         let mut clusters = 0;
         for (i, n) in hierarchy.nodes.iter().enumerate() {
@@ -91,7 +91,7 @@ impl<'a> System<'a> {
     }
 
     /// Replaces the links (in any order; sorted here by receiver, stably).
-    pub fn set_links(&mut self, mut links: Vec<Link>) {
+    pub(super) fn set_links(&mut self, mut links: Vec<Link>) {
         links.sort_by_key(|l| l.receiver);
         self.first_link.iter_mut().for_each(|f| *f = 0);
         for l in &links {
@@ -104,7 +104,7 @@ impl<'a> System<'a> {
     }
 
     /// The links `id` receives along.
-    pub fn links_of(&self, id: u32) -> &[Link] {
+    pub(super) fn links_of(&self, id: u32) -> &[Link] {
         let (a, b) = (
             self.first_link[id as usize] as usize,
             self.first_link[id as usize + 1] as usize,
@@ -112,7 +112,7 @@ impl<'a> System<'a> {
         &self.links[a..b]
     }
 
-    pub fn radiosities<'f>(&'f self, field: &'f Field) -> Radiosities<'f> {
+    pub(super) fn radiosities<'f>(&'f self, field: &'f Field) -> Radiosities<'f> {
         Radiosities {
             b: &field.b,
             q: &field.q,
@@ -123,7 +123,7 @@ impl<'a> System<'a> {
     }
 
     /// The field before any reflected light has been gathered: the direct light reflected.
-    pub fn initial_field(&self) -> Field {
+    pub(super) fn initial_field(&self) -> Field {
         let n = self.hierarchy.nodes.len();
         let mut field = Field::new(n, self.clusters);
         if let Some(root) = self.hierarchy.root {
@@ -137,7 +137,7 @@ impl<'a> System<'a> {
     }
 
     /// One Jacobi sweep from `field`: the new field.
-    pub fn sweep(&self, field: &Field) -> Field {
+    pub(super) fn sweep(&self, field: &Field) -> Field {
         let gathered = self.gather(field);
         let mut next = Field::new(field.b.len(), self.clusters);
         if let Some(root) = self.hierarchy.root {
@@ -272,7 +272,7 @@ impl<'a> System<'a> {
 
     /// Σ area × |change of radiosity| over the leaves, relative to Σ area × reflected direct
     /// radiosity (channel means): the sweep's relative residual.
-    pub fn change(&self, before: &Field, after: &Field) -> (f64, Rgb) {
+    pub(super) fn change(&self, before: &Field, after: &Field) -> (f64, Rgb) {
         let (mut change, mut scale, mut signed) = (0.0, 0.0, Rgb::ZERO);
         for (i, n) in self.hierarchy.nodes.iter().enumerate() {
             if n.is_leaf() {

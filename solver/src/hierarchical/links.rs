@@ -71,12 +71,12 @@ pub(crate) struct Radiosities<'s> {
 impl Radiosities<'_> {
     /// Half the range of element `id`'s leaves' radiosities: how far its mean may be from its
     /// parts (a light in the middle of a wall leaves halves of equal means).
-    pub fn spread(&self, id: u32) -> Rgb {
+    pub(super) fn spread(&self, id: u32) -> Rgb {
         (self.high[id as usize] - self.low[id as usize]) * 0.5
     }
 
     /// The power the source sends (W).
-    pub fn power(&self, node: &Node, id: u32) -> Rgb {
+    pub(super) fn power(&self, node: &Node, id: u32) -> Rgb {
         if node.is_cluster() {
             self.q[self.slot[id as usize] as usize]
                 .iter()
@@ -88,7 +88,7 @@ impl Radiosities<'_> {
     }
 
     /// The source's intensity toward unit `d` (W/sr).
-    pub fn intensity(&self, node: &Node, id: u32, d: DVec3) -> Rgb {
+    pub(super) fn intensity(&self, node: &Node, id: u32, d: DVec3) -> Rgb {
         if node.is_cluster() {
             cluster_intensity(&self.q[self.slot[id as usize] as usize], d)
         } else {
@@ -106,7 +106,7 @@ pub(crate) struct RefineCounts {
 }
 
 impl RefineCounts {
-    pub fn add(&mut self, other: RefineCounts) {
+    pub(super) fn add(&mut self, other: RefineCounts) {
         self.hidden += other.hidden;
         self.rays += other.rays;
     }
@@ -150,7 +150,7 @@ impl Refiner<'_> {
 
     /// The links that replace the link from `s` to `r` (itself, if it holds), appended to `out`.
     /// `candidates` are the blockers of a shaft that holds this pair's.
-    pub fn refine(
+    pub(super) fn refine(
         &self,
         r: u32,
         s: u32,
@@ -376,7 +376,7 @@ impl Refiner<'_> {
 
     /// The error a kept link still carries, with the radiosities as they are now: links over
     /// `tolerance` are refined again.
-    pub fn error_of(&self, link: &Link, state: &Radiosities) -> f64 {
+    pub(super) fn error_of(&self, link: &Link, state: &Radiosities) -> f64 {
         let (r, s) = (link.receiver, link.source);
         match link.transfer {
             Transfer::Factor { factor, spread } => self.factor_error(r, s, factor, spread, state),

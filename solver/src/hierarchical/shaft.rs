@@ -42,7 +42,7 @@ pub(crate) struct Shafts<'a> {
 }
 
 impl<'a> Shafts<'a> {
-    pub fn new(scene: &'a Scene, visibility: &'a Visibility) -> Shafts<'a> {
+    pub(super) fn new(scene: &'a Scene, visibility: &'a Visibility) -> Shafts<'a> {
         Shafts {
             visibility,
             scene,
@@ -57,7 +57,7 @@ impl<'a> Shafts<'a> {
 
     /// What lies between `a` and `b`; `candidates` are the blockers of a shaft that holds this
     /// one (all of the scene's when `None`).
-    pub fn classify(&self, a: &Node, b: &Node, candidates: Option<&[u32]>) -> Sight {
+    pub(super) fn classify(&self, a: &Node, b: &Node, candidates: Option<&[u32]>) -> Sight {
         let shaft = Shaft::new(&a.hull, &b.hull, self.tol);
         let own = |s: SurfaceId| a.surface == Some(s) || b.surface == Some(s);
         let triangles = self.visibility.triangles();

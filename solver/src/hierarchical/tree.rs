@@ -49,11 +49,11 @@ pub(crate) struct Node {
 }
 
 impl Node {
-    pub fn is_cluster(&self) -> bool {
+    pub(super) fn is_cluster(&self) -> bool {
         self.surface.is_none()
     }
 
-    pub fn is_leaf(&self) -> bool {
+    pub(super) fn is_leaf(&self) -> bool {
         self.children.is_none()
     }
 }
@@ -84,7 +84,10 @@ pub(crate) struct Hierarchy {
 impl Hierarchy {
     /// The hierarchy over the elements of `disc` on surfaces that reflect some light (the others
     /// still block it, but neither send nor receive reflected light).
-    pub fn build(disc: &Discretization, reflectance: impl Fn(SurfaceId) -> Rgb) -> Hierarchy {
+    pub(super) fn build(
+        disc: &Discretization,
+        reflectance: impl Fn(SurfaceId) -> Rgb,
+    ) -> Hierarchy {
         let mut by_surface: Vec<Vec<u32>> = vec![Vec::new(); disc.offsets.len()];
         for (i, e) in disc.elements.iter().enumerate() {
             if e.area > 0.0 && reflectance(e.surface).max_channel() > 0.0 {
@@ -124,13 +127,13 @@ impl Hierarchy {
         h
     }
 
-    pub fn node(&self, id: u32) -> &Node {
+    pub(super) fn node(&self, id: u32) -> &Node {
         &self.nodes[id as usize]
     }
 
     /// A point of node `id` in stratum `k` of `strata` (equal shares of its area), uniform in
     /// the triangle the stratum's draw falls in, and that triangle.
-    pub fn sample(
+    pub(super) fn sample(
         &self,
         id: u32,
         k: usize,
@@ -157,7 +160,7 @@ impl Hierarchy {
     /// Points of element `id` and their weights (summing to one) for averaging over it: a leaf's
     /// three-point rule (exact for quadratics), else the centroids of its grandchildren (or
     /// children, where those are leaves), by area.
-    pub fn quadrature(&self, id: u32) -> SmallVec<[(DVec3, f64); 4]> {
+    pub(super) fn quadrature(&self, id: u32) -> SmallVec<[(DVec3, f64); 4]> {
         let n = self.node(id);
         let Some(children) = n.children else {
             let t = &self.triangles[n.first as usize].points;
@@ -189,7 +192,7 @@ impl Hierarchy {
     /// (or leaf child) by its own second-moment rule (centroid ± half-axes) or, for a leaf, its
     /// three-point rule. Centroids alone read a form factor that peaks inside the element too
     /// high (its mean is below its middle's value), and that bias adds up at many bounces.
-    pub fn fine_quadrature(&self, id: u32) -> SmallVec<[(DVec3, f64); 16]> {
+    pub(super) fn fine_quadrature(&self, id: u32) -> SmallVec<[(DVec3, f64); 16]> {
         let n = self.node(id);
         let mut out = SmallVec::new();
         let mut add = |part: u32| {
@@ -224,7 +227,7 @@ impl Hierarchy {
     }
 
     /// The nodes from `id` up to the root.
-    pub fn ancestry(&self, id: u32) -> impl Iterator<Item = u32> + '_ {
+    pub(super) fn ancestry(&self, id: u32) -> impl Iterator<Item = u32> + '_ {
         std::iter::successors(Some(id), |&n| {
             let p = self.node(n).parent;
             (p != NONE).then_some(p)
