@@ -15,10 +15,11 @@ use std::collections::HashMap;
 use glam::{DVec2, DVec3};
 use penumbra_scenes::{PlaneFrame, Surface, SurfaceId};
 
+use crate::cdt::{Cdt, SurfaceTriangulation, insert_segment, quietly};
 use crate::error::MeshError;
 use crate::grading::Density;
 use crate::mesh::{ON_SEGMENT_TOLERANCE, SurfaceMesh};
-use crate::uniform::{Cdt, MeshCoordinates, SurfaceTriangulation, insert_segment, snap};
+use crate::mesh_coordinates::{MeshCoordinates, snap};
 use penumbra_scenes::polygon::clip_segment;
 use spade::Triangulation as _;
 
@@ -30,30 +31,6 @@ const FRAME_MARGIN: f64 = 0.05;
 /// Smallest angle the refinement of constrained meshes aims for: constraints may meet at any
 /// angle, and 20 degrees keeps Ruppert's refinement from cascading around them.
 pub(crate) const CONSTRAINED_MIN_ANGLE_DEG: f64 = 20.0;
-
-thread_local! {
-    /// Set while a panic would be caught and turned into an error ([`quietly`]).
-    static CATCHING: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
-}
-
-/// Runs `f`, turning a panic into `Err` without the panic message the process would print
-/// otherwise: the caller reports the failure as an error (or tries again another way). Other
-/// panics print as before.
-pub(crate) fn quietly<T>(f: impl FnOnce() -> T) -> std::thread::Result<T> {
-    static HOOK: std::sync::Once = std::sync::Once::new();
-    HOOK.call_once(|| {
-        let previous = std::panic::take_hook();
-        std::panic::set_hook(Box::new(move |info| {
-            if !CATCHING.with(std::cell::Cell::get) {
-                previous(info);
-            }
-        }));
-    });
-    CATCHING.with(|c| c.set(true));
-    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(f));
-    CATCHING.with(|c| c.set(false));
-    result
-}
 
 /// A segment to be a chain of mesh edges, in the surface's plane-frame coordinates.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -18,7 +18,8 @@ use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 use spade::{PositionInTriangulation, Triangulation as _};
 
-use crate::uniform::{Cdt, MeshCoordinates, SurfaceTriangulation};
+use crate::cdt::{Cdt, SurfaceTriangulation};
+use crate::mesh_coordinates::MeshCoordinates;
 
 /// How many times smaller in area triangles in a penumbra are than elsewhere, by default: about
 /// the curvature ratio between penumbra and full light in the built-in scenes, to the power 2/3.

@@ -71,6 +71,7 @@
 #![warn(missing_docs)]
 
 mod budget;
+mod cdt;
 mod constrained;
 pub mod discontinuity;
 mod error;
@@ -79,6 +80,7 @@ pub mod fuzzing;
 mod grading;
 mod locate;
 mod mesh;
+mod mesh_coordinates;
 mod progress;
 mod scene_mesh;
 mod uniform;
