@@ -6,6 +6,7 @@ use penumbra::{MeshMethod, RunOptions, run};
 use penumbra_meshing::discontinuity::{
     Boundary, DiscontinuityOptions, Event, find_discontinuities,
 };
+use penumbra_scenes::polygon::closest_point_on_segment;
 use penumbra_scenes::{LoadedScene, Scene, Visibility, builtin};
 use penumbra_solver::direct_interpolation_error;
 use penumbra_solver::{DirectLight, NoProgress, SolverOptions};
@@ -244,11 +245,8 @@ fn eee_curves_are_where_the_light_changes_form() {
             let across = normal.cross(s.to - s.from).normalize();
             // Other lines within the stencil would confuse the check; skip those spots.
             let crowded = found.segments[r].iter().any(|o| {
-                !std::ptr::eq(o, s) && {
-                    let d = o.to - o.from;
-                    let t = ((mid - o.from).dot(d) / d.length_squared()).clamp(0.0, 1.0);
-                    (o.from + d * t).distance(mid) < 20.0 * h
-                }
+                !std::ptr::eq(o, s)
+                    && closest_point_on_segment(mid, o.from, o.to).distance(mid) < 20.0 * h
             });
             if crowded || s.from.distance(s.to) < 100.0 * h {
                 continue;
@@ -288,9 +286,7 @@ fn a_hovering_light_casts_contact_lines_on_the_ceiling() {
         (0..light.len()).any(|i| {
             let (a, b) = (light[i], light[(i + 1) % light.len()]);
             let (a, b) = (DVec3::new(a.x, 548.8, a.z), DVec3::new(b.x, 548.8, b.z));
-            let d = b - a;
-            let t = ((p - a).dot(d) / d.length_squared()).clamp(0.0, 1.0);
-            p.distance(a + d * t) < 1e-9 * 1000.0
+            p.distance(closest_point_on_segment(p, a, b)) < 1e-9 * 1000.0
         })
     };
     let contacts: Vec<_> = found.segments[ceiling]

@@ -12,7 +12,7 @@ use penumbra_meshing::discontinuity::{
     DiscontinuityOptions, DiscontinuitySegment, Event, EventSet, find_discontinuities,
 };
 use penumbra_scenes::SplitMix64;
-use penumbra_scenes::polygon::clip_segment;
+use penumbra_scenes::polygon::{clip_segment, closest_point_on_segment};
 use penumbra_scenes::{PlaneFrame, Rgb, Scene, Surface, SurfaceId, Visibility, builtin};
 use penumbra_solver::{DirectLight, ReceivingPoint};
 use rayon::prelude::*;
@@ -128,9 +128,7 @@ fn jumps(f: &[f64], h: f64) -> Vec<Jump> {
 }
 
 fn distance_to(p: DVec2, [a, b]: [DVec2; 2]) -> f64 {
-    let d = b - a;
-    let t = ((p - a).dot(d) / d.length_squared()).clamp(0.0, 1.0);
-    p.distance(a + d * t)
+    p.distance(closest_point_on_segment(p, a, b))
 }
 
 /// What the oracle found on one receiver.

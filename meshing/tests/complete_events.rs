@@ -4,6 +4,7 @@
 
 use glam::DVec3;
 use penumbra_meshing::discontinuity::{DiscontinuityOptions, EventSet, find_discontinuities};
+use penumbra_scenes::polygon::closest_point_on_segment;
 use penumbra_scenes::{Rgb, Scene, Surface, Visibility};
 
 /// A regular `n`-gon of circumradius `radius` about (`x`, `y`) at height `z`, turned by `turn`,
@@ -41,9 +42,7 @@ fn on_floor(q: DVec3, p: DVec3) -> DVec3 {
 }
 
 fn distance_to_segment(x: DVec3, [a, b]: [DVec3; 2]) -> f64 {
-    let d = b - a;
-    let t = ((x - a).dot(d) / d.length_squared()).clamp(0.0, 1.0);
-    x.distance(a + d * t)
+    x.distance(closest_point_on_segment(x, a, b))
 }
 
 #[test]

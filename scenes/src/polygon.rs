@@ -4,6 +4,8 @@
 //! Combinatorial decisions (does an edge cross another, is a vertex an ear) use Shewchuk's exact
 //! `orient2d`, so a polygon's topology is decided the same way however it was rounded.
 
+use std::ops::{Add, Mul, Sub};
+
 use glam::{DVec2, DVec3};
 use robust::{Coord, orient2d};
 
@@ -293,18 +295,40 @@ pub fn closest_point_in_polygon(polygon: &[DVec2], p: DVec2) -> DVec2 {
     }
     let n = polygon.len();
     (0..n)
-        .map(|i| {
-            let (a, b) = (polygon[i], polygon[(i + 1) % n]);
-            let d = b - a;
-            let t = if d == DVec2::ZERO {
-                0.0
-            } else {
-                ((p - a).dot(d) / d.length_squared()).clamp(0.0, 1.0)
-            };
-            a + d * t
-        })
+        .map(|i| closest_point_on_segment(p, polygon[i], polygon[(i + 1) % n]))
         .min_by(|x, y| x.distance_squared(p).total_cmp(&y.distance_squared(p)))
         .unwrap_or(p)
+}
+
+/// The vectors [`closest_point_on_segment`] works in: [`DVec2`] and [`DVec3`].
+pub trait Vector: Copy + Add<Output = Self> + Sub<Output = Self> + Mul<f64, Output = Self> {
+    /// The dot product.
+    fn dot(self, other: Self) -> f64;
+}
+
+impl Vector for DVec2 {
+    fn dot(self, other: Self) -> f64 {
+        DVec2::dot(self, other)
+    }
+}
+
+impl Vector for DVec3 {
+    fn dot(self, other: Self) -> f64 {
+        DVec3::dot(self, other)
+    }
+}
+
+/// The point of the segment `a-b` closest to `p`: the projection of `p` onto the segment's
+/// line, clamped to its ends; `a` when the segment has no length.
+pub fn closest_point_on_segment<V: Vector>(p: V, a: V, b: V) -> V {
+    let d = b - a;
+    let length_squared = d.dot(d);
+    let t = if length_squared > 0.0 {
+        ((p - a).dot(d) / length_squared).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    a + d * t
 }
 
 #[cfg(test)]

@@ -13,7 +13,7 @@
 use std::f64::consts::PI;
 
 use glam::{DVec2, DVec3};
-use penumbra_scenes::polygon::{self, is_convex_ccw, triangulate_ccw};
+use penumbra_scenes::polygon::{self, closest_point_on_segment, is_convex_ccw, triangulate_ccw};
 use penumbra_scenes::{PlaneFrame, Rgb, Scene, SurfaceId, Visibility};
 use smallvec::SmallVec;
 
@@ -1133,10 +1133,8 @@ fn contact_shadow(
     let mut through = Vec::new();
     for k in 0..m {
         let (a, b) = (occ.polygon[k], occ.polygon[(k + 1) % m]);
-        let d = b - a;
-        let t = ((x.point - a).dot(d) / d.length_squared()).clamp(0.0, 1.0);
-        if (a + d * t).distance(x.point) <= tol {
-            through.push((k, n.cross(d).normalize_or_zero()));
+        if closest_point_on_segment(x.point, a, b).distance(x.point) <= tol {
+            through.push((k, n.cross(b - a).normalize_or_zero()));
         }
     }
     let inside = through.is_empty()

@@ -5,6 +5,7 @@ use std::collections::{BTreeMap, HashMap, HashSet};
 
 use glam::{DVec2, DVec3};
 use penumbra_meshing::SceneMesh;
+use penumbra_scenes::polygon::closest_point_on_segment;
 use penumbra_scenes::{Bounds, Rgb, Scene, SurfaceId};
 
 use crate::lambert::ReceivingPoint;
@@ -305,12 +306,7 @@ fn hover_lifts(
     for (v, p) in m.points3.iter().enumerate() {
         let gap = lines
             .iter()
-            .filter(|(a, b, _)| {
-                let d = *b - *a;
-                let t =
-                    ((*p - *a).dot(d) / d.length_squared().max(f64::MIN_POSITIVE)).clamp(0.0, 1.0);
-                p.distance(*a + d * t) <= tol
-            })
+            .filter(|&&(a, b, _)| p.distance(closest_point_on_segment(*p, a, b)) <= tol)
             .map(|l| l.2)
             .fold(0.0, f64::max);
         if gap > 0.0 && shortest[v].is_finite() {

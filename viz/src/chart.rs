@@ -10,6 +10,7 @@ use std::fmt::Write;
 
 use glam::DVec2;
 use image::{Rgb, RgbImage};
+use penumbra_scenes::polygon::closest_point_on_segment;
 
 use crate::VizError;
 use crate::render::encode_png;
@@ -480,11 +481,8 @@ impl Canvas {
 
     fn stroke(&mut self, a: DVec2, b: DVec2, width: f64, color: [u8; 3]) {
         let r = width / 2.0;
-        let d = b - a;
-        let len2 = d.length_squared().max(f64::MIN_POSITIVE);
         self.fill(a.min(b) - r - 1.0, a.max(b) + r + 1.0, color, |p| {
-            let t = ((p - a).dot(d) / len2).clamp(0.0, 1.0);
-            (p - (a + d * t)).length() - r
+            (p - closest_point_on_segment(p, a, b)).length() - r
         });
     }
 

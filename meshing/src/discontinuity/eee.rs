@@ -17,6 +17,7 @@ use std::cell::OnceCell;
 use std::collections::{BTreeSet, HashMap};
 
 use glam::DVec3;
+use penumbra_scenes::polygon::closest_point_on_segment;
 use penumbra_scenes::{Bounds, IndexBox, PlaneFrame, SurfaceId, Visibility};
 
 use super::pair::PairGeometry;
@@ -647,13 +648,7 @@ impl EeeSearch<'_> {
     ) {
         let um = 0.5 * (a.0 + b.0);
         if let Some(m) = line(um).map(|x| x.receiver) {
-            let chord = b.1 - a.1;
-            let off = if chord.length_squared() > 0.0 {
-                let s = ((m - a.1).dot(chord) / chord.length_squared()).clamp(0.0, 1.0);
-                m.distance(a.1 + chord * s)
-            } else {
-                m.distance(a.1)
-            };
+            let off = m.distance(closest_point_on_segment(m, a.1, b.1));
             if (off > self.chord_tolerance || depth < 1) && depth < MAX_DEPTH {
                 self.subdivide(line, a, (um, m), depth + 1, points);
                 self.subdivide(line, (um, m), b, depth + 1, points);

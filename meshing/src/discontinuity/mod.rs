@@ -27,6 +27,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
 use glam::{DVec2, DVec3};
+use penumbra_scenes::polygon::closest_point_on_segment;
 use penumbra_scenes::{PlaneFrame, Scene, SurfaceId, Visibility};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -559,11 +560,7 @@ pub(crate) fn emitter_samples(polygon: &[DVec3]) -> Vec<DVec3> {
 /// Whether segment `a-b` lies along one edge of the polygon (within `tol`).
 fn on_polygon_edge(polygon: &[DVec2], a: DVec2, b: DVec2, tol: f64) -> bool {
     let n = polygon.len();
-    let near = |p: DVec2, c: DVec2, d: DVec2| {
-        let e = d - c;
-        let t = ((p - c).dot(e) / e.length_squared()).clamp(0.0, 1.0);
-        p.distance(c + e * t) <= tol
-    };
+    let near = |p: DVec2, c: DVec2, d: DVec2| p.distance(closest_point_on_segment(p, c, d)) <= tol;
     (0..n).any(|i| {
         let (c, d) = (polygon[i], polygon[(i + 1) % n]);
         near(a, c, d) && near(b, c, d)
