@@ -14,6 +14,7 @@ use penumbra_scenes::polygon::closest_point_on_segment;
 
 use crate::VizError;
 use crate::render::encode_png;
+use crate::svg_plot::escape;
 
 const WIDTH: f64 = 720.0;
 const HEIGHT: f64 = 460.0;
@@ -442,12 +443,6 @@ impl LogLogChart {
         }
         encode_png(&canvas.image)
     }
-}
-
-fn escape(text: &str) -> String {
-    text.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
 }
 
 struct Canvas {

@@ -357,7 +357,7 @@ fn nice_length(limit: f64) -> (f64, String) {
     (length, label)
 }
 
-/// XML text and attribute escaping.
+/// XML text and attribute escaping, for every SVG this crate writes.
 pub(crate) fn escape(s: &str) -> String {
     let mut out = String::with_capacity(s.len());
     for c in s.chars() {
