@@ -477,19 +477,30 @@ fn temporary_beside(path: &Path) -> PathBuf {
     dir.join(format!(".{file_name}.tmp-{}", std::process::id()))
 }
 
-/// Writes `bytes` to `path` atomically: a temporary file in the same directory, then a rename.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+/// Writes `bytes` to a temporary file beside `path` ([`temporary_beside`]) and syncs it;
+/// returns the temporary's path, for a rename into place. On failure the temporary is removed.
+fn write_temporary(path: &Path, bytes: &[u8]) -> std::io::Result<PathBuf> {
     let tmp = temporary_beside(path);
-    let result = (|| {
+    let written = (|| {
         let mut f = std::fs::File::create(&tmp)?;
         f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
+        f.sync_all()
     })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
+    match written {
+        Ok(()) => Ok(tmp),
+        Err(e) => {
+            let _ = std::fs::remove_file(&tmp);
+            Err(e)
+        }
     }
-    result
+}
+
+/// Writes `bytes` to `path` atomically: a temporary file in the same directory, then a rename.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let tmp = write_temporary(path, bytes)?;
+    std::fs::rename(&tmp, path).inspect_err(|_| {
+        let _ = std::fs::remove_file(&tmp);
+    })
 }
 
 /// The solver's convergence as CSV (iteration, residual, seconds) and as log–log charts against
@@ -561,16 +572,8 @@ impl Staging {
         if path.is_dir() {
             anyhow::bail!("cannot write {}: a directory is in the way", path.display());
         }
-        let tmp = temporary_beside(&path);
-        let written = (|| {
-            let mut f = std::fs::File::create(&tmp)?;
-            f.write_all(bytes)?;
-            f.sync_all()
-        })();
-        if let Err(e) = written {
-            let _ = std::fs::remove_file(&tmp);
-            return Err(e).with_context(|| format!("cannot write {}", path.display()));
-        }
+        let tmp = write_temporary(&path, bytes)
+            .with_context(|| format!("cannot write {}", path.display()))?;
         self.staged.push((tmp, path));
         Ok(())
     }
