@@ -85,12 +85,13 @@ pub fn newell_normal(points: &[DVec3]) -> DVec3 {
     normal
 }
 
-/// Largest distance between two vertices.
-pub fn diameter(points: &[DVec3]) -> f64 {
+/// Largest distance between two vertices, of a polygon in 3D or in its plane.
+pub fn diameter<V: Vector>(points: &[V]) -> f64 {
     let mut d2: f64 = 0.0;
     for (i, &a) in points.iter().enumerate() {
         for &b in &points[i + 1..] {
-            d2 = d2.max(a.distance_squared(b));
+            let d = a - b;
+            d2 = d2.max(d.dot(d));
         }
     }
     d2.sqrt()
@@ -300,7 +301,7 @@ pub fn closest_point_in_polygon(polygon: &[DVec2], p: DVec2) -> DVec2 {
         .unwrap_or(p)
 }
 
-/// The vectors [`closest_point_on_segment`] works in: [`DVec2`] and [`DVec3`].
+/// The vectors [`closest_point_on_segment`] and [`diameter`] work in: [`DVec2`] and [`DVec3`].
 pub trait Vector: Copy + Add<Output = Self> + Sub<Output = Self> + Mul<f64, Output = Self> {
     /// The dot product.
     fn dot(self, other: Self) -> f64;

@@ -2,7 +2,7 @@
 //! two convex polygons as convex pieces.
 
 use glam::{DVec2, DVec3};
-use penumbra_scenes::polygon::orient;
+use penumbra_scenes::polygon::{diameter, orient, signed_area_2d};
 
 /// The part of a polygon where `height(p) >= 0` (Sutherland–Hodgman). Convex in, convex out.
 pub(crate) fn clip_polygon_3d(polygon: &[DVec3], height: impl Fn(DVec3) -> f64) -> Vec<DVec3> {
@@ -50,10 +50,6 @@ pub(crate) fn clip_left_of(polygon: &[DVec2], a: DVec2, b: DVec2) -> Vec<DVec2> 
     out
 }
 
-pub(crate) fn area_2d(polygon: &[DVec2]) -> f64 {
-    penumbra_scenes::polygon::signed_area_2d(polygon)
-}
-
 fn bounds_2d(polygon: &[DVec2]) -> (DVec2, DVec2) {
     polygon
         .iter()
@@ -77,20 +73,9 @@ pub(crate) fn merge_close_vertices(polygon: &mut Vec<DVec2>, tol: f64) {
     *polygon = out;
 }
 
-/// Largest distance between two vertices.
-pub(crate) fn diameter_2d(polygon: &[DVec2]) -> f64 {
-    let mut d2: f64 = 0.0;
-    for (i, &a) in polygon.iter().enumerate() {
-        for &b in &polygon[i + 1..] {
-            d2 = d2.max(a.distance_squared(b));
-        }
-    }
-    d2.sqrt()
-}
-
 /// Whether a convex polygon is wider than `min_width` (area over diameter estimates the width).
 pub(crate) fn wider_than(polygon: &[DVec2], min_width: f64) -> bool {
-    polygon.len() >= 3 && area_2d(polygon) > min_width * diameter_2d(polygon)
+    polygon.len() >= 3 && signed_area_2d(polygon) > min_width * diameter(polygon)
 }
 
 /// `piece - hole` for convex counter-clockwise polygons, as convex pieces. Pieces no wider than
@@ -281,13 +266,13 @@ mod tests {
     fn difference_of_squares_has_the_right_area() {
         let mut out = Vec::new();
         subtract_convex(&sq(0.0, 0.0, 10.0), &sq(5.0, 5.0, 10.0), 0.0, &mut out);
-        let area: f64 = out.iter().map(|p| area_2d(p)).sum();
+        let area: f64 = out.iter().map(|p| signed_area_2d(p)).sum();
         assert!((area - 75.0).abs() < 1e-12);
-        assert!(out.iter().all(|p| area_2d(p) > 0.0));
+        assert!(out.iter().all(|p| signed_area_2d(p) > 0.0));
 
         let mut out = Vec::new();
         subtract_convex(&sq(0.0, 0.0, 10.0), &sq(2.0, 2.0, 1.0), 0.0, &mut out);
-        let area: f64 = out.iter().map(|p| area_2d(p)).sum();
+        let area: f64 = out.iter().map(|p| signed_area_2d(p)).sum();
         assert!((area - 99.0).abs() < 1e-12);
 
         let mut out = Vec::new();
@@ -299,13 +284,13 @@ mod tests {
         hole.insert(1, hole[1]);
         let mut out = Vec::new();
         subtract_convex(&sq(0.0, 0.0, 10.0), &hole, 0.0, &mut out);
-        let area: f64 = out.iter().map(|p| area_2d(p)).sum();
+        let area: f64 = out.iter().map(|p| signed_area_2d(p)).sum();
         assert!((area - 99.0).abs() < 1e-12);
 
         // Touching along an edge: nothing removed, nothing of zero area added.
         let mut out = Vec::new();
         subtract_convex(&sq(0.0, 0.0, 1.0), &sq(1.0, 0.0, 1.0), 0.0, &mut out);
-        let area: f64 = out.iter().map(|p| area_2d(p)).sum();
+        let area: f64 = out.iter().map(|p| signed_area_2d(p)).sum();
         assert!((area - 1.0).abs() < 1e-15);
     }
 

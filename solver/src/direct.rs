@@ -13,12 +13,14 @@
 use std::f64::consts::PI;
 
 use glam::{DVec2, DVec3};
-use penumbra_scenes::polygon::{self, closest_point_on_segment, is_convex_ccw, triangulate_ccw};
+use penumbra_scenes::polygon::{
+    self, closest_point_on_segment, is_convex_ccw, signed_area_2d, triangulate_ccw,
+};
 use penumbra_scenes::{PlaneFrame, Rgb, Scene, SurfaceId, Visibility};
 use smallvec::SmallVec;
 
 use crate::clip::{
-    HalfPlane, area_2d, clip_half_plane, clip_polygon_3d, convex_hull_2d, inside_convex,
+    HalfPlane, clip_half_plane, clip_polygon_3d, convex_hull_2d, inside_convex,
     merge_close_vertices, subtract_convex, subtract_half_planes, wider_than,
 };
 use crate::lambert::{ReceivingPoint, contour_sum};
@@ -378,7 +380,7 @@ impl<'a> DirectLight<'a> {
         let mut views = Vec::with_capacity(e.pieces.len());
         for full in &e.pieces {
             let mut piece: Vec<DVec2> = full.iter().map(|&p| e.frame.to_2d(p)).collect();
-            if area_2d(&piece) < 0.0 {
+            if signed_area_2d(&piece) < 0.0 {
                 piece.reverse();
             }
             let (visible, touching) = match self.blockings(point, None, e, full, h_x, &piece, true)
@@ -619,7 +621,7 @@ impl<'a> DirectLight<'a> {
         // The rounding scale of this evaluation: coordinates as large as these carry this error.
         let min_width = e.sliver_width(x.point);
         let mut piece = front.iter().map(|&p| e.frame.to_2d(p)).collect::<Vec<_>>();
-        if area_2d(&piece) < 0.0 {
+        if signed_area_2d(&piece) < 0.0 {
             piece.reverse();
         }
         let Some(Blocked {
@@ -863,7 +865,7 @@ impl<'a> DirectLight<'a> {
             return Window::Covered;
         }
         let hull = convex_hull_2d(visible_points(&visible).copied().collect());
-        if hull.len() < 3 || area_2d(&hull) > WINDOW_SHRINK * area_2d(piece) {
+        if hull.len() < 3 || signed_area_2d(&hull) > WINDOW_SHRINK * signed_area_2d(piece) {
             return Window::Wide;
         }
         Window::Narrowed { visible, hull }
@@ -1014,7 +1016,7 @@ fn tidy_shadow(corners: &[DVec2], e: &Emitter, min_width: f64) -> Option<Vec<DVe
     if shadow.len() < 3 {
         return None;
     }
-    if area_2d(&shadow) < 0.0 {
+    if signed_area_2d(&shadow) < 0.0 {
         shadow.reverse();
     }
     wider_than(&shadow, min_width).then_some(shadow)
@@ -1419,7 +1421,7 @@ mod tests {
         let x = floor_point(0.1, -0.2);
         let e = &narrow.emitters[0];
         let mut piece: Vec<DVec2> = e.pieces[0].iter().map(|&p| e.frame.to_2d(p)).collect();
-        if area_2d(&piece) < 0.0 {
+        if signed_area_2d(&piece) < 0.0 {
             piece.reverse();
         }
         let h_x = e.frame.height(x.point);

@@ -24,7 +24,8 @@ use std::time::Instant;
 use clipper2_rust::{ClipType, Clipper64, FillRule, Path64, Paths64, Point64, PolyTree64};
 use glam::DVec2;
 
-use crate::clip::{area_2d, clip_to_convex, convex_hull_2d};
+use crate::clip::{clip_to_convex, convex_hull_2d};
+use penumbra_scenes::polygon::signed_area_2d;
 
 /// Shadows go into one overlay until they have this many edges; the next batch is subtracted
 /// from what the last left visible, so no overlay holds the many overlapping shadows of a large
@@ -76,7 +77,7 @@ impl ShadowUnion {
     /// Adds the shadow of a face wholly inside the shaft: its corners' keys and projections.
     pub(crate) fn add_face(&mut self, keys: &[CornerKey], corners: &[DVec2]) {
         let n = corners.len();
-        let reversed = area_2d(corners) < 0.0;
+        let reversed = signed_area_2d(corners) < 0.0;
         for i in 0..n {
             let (a, b) = if reversed {
                 (n - 1 - i, (2 * n - 2 - i) % n)
@@ -184,7 +185,7 @@ type Shadow = Vec<Vec<DVec2>>;
 
 /// The shadows by area, largest first (ties in their given order).
 fn largest_first(mut shadows: Vec<Shadow>) -> Vec<Shadow> {
-    let area = |s: &Shadow| s.iter().map(|c| area_2d(c)).sum::<f64>();
+    let area = |s: &Shadow| s.iter().map(|c| signed_area_2d(c)).sum::<f64>();
     let mut ranked: Vec<(f64, Shadow)> = shadows.drain(..).map(|s| (area(&s), s)).collect();
     ranked.sort_by(|a, b| b.0.total_cmp(&a.0));
     ranked.into_iter().map(|(_, s)| s).collect()
@@ -497,7 +498,7 @@ mod tests {
     }
 
     fn area(shapes: &[VisibleShape]) -> f64 {
-        shapes.iter().flatten().map(|c| area_2d(c)).sum()
+        shapes.iter().flatten().map(|c| signed_area_2d(c)).sum()
     }
 
     /// The cells of an n x n grid of squares of side `step` that `keep` keeps, each as two
@@ -598,7 +599,7 @@ mod tests {
         assert!((area(&visible) - (25.0 - 1.75 - 0.25)).abs() < 1e-13);
         assert_eq!(visible.len(), 1);
         assert_eq!(visible[0].len(), 2, "one outline with one hole");
-        assert!(area_2d(&visible[0][1]) < 0.0);
+        assert!(signed_area_2d(&visible[0][1]) < 0.0);
     }
 
     /// 600 squares overlapping in a row, more edges than one batch: the union is counted once,
@@ -716,7 +717,7 @@ mod tests {
         ])
         .map(contour)
         .collect();
-        let visible_area = area_2d(&visible);
+        let visible_area = signed_area_2d(&visible);
         let left = difference(&[vec![visible]], &shadows, usize::MAX).expect("finite");
         assert!(area(&left).abs() < 1e-12 * visible_area, "{}", area(&left));
     }
