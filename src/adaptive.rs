@@ -22,7 +22,7 @@ use penumbra_solver::solve_hierarchical;
 use penumbra_solver::{Progress, ProgressiveSolver, Solution, SolveError, SolverOptions};
 use serde::Serialize;
 
-/// How adaptive refinement runs.
+/// How adaptive refinement runs ([`crate::RunOptions::refine`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct RefineOptions {
     /// Split triangles whose residual exceeds this fraction of the mean reflected radiosity
@@ -32,13 +32,17 @@ pub struct RefineOptions {
     /// Triangles of the mesh refinement starts from (the budget caps where it ends);
     /// [`INITIAL_FRACTION`] of the budget by default.
     pub initial_elements: usize,
-    /// Rounds at most.
+    /// Rounds at most, from 1 to [`crate::options::MAX_REFINE_ROUNDS`];
+    /// [`DEFAULT_MAX_ROUNDS`] by default.
     pub max_rounds: usize,
-    /// How full solutions estimate the indirect light's error.
+    /// How full solutions estimate the indirect light's error: from its gradient's jumps (the
+    /// default, and the only estimate the hierarchical solver takes), or gathered at triangle
+    /// centroids from the patches shot so far. Direct-only runs have no indirect light, and
+    /// ignore it.
     pub indirect: IndirectEstimate,
 }
 
-/// Why refinement stopped.
+/// Why refinement stopped (`refinement.stop` in `report.json`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum RefineStop {
@@ -71,23 +75,29 @@ pub const DEFAULT_MAX_ROUNDS: usize = 32;
 /// full solution. The indirect light is smooth, and what is still unshot changes it little.
 pub const ROUND_EPSILON: f64 = 0.02;
 
-/// One round: the residuals found, and what was split.
+/// One round: the residuals found, and what was split (an entry of `refinement.rounds` in
+/// `report.json`).
 #[derive(Clone, Debug, Serialize)]
 pub struct RefineRound {
+    /// Triangles of the mesh at the start of the round.
     pub triangles: usize,
-    /// Patch shots so far (none in direct-only runs).
+    /// Patch shots of progressive refinement so far (0 in direct-only runs and with the
+    /// hierarchical solver).
     pub shots: usize,
+    /// The residuals of this round's mesh, in W/m².
     pub residual: ResidualSummary,
-    /// The residual a triangle may have, in radiosity units: the tolerance times the mean
-    /// reflected radiosity.
+    /// The residual a triangle may have this round, in W/m²: the tolerance times this round's
+    /// mean reflected radiosity.
     pub threshold: f64,
-    /// Triangles over the tolerance, how many of them were split, and the triangles that made.
+    /// Triangles whose residual exceeds `threshold`.
     pub over_tolerance: usize,
+    /// Of those, how many were split: the worst, within the room left in the budget.
     pub split: usize,
+    /// Triangles the splits, and the quality refinement around them, added.
     pub added: usize,
 }
 
-/// What adaptive refinement did.
+/// What adaptive refinement did (`refinement` in `report.json`).
 #[derive(Clone, Debug, Serialize)]
 pub struct RefineReport {
     /// The tolerance asked for, relative to [`RefineReport::tolerance_relative_to`].
@@ -95,9 +105,11 @@ pub struct RefineReport {
     /// What the tolerance is a fraction of: always `"mean_reflected_radiosity"`, the
     /// area-weighted mean of B − E over the surfaces that reflect, round by round.
     pub tolerance_relative_to: &'static str,
+    /// Each round, in order. The last one splits nothing.
     pub rounds: Vec<RefineRound>,
+    /// Why refinement stopped.
     pub stop: RefineStop,
-    /// The residuals of the final mesh.
+    /// The residuals of the final mesh (those of the last round), in W/m².
     pub residual: ResidualSummary,
 }
 

@@ -22,18 +22,34 @@ use serde::Serialize;
 pub const ENERGY_BALANCE_TOLERANCE: f64 = 1e-3;
 
 /// Where the emitted power went, per channel and as fractions of the emitted power (channel
-/// means), and whether that account closes.
+/// means), and whether that account closes (`energy` in `report.json`). Powers are radiosity
+/// times area: W/m² times the scene's units squared, so watts per channel for a scene in metres.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct EnergyBalance {
+    /// Power leaving the emitters by their own emission, per channel.
     pub emitted: Rgb,
+    /// Power absorbed by all surfaces, ∫ (1 − ρ) H, per channel.
     pub absorbed: Rgb,
+    /// Shot power that no vertex received, per channel: light leaving an open scene, plus the
+    /// discretization error of vertex-sampled form factors. Negative where the mesh received
+    /// more light than was shot.
     pub escaped: Rgb,
+    /// Reflected power not propagated yet, per channel (see
+    /// [`SolveStats::unshot`](penumbra_solver::SolveStats::unshot)); it can be negative.
     pub unshot: Rgb,
+    /// Absorbed over emitted power (channel means); above 1 when the mesh received more light
+    /// than was shot.
     pub absorbed_fraction: f64,
+    /// Escaped over emitted power (channel means); negative when the mesh received more light
+    /// than was shot.
     pub escaped_fraction: f64,
+    /// Unshot over emitted power (channel means), with its sign (unlike
+    /// [`SolveStats::unshot_fraction`](penumbra_solver::SolveStats::unshot_fraction), a
+    /// magnitude).
     pub unshot_fraction: f64,
-    /// Emitted − absorbed − escaped − unshot, over the emitted power: the channel furthest from
-    /// zero.
+    /// Emitted − absorbed − escaped − unshot in the channel furthest from zero, with its sign,
+    /// over the emitted power (channel mean). Zero to rounding: the solvers keep the account
+    /// so that it closes.
     pub closure_error: f64,
     /// The account closes within [`ENERGY_BALANCE_TOLERANCE`] and nothing escaped negatively.
     pub balanced: bool,
@@ -45,6 +61,8 @@ impl EnergyBalance {
         EnergyBalance::new(stats.emitted, stats.absorbed, stats.escaped, stats.unshot)
     }
 
+    /// The account of these powers, per channel. Fractions are over the emitted power's
+    /// channel mean; an account of no light at all has fractions of 0, and is balanced.
     pub fn new(emitted: Rgb, absorbed: Rgb, escaped: Rgb, unshot: Rgb) -> EnergyBalance {
         let scale = emitted.mean().max(f64::MIN_POSITIVE);
         let fraction = |p: Rgb| p.mean() / scale;

@@ -5,8 +5,9 @@
 //! estimate is checked twice: from the scene and the budget before anything is built, then from
 //! the mesh's real counts before the solver allocates its form factors.
 //!
-//! The per-item costs are measured peaks (README, "Large scenes"), rounded up; the form-factor
-//! terms are upper bounds from the data structures (every vertex seeing every patch).
+//! The per-item costs are measured peaks (`docs/benchmarks.md`, "Large scenes"), rounded up;
+//! the form-factor terms are upper bounds from the data structures (every vertex seeing every
+//! patch).
 
 use penumbra_meshing::SceneMesh;
 use penumbra_scenes::Scene;
@@ -30,8 +31,11 @@ const BYTES_PER_PIXEL: u64 = 64;
 /// How big a mesh is, for the estimate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 pub struct MeshCounts {
+    /// Triangles over all surfaces.
     pub triangles: u64,
+    /// Vertices over all surfaces (the solver's receivers).
     pub vertices: u64,
+    /// The solver's shooting patches: groups of `elements_per_patch` triangles of a surface.
     pub patches: u64,
 }
 
@@ -69,17 +73,27 @@ impl MeshCounts {
     }
 }
 
-/// Bytes a run needs, in parts.
+/// Bytes a run needs, in parts (`memory.estimate` in `report.json`).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct MemoryEstimate {
+    /// The scene: a fixed amount per surface (its polygon, BVH triangles, discontinuity lists
+    /// and mesh's fixed parts).
     pub scene: u64,
+    /// The mesh and the solver's data for it: a fixed amount per triangle.
     pub mesh: u64,
-    /// Form factors kept by the solver: the rows of a hemicube, the gathering solvers' matrix.
+    /// Form factors kept by the solver: the hemicube's rows (progressive refinement with a
+    /// hemicube), the patch matrix (gathering and dense solves), the hierarchical solver's
+    /// links; 0 for direct light only and for progressive refinement otherwise, whose column
+    /// cache only takes what is left
+    /// ([`MemoryReport::cache_bytes`](crate::pipeline::MemoryReport::cache_bytes)).
     pub form_factors: u64,
+    /// The render: a fixed amount per pixel.
     pub render: u64,
 }
 
 impl MemoryEstimate {
+    /// Bytes in all: the parts, and a fixed base for the process itself, its buffers and the
+    /// allocator's slack. Saturates rather than overflows.
     pub fn total(&self) -> u64 {
         BASE_BYTES
             .saturating_add(self.scene)
@@ -89,8 +103,10 @@ impl MemoryEstimate {
     }
 }
 
-/// What a run of `options` over `scene` with a mesh of `counts` needs. The progressive solver's
-/// column cache is left out: it only uses what is left ([`cache_bytes`]).
+/// What a run of `options` over `scene` with a mesh of `counts` needs, in bytes: [`crate::run`]
+/// checks it against the memory limit with [`MeshCounts::predicted`] before meshing, and with
+/// [`MeshCounts::of_mesh`] before solving. The progressive solver's column cache is left out:
+/// it only uses what is left.
 pub fn estimate(scene: &Scene, options: &RunOptions, counts: MeshCounts) -> MemoryEstimate {
     let solver = &options.solver;
     let (v, p) = (counts.vertices, counts.patches);
@@ -126,7 +142,7 @@ pub fn estimate(scene: &Scene, options: &RunOptions, counts: MeshCounts) -> Memo
 
 /// The progressive solver's column cache: what it asks for, within half of what the estimate
 /// leaves of `limit`.
-pub fn cache_bytes(requested: usize, needed: u64, limit: u64) -> usize {
+pub(crate) fn cache_bytes(requested: usize, needed: u64, limit: u64) -> usize {
     let spare = limit.saturating_sub(needed) / 2;
     usize::try_from(spare).map_or(requested, |spare| requested.min(spare))
 }
@@ -135,7 +151,7 @@ pub fn cache_bytes(requested: usize, needed: u64, limit: u64) -> usize {
 /// estimate for a mesh of `counts` fits in `limit`, rounded up to two digits; `None` for other
 /// solvers, or when even the coarsest links do not fit (the nodes and the mesh alone are too
 /// many).
-pub fn least_fitting_link_tol(
+pub(crate) fn least_fitting_link_tol(
     scene: &Scene,
     options: &RunOptions,
     counts: MeshCounts,
@@ -173,7 +189,7 @@ pub fn least_fitting_link_tol(
 
 /// The largest element budget at most `max_elements` whose predicted estimate fits in `limit`,
 /// if any does.
-pub fn largest_fitting_budget(
+pub(crate) fn largest_fitting_budget(
     scene: &Scene,
     options: &RunOptions,
     max_elements: usize,

@@ -1,9 +1,9 @@
 //! The options of a run, their defaults, and the one place their ranges are checked, for the
 //! command line and library callers alike.
 
+use penumbra_meshing::DEFAULT_PENUMBRA_DENSITY;
 use penumbra_meshing::ElementBudget;
 use penumbra_meshing::discontinuity::DiscontinuityOptions;
-use penumbra_meshing::DEFAULT_PENUMBRA_DENSITY;
 use penumbra_solver::estimate::IndirectEstimate;
 use penumbra_solver::{SolveError, SolverMethod, SolverOptions};
 use penumbra_viz::RenderOptions;
@@ -12,7 +12,7 @@ use serde::Serialize;
 use crate::adaptive::RefineOptions;
 use crate::shard::Shard;
 
-/// How surfaces are meshed.
+/// How surfaces are meshed (`--mesh`; `method.mesh_requested` in `report.json`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum MeshMethod {
@@ -20,16 +20,19 @@ pub enum MeshMethod {
     Uniform,
     /// The same, with the discontinuities of the direct light as constraint edges.
     Discontinuity,
-    /// Discontinuity meshing where the scene casts shadows, uniform meshing where it has none.
+    /// Discontinuity meshing if the scene casts shadows, else uniform: the discontinuity search
+    /// is made, and a scene where it finds no segment (and skips no emitter–receiver pair) is
+    /// meshed uniformly.
     Auto,
 }
 
-/// Triangles for the whole scene by default: this many, or what the scene needs when that is
-/// more (its least mesh and [`penumbra_meshing::FIT_TRIANGLES_PER_SURFACE`] per surface; see
-/// [`ElementBudget::Fit`]).
+/// Triangles for the whole scene by default with every solver but the hierarchical one, and in
+/// direct-only runs: this many, or what the scene needs when that is more (its least mesh and
+/// [`penumbra_meshing::FIT_TRIANGLES_PER_SURFACE`] per surface; see [`ElementBudget::Fit`]).
 pub const DEFAULT_MAX_ELEMENTS: usize = 10_000;
 
-/// The element budget of a run when none is given.
+/// The element budget of a run when none is given, but for a full solution by the hierarchical
+/// solver ([`default_budget`]): [`DEFAULT_MAX_ELEMENTS`] fitted to the scene.
 pub const DEFAULT_BUDGET: ElementBudget = ElementBudget::fit(DEFAULT_MAX_ELEMENTS);
 
 /// Triangles for the whole scene by default with the hierarchical solver: its cost grows about
@@ -66,13 +69,17 @@ pub struct RunOptions {
     pub mesh: MeshMethod,
     /// Triangles for the whole scene: a cap, or fitted to the scene ([`default_budget`]).
     pub max_elements: ElementBudget,
-    /// How many times smaller in area discontinuity-mesh triangles are in penumbrae (1: none).
+    /// How many times smaller in area discontinuity-mesh triangles are in penumbrae than in
+    /// full light or full shadow: from 1 (no grading) to [`MAX_PENUMBRA_DENSITY`];
+    /// [`DEFAULT_PENUMBRA_DENSITY`] by default.
     pub penumbra_density: f64,
     /// How discontinuities are found (EEE events on or off, tolerances).
     pub discontinuity: DiscontinuityOptions,
     /// Adaptive refinement from a coarser mesh up to `max_elements`, if asked for.
     pub refine: Option<RefineOptions>,
-    /// Seconds after which refinement and shooting stop and the best solution so far is kept.
+    /// Seconds from the run's start after which the discontinuity search, adaptive refinement
+    /// and the solver stop, and the best so far is kept (`None`: no limit); `report.json` then
+    /// marks the run `partial`.
     pub time_budget: Option<f64>,
     /// The solver's own options (tolerances, rays, seed, interrupt).
     pub solver: SolverOptions,
@@ -177,7 +184,9 @@ impl RunOptions {
         if !(1..=MAX_RENDER_SIZE).contains(&width) || !(1..=MAX_RENDER_SIZE).contains(&height) {
             return Err(InvalidOption::new(
                 "render size",
-                format!("must be from 1 to {MAX_RENDER_SIZE} pixels a side, not {width} x {height}"),
+                format!(
+                    "must be from 1 to {MAX_RENDER_SIZE} pixels a side, not {width} x {height}"
+                ),
             ));
         }
         if let Some(refine) = &self.refine {
@@ -205,7 +214,10 @@ impl RunOptions {
         if !(1..=MAX_REFINE_ROUNDS).contains(&refine.max_rounds) {
             return Err(InvalidOption::new(
                 "refine rounds",
-                format!("must be from 1 to {MAX_REFINE_ROUNDS}, not {}", refine.max_rounds),
+                format!(
+                    "must be from 1 to {MAX_REFINE_ROUNDS}, not {}",
+                    refine.max_rounds
+                ),
             ));
         }
         let direct_only = self.solver.direct_only;

@@ -16,7 +16,9 @@ use serde::Serialize;
 use crate::energy::EnergyBalance;
 use crate::pipeline::{RunResult, StageTimes};
 
+/// The `format` of `solution.json`, and its version (`docs/schemas/solution.schema.json`).
 pub const SOLUTION_FORMAT: &str = "penumbra-solution/1";
+/// The `format` of `report.json`, and its version (`docs/schemas/report.schema.json`).
 pub const REPORT_FORMAT: &str = "penumbra-report/1";
 
 #[derive(Serialize)]
@@ -31,23 +33,43 @@ struct SolutionFile<'a> {
 #[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SurfaceSolution {
+    /// The surface's index in the scene: in a shard's part only.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub index: Option<SurfaceId>,
+    /// The surface's name in the scene, unique within it.
     pub name: String,
+    /// The mesh's vertices, in 3D scene coordinates and units. The two sides of a value
+    /// discontinuity (a blocker touching the surface) each have their own vertex at the same
+    /// position.
     pub vertices: Vec<[f64; 3]>,
+    /// The mesh's triangles, as indices into `vertices`, counter-clockwise seen from the
+    /// surface's front.
     pub triangles: Vec<[u32; 3]>,
+    /// Radiosity B at each vertex, `[r, g, b]` in W/m², in the order of `vertices`: the
+    /// surface's own emission included, the display-only ambient term left out.
     pub radiosity: Vec<[f64; 3]>,
+    /// The discontinuity segments of the direct light built into the mesh as edges (none for
+    /// uniform meshes, for surfaces no shadow falls on, and for emitters).
     pub discontinuities: Vec<Discontinuity>,
 }
 
-/// A discontinuity segment of the direct light on a surface (none for uniform meshes).
+/// A straight segment of a discontinuity line of the direct light on a surface, as
+/// `solution.json` gives it (curved EEE lines come as several segments).
 #[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Discontinuity {
+    /// The segment's first end, in 3D scene coordinates, on the surface.
     pub from: [f64; 3],
+    /// The segment's second end.
     pub to: [f64; 3],
+    /// The visual event that makes the line: `EV`, `VE`, `EEE`, `contact`, `blocker-EV` or
+    /// `horizon` ([`Event::name`](penumbra_meshing::discontinuity::Event::name)).
     pub event: String,
+    /// What the line bounds: `umbra` (one side sees none of the emitter), `penumbra` (one side
+    /// sees all of it) or `inner` (both sides see part of it).
     pub boundary: String,
+    /// Which derivative of the direct light jumps across the line: 0 the value (contact
+    /// lines), 1 the slope, 2 the curvature.
     pub order: u8,
 }
 
@@ -76,7 +98,9 @@ pub fn surface_solution(result: &RunResult, s: SurfaceId) -> SurfaceSolution {
     }
 }
 
-/// `solution.json`: per surface, vertices, triangles and radiosity (no display-only ambient term).
+/// `solution.json`: per surface in the scene's order, its mesh's vertices and triangles, the
+/// radiosity at every vertex (no display-only ambient term) and its discontinuity segments;
+/// pretty-printed, with a final newline.
 pub fn solution_json(result: &RunResult) -> String {
     let surfaces: Vec<SurfaceSolution> = (0..result.mesh.surfaces.len())
         .map(|s| surface_solution(result, s))
@@ -268,7 +292,9 @@ pub fn quality_warning(below: usize, triangles: usize, adaptive: bool) -> Option
     })
 }
 
-/// `report.json`, for a run whose SVGs are chosen by `svgs`.
+/// `report.json`, for a run whose SVGs are chosen by `svgs`: how the run was made, what it
+/// built, stage times, memory, the solver's figures, the energy balance, mesh quality and the
+/// warnings of the loader and the run (`docs/schemas/report.schema.json`).
 pub fn report_json(result: &RunResult, svgs: &SvgSelection) -> String {
     let scene = &result.loaded.scene;
     let stats = &result.solution.stats;
@@ -380,7 +406,9 @@ pub enum SvgSelection {
     /// first, then the largest, then the first in the scene.
     #[default]
     Auto,
+    /// Every surface.
     All,
+    /// No surface.
     None,
     /// These surfaces, by index.
     Named(Vec<SurfaceId>),
@@ -566,6 +594,9 @@ pub struct Staging {
 }
 
 impl Staging {
+    /// Writes `bytes` to a temporary file beside `path`, to be renamed into place by
+    /// [`Staging::commit`]. If that fails (the file cannot be written, or a directory stands at
+    /// `path`), the temporary is removed; what was staged before stays staged.
     pub fn stage(&mut self, path: PathBuf, bytes: &[u8]) -> anyhow::Result<()> {
         use anyhow::Context;
         // A directory in the file's place would fail its rename after others were done.
@@ -616,9 +647,10 @@ pub fn write_all_atomic(files: &[(PathBuf, Vec<u8>)]) -> anyhow::Result<()> {
 /// tens of thousands of surfaces).
 const SVG_BATCH: usize = 256;
 
-/// Writes every output of a run into `dir` (created if needed), the SVGs of the surfaces `svgs`
-/// chooses in `dir/surfaces`, with `extra` files (name and bytes) beside them, all or nothing
-/// (see [`Staging`]); returns the paths written.
+/// Writes every output of a run into `dir` (created if needed): `solution.json`, `report.json`,
+/// `render.png`, the SVGs of the surfaces `svgs` chooses in `dir/surfaces` ([`SVG_DIR`],
+/// named by [`svg_name`]), and `extra` files (name and bytes) beside them, all or nothing (see
+/// [`Staging`]); returns the paths written.
 pub fn write_outputs(
     result: &RunResult,
     dir: &Path,

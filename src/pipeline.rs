@@ -1,5 +1,5 @@
-//! The pipeline: load, mesh, build visibility, solve, render. Pure computation; writing the
-//! results is [`crate::outputs`]' job.
+//! The pipeline: from a loaded scene, build visibility, find the discontinuities, mesh, light
+//! and solve, render. Pure computation; writing the results is [`crate::outputs`]' job.
 
 use std::time::Instant;
 
@@ -20,84 +20,133 @@ use penumbra_solver::{
 use penumbra_viz::{Render, VizError};
 use serde::Serialize;
 
-/// Wall-clock seconds per stage.
+/// Wall-clock seconds per stage (`times_seconds` in `report.json`).
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct StageTimes {
+    /// Building the visibility index (the BVH).
     pub visibility: f64,
+    /// The discontinuity search (0 for uniform meshes).
     pub discontinuities: f64,
+    /// Meshing.
     pub mesh: f64,
-    /// Adaptive refinement's residuals and splits (its solving is counted below).
+    /// Adaptive refinement's own work, residuals and splits (its solving is counted in
+    /// `direct`, `shooting` and `gather`); 0 without refinement.
     pub refine: f64,
+    /// The exact direct light.
     pub direct: f64,
+    /// Solving after the direct light: shooting, sweeps, the hierarchical solver's links.
     pub shooting: f64,
-    /// New vertices gathering the light shot before the mesh was refined.
+    /// Vertices gathering light: new vertices of refined meshes gathering what was shot
+    /// before, the hierarchical solver's final gather.
     pub gather: f64,
+    /// Rendering `render.png`.
     pub render: f64,
+    /// The whole run, from its start to the end of the render (writing the files aside).
     pub total: f64,
 }
 
-/// The most memory the process had held by the end of each stage (bytes; absent where the
-/// system does not say).
+/// The most memory the process had held (its peak resident set, in bytes) by the end of each
+/// stage; `None` where the system does not say ([`memory::peak_resident_bytes`]). The peak
+/// is the whole process's, so it includes whatever the caller held before the run.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct StagePeaks {
+    /// After building the visibility index.
     pub visibility: Option<u64>,
+    /// After the discontinuity search.
     pub discontinuities: Option<u64>,
+    /// After meshing.
     pub mesh: Option<u64>,
+    /// After solving (adaptive refinement included).
     pub solve: Option<u64>,
+    /// After rendering.
     pub render: Option<u64>,
 }
 
-/// What the run was expected to need, what it could have, and what it used.
+/// What the run was expected to need, what it could have, and what it used (`memory` in
+/// `report.json`).
 #[derive(Clone, Debug, Serialize)]
 pub struct MemoryReport {
-    /// Bytes the run could use: the run's memory limit, or what the machine had available.
+    /// Bytes the run could use: [`RunOptions::memory_limit`], or what the machine had
+    /// available when the run started ([`memory::available_bytes`]); `None` where the system
+    /// does not say.
     pub limit_bytes: Option<u64>,
-    /// Estimated from the mesh that was built.
+    /// Bytes the run was estimated to need in all (`estimate`'s parts and a fixed base): from
+    /// the mesh that was built or, with adaptive refinement, the most of that and of the mesh
+    /// grown to the budget.
     pub estimate_bytes: u64,
+    /// The estimate's parts, in bytes.
     pub estimate: memory::MemoryEstimate,
-    /// The progressive solver's form-factor cache, as capped to fit.
+    /// Bytes allowed for the progressive solver's cache of vertex–patch form factors: what
+    /// [`penumbra_solver::SolverOptions::cache_bytes`] asks for, within half of what the
+    /// estimate leaves of `limit_bytes`.
     pub cache_bytes: usize,
+    /// The process's peak resident set by the end of each stage, in bytes.
     pub peak_bytes: StagePeaks,
 }
 
-/// Everything a run computes.
+/// Everything a run computes: what [`crate::outputs`] writes, in memory.
 #[derive(Debug)]
 pub struct RunResult {
+    /// The scene that was run, with its source and the loader's warnings.
     pub loaded: LoadedScene,
+    /// The options the run was given (before [`run`] resolved the budget and the deadline).
     pub options: RunOptions,
+    /// The final mesh: per surface, its triangles and vertices, and the discontinuity segments
+    /// built into it (the discontinuity search's figures, if one was made).
     pub mesh: SceneMesh,
+    /// What adaptive refinement did, if it was asked for.
     pub refinement: Option<RefineReport>,
-    /// The element budget used, resolved: the mesh's, or the cap of adaptive refinement.
+    /// The element budget used, in triangles for the whole scene, resolved: the mesh's, or the
+    /// cap of adaptive refinement. The mesh may have fewer.
     pub budget: usize,
+    /// Radiosity (W/m² per channel) and irradiance at every vertex of `mesh`, per surface in
+    /// the scene's order, with the solver's figures. It leaves out the display-only ambient
+    /// term (`solution.ambient`), which only `render` adds.
     pub solution: Solution,
+    /// The image from the scene's camera, and the exposure it was made with.
     pub render: Render,
+    /// Wall-clock seconds per stage.
     pub times: StageTimes,
+    /// The memory the run was expected to need, what it could have, and what it used.
     pub memory: MemoryReport,
     /// The command line that asked for the run, if one did (set by the front end; recorded in
     /// `report.json`).
     pub invocation: Option<crate::outputs::Invocation>,
 }
 
+/// Why a run failed. [`RunError::is_usage`] tells the errors a user fixes by changing the
+/// options (a bad option, a budget or memory too small) from failures of the run.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum RunError {
+    /// An option out of its range, or options that do not go together
+    /// ([`RunOptions::validate`]).
     #[error(transparent)]
     InvalidOption(#[from] InvalidOption),
+    /// Meshing failed, or the scene's least mesh does not fit a capped element budget
+    /// ([`MeshError::BudgetTooSmall`]).
     #[error(transparent)]
     Mesh(#[from] MeshError),
     /// The starting mesh of adaptive refinement does not fit its budget
-    /// ([`RefineOptions::initial_elements`]), though the scene fits the run's budget.
+    /// ([`RefineOptions::initial_elements`](crate::adaptive::RefineOptions::initial_elements)),
+    /// though the scene fits the run's budget.
     #[error("the starting mesh of adaptive refinement: {0}")]
     InitialBudget(MeshError),
+    /// Solving failed, or the run was interrupted ([`SolveError::Interrupted`]) before a
+    /// solution existed.
     #[error(transparent)]
     Solve(#[from] SolveError),
+    /// The render failed.
     #[error(transparent)]
     Render(#[from] VizError),
+    /// The options cannot be split into shards ([`crate::shard::Shard::check`]).
     #[error(transparent)]
     Shard(#[from] ShardError),
+    /// The run's estimated memory exceeds what it may use; refused before the stage that would
+    /// allocate it. The message says what would fit.
     #[error("{}", memory_message(.needed, .limit, .suggestion, .link_tol))]
     Memory {
-        /// Estimated bytes.
+        /// Bytes the run was estimated to need.
         needed: u64,
         /// Bytes the run may use.
         limit: u64,
@@ -155,7 +204,17 @@ fn planned_budget(scene: &penumbra_scenes::Scene, options: &RunOptions) -> usize
         .max(1)
 }
 
-/// Runs the whole pipeline on a loaded scene.
+/// Runs the whole pipeline on a loaded scene: validates `options`, then builds visibility,
+/// finds the discontinuities, meshes, solves and renders, reporting each long stage to
+/// `progress`.
+///
+/// Memory is checked before it is spent: from the scene and the budget before anything is
+/// built, then from the mesh's real counts before the solver allocates ([`RunError::Memory`]).
+/// A time budget ([`RunOptions::time_budget`]) cuts the discontinuity search and the solve short
+/// and keeps the best so far. An interrupt
+/// ([`SolverOptions::interrupt`](penumbra_solver::SolverOptions::interrupt)) ends the run with
+/// [`SolveError::Interrupted`] while no solution exists yet, and like the time budget after
+/// that; `solution.stats.stop` says why a solve stopped.
 pub fn run(
     loaded: LoadedScene,
     options: &RunOptions,

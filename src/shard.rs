@@ -33,11 +33,11 @@ use penumbra_scenes::{LoadedScene, PlaneFrame, Rgb, Scene, SceneError, SurfaceId
 use serde::{Deserialize, Serialize};
 
 use crate::energy::EnergyBalance;
+use crate::options::RunOptions;
 use crate::outputs::{
     DEFAULT_SVG_SURFACES, SVG_DIR, Staging, SurfaceSolution, SvgSelection, report_json,
     solution_json_of, surface_solution, svg_name, worth_looking_at,
 };
-use crate::options::RunOptions;
 use crate::pipeline::RunResult;
 
 /// The file a shard writes into its output directory.
@@ -48,7 +48,9 @@ pub const SHARD_FORMAT: &str = "penumbra-shard/1";
 /// One of `count` parts of a scene's surfaces: those whose index is `index` modulo `count`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Shard {
+    /// Which part, from 0 to `count - 1`.
     pub index: usize,
+    /// How many parts the scene is split into, at least 1.
     pub count: usize,
 }
 
@@ -56,22 +58,33 @@ pub struct Shard {
 #[derive(Debug, thiserror::Error, PartialEq, Eq)]
 #[non_exhaustive]
 pub enum ShardError {
+    /// The text given to [`Shard::parse`] is not `I/N`.
     #[error("a shard is written I/N with whole numbers I and N (I from 0 to N - 1), not {0:?}")]
     Syntax(String),
+    /// A count of 0.
     #[error("a scene cannot be split into 0 shards")]
     NoShards,
+    /// An index not below the count.
     #[error("there is no shard {index} of {count}: shards are numbered from 0 to {}", .count - 1)]
-    OutOfRange { index: usize, count: usize },
+    OutOfRange {
+        /// The index asked for.
+        index: usize,
+        /// The count of shards.
+        count: usize,
+    },
+    /// A full solution was asked for: only the direct light can be split.
     #[error(
         "a full solution cannot be split by surface: light bounces between all surfaces, so each \
          one's radiosity depends on every other's; only the direct light can be split"
     )]
     NeedsDirectOnly,
+    /// Adaptive refinement was asked for.
     #[error(
         "adaptive refinement cannot be split by surface: it spends one element budget over the \
          whole scene, against the scene's mean radiosity"
     )]
     Refinement,
+    /// A time budget was given.
     #[error(
         "a time budget cannot be split by surface: it would cut the shards short at different \
          points, and their parts would not belong to one run"
@@ -127,8 +140,9 @@ impl Shard {
 
 /// Whether a shard of a run with these options finds the discontinuities of its own surfaces and
 /// meshes them alone: a fitted budget of a scene whose polygons need more than the budget's
-/// floor ([`penumbra_meshing::ElementBudget::shared_extra`]) gives each surface a share that depends on nothing
-/// else. Otherwise each shard meshes the whole scene, as the run not split does.
+/// floor ([`penumbra_meshing::ElementBudget::shared_extra`]) gives each surface a share that
+/// depends on nothing else. Otherwise each shard meshes the whole scene, as the run not split
+/// does.
 pub fn meshed_alone(scene: &Scene, options: &RunOptions) -> bool {
     options.refine.is_none()
         && options
@@ -160,16 +174,21 @@ pub struct SceneOrigin {
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ShardFile {
+    /// [`SHARD_FORMAT`]; [`read_shard`] refuses any other.
     pub format: String,
+    /// Which shard wrote the file.
     pub shard: Shard,
     /// Of the scene and every option that changes an output: shards of one run share it.
     pub fingerprint: String,
     /// Of the scene alone.
     pub scene_fingerprint: String,
+    /// How the scene was given, for the merge to load it again.
     pub scene: SceneOrigin,
     /// Surfaces in the scene.
     pub scene_surfaces: usize,
+    /// The render's width in pixels, for the merge's render.
     pub render_width: u32,
+    /// The render's height in pixels.
     pub render_height: u32,
     /// The loader's warnings.
     pub warnings: Vec<String>,
@@ -296,21 +315,37 @@ pub fn write_shard(
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum MergeError {
+    /// No shard directory was given.
     #[error("no shard directories given")]
     Nothing,
+    /// A shard file could not be read.
     #[error("cannot read {}: {source} (is it the output directory of a sharded run?)", .path.display())]
     Read {
+        /// The file.
         path: PathBuf,
+        /// Why it could not be read.
         source: std::io::Error,
     },
+    /// A file is not a shard file of this format: not its JSON, another format, or a shard
+    /// number out of range.
     #[error("{} is not a shard file: {message}", .path.display())]
-    NotAShard { path: PathBuf, message: String },
+    NotAShard {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong with it.
+        message: String,
+    },
+    /// Two shards are of different runs: their scenes, options or shard counts differ.
     #[error("{} is not from the same run as {}: {what} differ", .dir.display(), .first.display())]
     Mixed {
+        /// The first shard's directory.
         first: PathBuf,
+        /// The directory of the shard that differs from it.
         dir: PathBuf,
+        /// What differs, in words (`"their options"`).
         what: &'static str,
     },
+    /// Two shards of a run whose mesh the scene chose (`auto`) chose differently.
     #[error(
         "{} meshed its surfaces by {mesh} but {} by {first_mesh}: when the mesh is chosen by the \
          scene, a shard whose surfaces have no discontinuities meshes them uniformly, unlike the \
@@ -318,38 +353,66 @@ pub enum MergeError {
         .dir.display(), .first.display()
     )]
     MeshChoice {
+        /// The first shard's directory.
         first: PathBuf,
+        /// The directory of the shard that differs from it.
         dir: PathBuf,
+        /// The first shard's mesh: `discontinuity` or `uniform`.
         first_mesh: String,
+        /// The other shard's mesh.
         mesh: String,
     },
+    /// A shard is given twice.
     #[error("shard {shard} is given twice: {} and {}", .first.display(), .second.display())]
     Duplicate {
+        /// The shard.
         shard: Shard,
+        /// One directory that holds it.
         first: PathBuf,
+        /// Another.
         second: PathBuf,
     },
+    /// Shards of the run are missing.
     #[error("missing {} {} of {count}", if .missing.len() == 1 { "shard" } else { "shards" }, list(.missing))]
-    Missing { missing: Vec<usize>, count: usize },
+    Missing {
+        /// Their indices.
+        missing: Vec<usize>,
+        /// The count of shards of the run.
+        count: usize,
+    },
+    /// A shard file holds a surface that is not its shard's, or not in the scene.
     #[error("{}: surface {index} ({name:?}) is not this shard's, or not the scene's", .path.display())]
     StraySurface {
+        /// The shard file.
         path: PathBuf,
+        /// The surface's index as the file gives it (`usize::MAX` when it gives none).
         index: usize,
+        /// The surface's name.
         name: String,
     },
+    /// A shard was cut short.
     #[error(
         "{} was cut short (interrupted: its discontinuity search skipped pairs), so its mesh is \
          not the run's; run that shard again",
         .dir.display()
     )]
-    Partial { dir: PathBuf },
+    Partial {
+        /// The shard's directory.
+        dir: PathBuf,
+    },
+    /// The scene the shards were run on could not be loaded again.
     #[error("cannot load the scene to render the joined solution: {0}")]
     Scene(#[source] SceneError),
+    /// The scene loaded is not the one the shards were run on (its fingerprint differs).
     #[error(
         "the scene loaded from {spec:?} is not the one the shards were run on (it has changed, \
          or names another file from here)"
     )]
-    SceneChanged { spec: String },
+    SceneChanged {
+        /// The scene as given on the command line.
+        spec: String,
+    },
+    /// The joined solution could not be rendered.
     #[error(transparent)]
     Render(#[from] penumbra_viz::VizError),
 }
@@ -476,14 +539,22 @@ pub fn check_shards(
 /// Shards joined: the files of the run they were split from.
 #[derive(Debug)]
 pub struct Merged {
+    /// The scene's name.
     pub scene_name: String,
+    /// Shards joined.
     pub shards: usize,
+    /// Surfaces of the scene.
     pub surfaces: usize,
+    /// Triangles of the joined mesh, over all surfaces.
     pub triangles: usize,
+    /// Vertices of the joined mesh, over all surfaces.
     pub vertices: usize,
     /// `solution.json`, as the run not split would have written it.
     pub solution_json: String,
+    /// `report.json`: the first shard's, with the light's figures joined over the shards, the
+    /// mesh's summed where the shards meshed alone, and a `shards` section.
     pub report_json: String,
+    /// `render.png` of the joined solution, encoded.
     pub render_png: Vec<u8>,
     /// Each SVG: where a shard wrote it, and its place relative to the output directory.
     pub svgs: Vec<(PathBuf, String)>,

@@ -24,10 +24,14 @@ use crate::pipeline::{RunError, run};
 /// A way of meshing that a sweep compares.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SweepMethod {
+    /// Uniform meshes of the budget.
     Uniform,
+    /// Uniform meshes refined adaptively from a fraction of the budget up to it.
     UniformAdaptive,
     /// Discontinuity meshes of the default events ([`EventSet::Complete`]).
     Discontinuity,
+    /// Discontinuity meshes refined adaptively from a fraction of the budget up to it, without
+    /// penumbra grading (refinement places the small triangles).
     DiscontinuityAdaptive,
     /// Discontinuity meshes of every vertex–edge event ([`EventSet::Complete`]).
     DiscontinuityComplete,
@@ -53,6 +57,9 @@ impl SweepMethod {
         SweepMethod::DiscontinuityExtremal,
     ];
 
+    /// The method's name in `--methods`, the CSV and the charts: `uniform`,
+    /// `uniform+adaptive`, `discontinuity`, `discontinuity+adaptive`, `discontinuity-complete`
+    /// or `discontinuity-extremal`.
     pub fn name(self) -> &'static str {
         match self {
             SweepMethod::Uniform => "uniform",
@@ -92,6 +99,7 @@ impl SweepMethod {
 pub struct SweepOptions {
     /// Element budgets (`--max-elements` of each run).
     pub budgets: Vec<usize>,
+    /// The meshing methods compared; each runs at every budget.
     pub methods: Vec<SweepMethod>,
     /// Names of the surfaces scored, for the record (empty: all; the samples are chosen by
     /// [`sample_points`]).
@@ -101,9 +109,11 @@ pub struct SweepOptions {
     /// Tolerance of the adaptive runs at the first budget; it shrinks in proportion as the
     /// budget grows, so that larger budgets are spent.
     pub refine_tol: f64,
-    /// Sample points and their seed.
+    /// Sample points the runs are scored at ([`sample_points`]).
     pub samples: usize,
+    /// The seed of the sample points.
     pub seed: u64,
+    /// The solver's options for every run (`direct_only` makes a direct-light sweep).
     pub solver: SolverOptions,
     /// The solvers to compare (each non-adaptive run is repeated with each, adaptive runs with
     /// progressive refinement and the hierarchical solver; direct-light sweeps use progressive
@@ -117,7 +127,10 @@ impl SweepOptions {
     pub fn validate(&self) -> Result<(), InvalidOption> {
         let bad = |option, reason: String| Err(InvalidOption { option, reason });
         if self.budgets.is_empty() || self.budgets.contains(&0) {
-            return bad("max elements", "every budget must be at least 1 triangle".into());
+            return bad(
+                "max elements",
+                "every budget must be at least 1 triangle".into(),
+            );
         }
         if self.samples == 0 {
             return bad("samples", "must be at least 1".into());
@@ -131,7 +144,10 @@ impl SweepOptions {
         if !(self.initial_fraction > 0.0 && self.initial_fraction <= 1.0) {
             return bad(
                 "initial elements",
-                format!("the fraction must be in (0, 1], not {}", self.initial_fraction),
+                format!(
+                    "the fraction must be in (0, 1], not {}",
+                    self.initial_fraction
+                ),
             );
         }
         self.solver.validate()?;
@@ -148,21 +164,33 @@ pub enum Reference {
     PathTraced(Vec<ReferenceValue>),
 }
 
-/// One run of a sweep: its size, its time and its error. Errors are relative to the mean of the
-/// reference over the samples.
+/// One run of a sweep: its size, its time and its error. Errors compare the channel means of
+/// the run's interpolated radiosity and of the reference at the samples, relative to the mean of
+/// the reference over the samples.
 #[derive(Clone, Debug, Serialize)]
 pub struct SweepRow {
+    /// The meshing method ([`SweepMethod::name`]).
     pub method: &'static str,
-    /// How the system was solved: progressive, jacobi, gauss-seidel or direct.
+    /// How the system was solved, as [`SolverMethod::name`] names it (`direct` is the dense
+    /// solve); `progressive` in direct-light sweeps, which solve no system.
     pub solver: &'static str,
+    /// The run's element budget, in triangles for the whole scene.
     pub max_elements: usize,
-    /// The adaptive runs' tolerance.
+    /// The adaptive runs' tolerance (a fraction of the mean reflected radiosity); `None` for
+    /// the others.
     pub refine_tol: Option<f64>,
+    /// Triangles of the run's final mesh.
     pub triangles: usize,
+    /// Vertices of the run's final mesh.
     pub vertices: usize,
+    /// Wall-clock seconds of the run, rendering left out.
     pub seconds: f64,
+    /// Root mean square error over the samples, relative to the reference's mean.
     pub rms: f64,
+    /// Largest error over the samples, relative to the reference's mean.
     pub max: f64,
+    /// Root mean square error over the penumbra samples, relative to the reference's mean over
+    /// all samples (0 when there are none).
     pub penumbra_rms: f64,
     /// The sample with the largest error, to see where a method fails.
     pub worst: Option<WorstSample>,
@@ -171,27 +199,38 @@ pub struct SweepRow {
 /// Where a run's error is largest.
 #[derive(Clone, Debug, Serialize)]
 pub struct WorstSample {
+    /// The name of the surface the sample lies on.
     pub surface: String,
+    /// The sample, in 3D scene coordinates.
     pub point: [f64; 3],
-    /// Reference and interpolated radiosity (channel means).
+    /// The reference radiosity there, in W/m² (channel mean).
     pub reference: f64,
+    /// The run's interpolated radiosity there, in W/m² (channel mean).
     pub value: f64,
 }
 
-/// A sweep's samples, reference and rows.
+/// A sweep's samples, reference and rows (`sweep.json`).
 #[derive(Clone, Debug, Serialize)]
 pub struct Sweep {
+    /// The format and its version: `penumbra-sweep/1`.
     pub format: &'static str,
+    /// The scene's name.
     pub scene: String,
     /// The surfaces scored (empty: every surface that does not emit).
     pub surfaces: Vec<String>,
+    /// What the runs were scored against: `exact direct light` or `path traced`.
     pub reference: &'static str,
     /// Root mean square of the reference's standard errors relative to the mean (zero for the
     /// exact direct light).
     pub reference_standard_error: f64,
+    /// Sample points scored.
     pub samples: usize,
+    /// Of those, the samples where some emitter is partly hidden.
     pub penumbra_samples: usize,
+    /// The reference's mean over the samples, in W/m² (channel mean): the scale of every
+    /// relative error.
     pub reference_mean: f64,
+    /// Every run, budget by budget, method by method within a budget.
     pub rows: Vec<SweepRow>,
 }
 
@@ -199,13 +238,20 @@ pub struct Sweep {
 /// some emitter is partly hidden from it.
 #[derive(Clone, Copy, Debug)]
 pub struct Sample {
+    /// The point, in 3D scene coordinates.
     pub point: DVec3,
+    /// The surface it lies on.
     pub surface: SurfaceId,
+    /// The exact direct radiosity there, emission included, in W/m² (channel mean).
     pub direct: f64,
+    /// Whether some emitter is partly hidden from the point.
     pub penumbra: bool,
 }
 
-/// Runs the sweep at `samples` (from [`sample_points`]) against `reference`.
+/// Runs the sweep at `samples` (from [`sample_points`]) against `reference`: every method of
+/// `options` at every budget (and, in full solutions, with every solver; adaptive methods with
+/// the progressive and hierarchical solvers only), each a whole [`run`] with a 1 × 1 render.
+/// Fails with the first run that fails.
 pub fn sweep(
     loaded: &LoadedScene,
     options: &SweepOptions,
