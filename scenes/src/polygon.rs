@@ -53,7 +53,7 @@ pub fn canonical_starts(points: &[DVec3]) -> Vec<usize> {
 /// The first of [`canonical_starts`] in list order: the corner a polygon's frame starts at.
 /// Where the polygon has a rotational symmetry, the list decides among equivalent corners, so
 /// that a moved scene keeps its frames (see [`crate::PlaneFrame`]).
-pub fn canonical_start(points: &[DVec3]) -> usize {
+pub(crate) fn canonical_start(points: &[DVec3]) -> usize {
     canonical_starts(points).first().copied().unwrap_or(0)
 }
 
@@ -124,7 +124,7 @@ pub fn orient(a: DVec2, b: DVec2, c: DVec2) -> f64 {
 }
 
 /// Whether the closed segments `a-b` and `c-d` share at least one point (exact).
-pub fn segments_touch(a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> bool {
+pub(crate) fn segments_touch(a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> bool {
     let o1 = orient(a, b, c);
     let o2 = orient(a, b, d);
     let o3 = orient(c, d, a);
@@ -146,7 +146,7 @@ pub fn segments_touch(a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> bool {
 
 /// The first pair of edges that makes a polygon non-simple: two non-adjacent edges that touch,
 /// or two adjacent edges that fold back onto each other. Edge `i` runs from vertex `i` to `i+1`.
-pub fn first_self_intersection(points: &[DVec2]) -> Option<(usize, usize)> {
+pub(crate) fn first_self_intersection(points: &[DVec2]) -> Option<(usize, usize)> {
     let n = points.len();
     if n < 3 {
         return None;
