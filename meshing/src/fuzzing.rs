@@ -1,5 +1,6 @@
 //! Arbitrary bytes turned into meshing input, shared by the fuzz targets and the regression
-//! tests that keep what they found.
+//! tests that keep what they found. Hidden from the documentation: support for those, not part
+//! of the crate's API.
 
 use glam::DVec2;
 

@@ -1,5 +1,6 @@
 //! Arbitrary bytes turned into scene input, shared by the fuzz targets (`fuzz/`) and the seeded
-//! property tests that run the same generators in the normal test command.
+//! property tests that run the same generators in the normal test command. Hidden from the
+//! documentation: support for those, not part of the crate's API.
 
 use std::path::Path;
 
