@@ -48,8 +48,11 @@ impl Default for StudyOptions {
 /// One method with its setting, and how it is named in the tables.
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct MethodConfig {
+    /// The method and what its setting is, as the tables name them (`hemicube (resolution)`).
     pub label: &'static str,
+    /// The setting: rays per pair, samples, or the hemicube's resolution in pixels.
     pub setting: usize,
+    /// The method and its setting, as the solver takes them.
     #[serde(skip)]
     pub method: FormFactorMethod,
 }
@@ -82,21 +85,24 @@ impl MethodConfig {
 /// A point-to-polygon case with a closed-form answer.
 #[derive(Clone, Debug, Serialize)]
 pub struct PointCase {
+    /// What the case is, in words.
     pub name: &'static str,
     /// Where the closed form comes from (its case in `docs/closed-forms.md`).
     pub source: &'static str,
+    /// The point-to-polygon form factor, from the closed form.
     pub exact: f64,
 }
 
 /// One method's error on every point case, and its cost.
 #[derive(Clone, Debug, Serialize)]
 pub struct PointRow {
+    /// The method and its setting.
     pub config: MethodConfig,
     /// Relative error per case, in the order of the cases (RMS over the random streams for
     /// stochastic methods).
     pub errors: Vec<f64>,
-    /// Mean time of one evaluation (for the hemicube: one hemicube, which gives the point's form
-    /// factor to every patch at once).
+    /// Mean time of one evaluation, in microseconds (for the hemicube: one hemicube, which gives
+    /// the point's form factor to every patch at once).
     pub micros: f64,
 }
 
@@ -104,48 +110,67 @@ pub struct PointRow {
 /// pixel: the range of computed / exact.
 #[derive(Clone, Debug, Serialize)]
 pub struct AliasingRow {
+    /// The method and its setting.
     pub config: MethodConfig,
     /// The square's side, in pixels of the hemicube at `pixels_of` resolution.
     pub pixels: f64,
+    /// The hemicube resolution `pixels` is measured in (the study's middle one), also for
+    /// Monte Carlo.
     pub pixels_of: usize,
+    /// The exact form factor, averaged over the square's positions.
     pub exact: f64,
+    /// The least of computed / exact over the positions.
     pub min_ratio: f64,
+    /// The most of computed / exact over the positions.
     pub max_ratio: f64,
 }
 
 /// The 1 × 2 × 3 box's face-to-face factors from the discrete system.
 #[derive(Clone, Debug, Serialize)]
 pub struct BoxRow {
+    /// The method and its setting.
     pub config: MethodConfig,
     /// Worst relative error of the 30 face pairs against the closed forms.
     pub worst_error: f64,
-    /// Worst |row sum − 1|.
+    /// Worst |row sum − 1|: the box is closed, so each face's factors sum to 1.
     pub worst_row_sum: f64,
+    /// Seconds of the form factors.
     pub seconds: f64,
 }
 
 /// The unit cube with one emitting face, solved densely.
 #[derive(Clone, Debug, Serialize)]
 pub struct CubeRow {
+    /// The method and its setting.
     pub config: MethodConfig,
+    /// Triangles of the cube's mesh.
     pub triangles: usize,
     /// Face-mean radiosities: the emitter, the mean of the four adjacent faces, the opposite.
     pub faces: [f64; 3],
     /// Their relative errors against the continuous limit (`docs/closed-forms.md`, "The unit cube
     /// with one emitting face").
     pub errors: [f64; 3],
-    /// Form factors and solve.
+    /// Seconds of the form factors and the solve.
     pub seconds: f64,
 }
 
+/// The whole study (`form-factors.json`); [`Study::markdown`] prints it as tables.
 #[derive(Clone, Debug, Serialize)]
 pub struct Study {
+    /// The point-to-polygon cases, with their closed-form values.
     pub cases: Vec<PointCase>,
+    /// Per method and setting, the error on each case and the cost.
     pub points: Vec<PointRow>,
+    /// The hemicube's and Monte Carlo's ranges on small sliding squares.
     pub aliasing: Vec<AliasingRow>,
+    /// Per method and setting, the 1 × 2 × 3 box's face-to-face factors.
     pub box_factors: Vec<BoxRow>,
+    /// The unit cube's reflectance, every face (0.9).
     pub cube_reflectance: f64,
+    /// The continuous limit of the unit cube's face means (emitter, adjacent, opposite), in
+    /// W/m² for an emitting face of exitance 1 W/m².
     pub cube_reference: [f64; 3],
+    /// Per method and setting, the unit cube's face means and their errors.
     pub cube: Vec<CubeRow>,
 }
 
@@ -225,8 +250,10 @@ impl Setup {
 /// Errors of the study (its scenes are built in, so these mean a bad option).
 #[derive(Debug, thiserror::Error)]
 pub enum StudyError {
+    /// The solver failed, or refused a method's setting.
     #[error(transparent)]
     Solve(#[from] SolveError),
+    /// A mesh of the study's scenes that could not be made.
     #[error(transparent)]
     Mesh(#[from] penumbra_meshing::MeshError),
 }
@@ -375,7 +402,8 @@ fn point_cases() -> Vec<(Scene, Probe, PointCase)> {
     ]
 }
 
-/// Runs the whole study.
+/// Runs the whole study: every method and setting of `options` on the point cases, the
+/// aliasing squares, the 1 × 2 × 3 box and the unit cube.
 pub fn run_study(options: &StudyOptions) -> Result<Study, StudyError> {
     let configs = MethodConfig::all(options);
     for c in &configs {
