@@ -40,24 +40,69 @@ fn refused(args: &[&str], flag: &str) {
 #[test]
 fn bad_values_name_their_own_flag() {
     refused(
-        &["run", "textbook", "--refine-tol", "0.01", "--initial-elements", "0"],
+        &[
+            "run",
+            "textbook",
+            "--refine-tol",
+            "0.01",
+            "--initial-elements",
+            "0",
+        ],
         "--initial-elements",
     );
-    refused(&["run", "textbook", "--max-elements", "0"], "--max-elements");
-    refused(&["sweep", "textbook", "--direct-only", "--budgets", "0"], "--budgets");
+    refused(
+        &["run", "textbook", "--max-elements", "0"],
+        "--max-elements",
+    );
+    refused(
+        &["sweep", "textbook", "--direct-only", "--budgets", "0"],
+        "--budgets",
+    );
     // This many rays made a run hang; the cap says what it is.
-    refused(&["run", "textbook", "--rays", "18446744073709551615"], "--rays");
-    refused(&["run", "textbook", "--ff-samples", "100000000", "--form-factors", "monte-carlo"], "--ff-samples");
+    refused(
+        &["run", "textbook", "--rays", "18446744073709551615"],
+        "--rays",
+    );
+    refused(
+        &[
+            "run",
+            "textbook",
+            "--ff-samples",
+            "100000000",
+            "--form-factors",
+            "monte-carlo",
+        ],
+        "--ff-samples",
+    );
     for density in ["0", "-5", "NaN"] {
-        refused(&["run", "textbook", &format!("--penumbra-density={density}")], "--penumbra-density");
+        refused(
+            &["run", "textbook", &format!("--penumbra-density={density}")],
+            "--penumbra-density",
+        );
     }
     refused(&["run", "textbook", "--memory-limit=-5"], "--memory-limit");
     refused(&["run", "textbook", "--refine-tol", "2"], "--refine-tol");
-    refused(&["run", "textbook", "--refine-tol", "0.01", "--refine-rounds", "0"], "--refine-rounds");
+    refused(
+        &[
+            "run",
+            "textbook",
+            "--refine-tol",
+            "0.01",
+            "--refine-rounds",
+            "0",
+        ],
+        "--refine-rounds",
+    );
     refused(&["run", "textbook", "--width", "100000"], "--width");
     refused(&["run", "textbook", "--up", "0,0,0"], "--up");
-    refused(&["run", "textbook", "--eye", "0,0,0.4", "--target", "0,0,0.4"], "--eye");
+    refused(
+        &["run", "textbook", "--eye", "0,0,0.4", "--target", "0,0,0.4"],
+        "--eye",
+    );
     refused(&["run", "textbook", "--fov", "180"], "--fov");
+    refused(&["form-factors", "--streams", "100000000"], "--streams");
+    refused(&["form-factors", "--resolutions", "3"], "--resolutions");
+    refused(&["form-factors", "--samples", "0"], "--samples");
 }
 
 #[test]
@@ -88,7 +133,10 @@ fn library_options_are_checked_without_flags() {
     }
     let mut options = RunOptions::default();
     options.solver.visibility_rays = usize::MAX;
-    assert_eq!(options.validate().expect_err("refused").option, "visibility rays");
+    assert_eq!(
+        options.validate().expect_err("refused").option,
+        "visibility rays"
+    );
     assert!(RunOptions::default().validate().is_ok());
 }
 
@@ -128,12 +176,17 @@ fn refinement_tolerance_is_relative_to_the_reflected_light() {
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let refinement = &json(&out.join("report.json"))["refinement"];
-    assert_eq!(refinement["tolerance_relative_to"], "mean_reflected_radiosity");
+    assert_eq!(
+        refinement["tolerance_relative_to"],
+        "mean_reflected_radiosity"
+    );
     assert_eq!(refinement["stop"], "tolerance");
     let reflected = mean_reflected(&json(&out.join("solution.json")));
     let worst = refinement["residual"]["max"].as_f64().expect("number");
     // The emitter's exitance lifts the mean radiosity far above what the floor reflects.
-    let mean = refinement["residual"]["mean_radiosity"].as_f64().expect("number");
+    let mean = refinement["residual"]["mean_radiosity"]
+        .as_f64()
+        .expect("number");
     assert!(mean > 3.0 * reflected, "{mean} against {reflected}");
     assert!(
         worst <= tolerance * reflected * (1.0 + 1e-9),
@@ -145,14 +198,24 @@ fn refinement_tolerance_is_relative_to_the_reflected_light() {
 fn mean_reflected(solution: &serde_json::Value) -> f64 {
     let (mut area, mut weighted) = (0.0, 0.0);
     let point = |v: &serde_json::Value| -> glam::DVec3 {
-        let c: Vec<f64> = v.as_array().expect("xyz").iter().map(|x| x.as_f64().expect("number")).collect();
+        let c: Vec<f64> = v
+            .as_array()
+            .expect("xyz")
+            .iter()
+            .map(|x| x.as_f64().expect("number"))
+            .collect();
         glam::DVec3::new(c[0], c[1], c[2])
     };
     for s in solution["surfaces"].as_array().expect("surfaces") {
         if s["name"] == "light" {
             continue;
         }
-        let vertices: Vec<glam::DVec3> = s["vertices"].as_array().expect("vertices").iter().map(point).collect();
+        let vertices: Vec<glam::DVec3> = s["vertices"]
+            .as_array()
+            .expect("vertices")
+            .iter()
+            .map(point)
+            .collect();
         let radiosity: Vec<f64> = s["radiosity"]
             .as_array()
             .expect("radiosity")
@@ -160,8 +223,16 @@ fn mean_reflected(solution: &serde_json::Value) -> f64 {
             .map(|c| point(c).element_sum() / 3.0)
             .collect();
         for t in s["triangles"].as_array().expect("triangles") {
-            let t: Vec<usize> = t.as_array().expect("triple").iter().map(|i| i.as_u64().expect("index") as usize).collect();
-            let a = 0.5 * (vertices[t[1]] - vertices[t[0]]).cross(vertices[t[2]] - vertices[t[0]]).length();
+            let t: Vec<usize> = t
+                .as_array()
+                .expect("triple")
+                .iter()
+                .map(|i| i.as_u64().expect("index") as usize)
+                .collect();
+            let a = 0.5
+                * (vertices[t[1]] - vertices[t[0]])
+                    .cross(vertices[t[2]] - vertices[t[0]])
+                    .length();
             area += a;
             weighted += a * t.iter().map(|&i| radiosity[i]).sum::<f64>() / 3.0;
         }
@@ -176,8 +247,17 @@ fn replays_repeat_a_run() {
     let dir = tempfile::tempdir().expect("temp dir");
     let (first, again) = (dir.path().join("first"), dir.path().join("again"));
     let o = penumbra(&[
-        "run", "textbook", "--solver", "progressive", "--max-elements", "1500", "--seed", "7",
-        "--quiet", "--out", first.to_str().expect("utf-8"),
+        "run",
+        "textbook",
+        "--solver",
+        "progressive",
+        "--max-elements",
+        "1500",
+        "--seed",
+        "7",
+        "--quiet",
+        "--out",
+        first.to_str().expect("utf-8"),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let report = json(&first.join("report.json"));
@@ -186,18 +266,39 @@ fn replays_repeat_a_run() {
     assert_eq!(report["invocation"]["options"]["solver"], "progressive");
     let recorded = first.join("report.json");
     let o = penumbra(&[
-        "run", "--replay", recorded.to_str().expect("utf-8"), "--quiet",
-        "--out", again.to_str().expect("utf-8"),
+        "run",
+        "--replay",
+        recorded.to_str().expect("utf-8"),
+        "--quiet",
+        "--out",
+        again.to_str().expect("utf-8"),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(
         std::fs::read(first.join("solution.json")).expect("reads"),
         std::fs::read(again.join("solution.json")).expect("reads")
     );
-    refused(&["run", "--replay", recorded.to_str().expect("utf-8"), "--seed", "8"], "--seed");
-    let o = penumbra(&["run", "--replay", first.join("solution.json").to_str().expect("utf-8")]);
+    refused(
+        &[
+            "run",
+            "--replay",
+            recorded.to_str().expect("utf-8"),
+            "--seed",
+            "8",
+        ],
+        "--seed",
+    );
+    let o = penumbra(&[
+        "run",
+        "--replay",
+        first.join("solution.json").to_str().expect("utf-8"),
+    ]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
-    assert!(stderr(&o).contains("no command line to replay"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("no command line to replay"),
+        "{}",
+        stderr(&o)
+    );
 }
 
 /// `scenes --dump` prints a built-in scene in the scene format: loading it back gives the same
@@ -211,7 +312,11 @@ fn dumped_scenes_load_back_unchanged() {
         let file = dir.path().join(format!("{name}.json"));
         std::fs::write(&file, &o.stdout).expect("writes");
         let loaded = penumbra_scenes::load_scene(file.to_str().expect("utf-8")).expect("loads");
-        assert_eq!(loaded.scene, builtin::builtin(name).expect("built-in"), "{name}");
+        assert_eq!(
+            loaded.scene,
+            builtin::builtin(name).expect("built-in"),
+            "{name}"
+        );
     }
     let o = penumbra(&["scenes", "--dump", "no-such-scene"]);
     assert_eq!(o.status.code(), Some(2));
@@ -222,7 +327,16 @@ fn dumped_scenes_load_back_unchanged() {
 #[test]
 fn camera_flags_move_the_render_only() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let common = ["--direct-only", "--max-elements", "600", "--width", "64", "--height", "64", "--quiet"];
+    let common = [
+        "--direct-only",
+        "--max-elements",
+        "600",
+        "--width",
+        "64",
+        "--height",
+        "64",
+        "--quiet",
+    ];
     let run = |name: &str, extra: &[&str]| {
         let out = dir.path().join(name);
         let mut args = vec!["run", "textbook", "--out", out.to_str().expect("utf-8")];
@@ -233,23 +347,55 @@ fn camera_flags_move_the_render_only() {
         out
     };
     let plain = run("plain", &[]);
-    let turned = run("turned", &["--eye", "0,-6.5,4.5", "--target", "0,0,0.4", "--up", "1,0,0", "--fov", "50"]);
+    let turned = run(
+        "turned",
+        &[
+            "--eye",
+            "0,-6.5,4.5",
+            "--target",
+            "0,0,0.4",
+            "--up",
+            "1,0,0",
+            "--fov",
+            "50",
+        ],
+    );
     let read = |dir: &Path, file: &str| std::fs::read(dir.join(file)).expect("reads");
-    assert_eq!(read(&plain, "solution.json"), read(&turned, "solution.json"));
+    assert_eq!(
+        read(&plain, "solution.json"),
+        read(&turned, "solution.json")
+    );
     assert_ne!(read(&plain, "render.png"), read(&turned, "render.png"));
 }
 
 /// Every command's help has examples, and `run`'s options come under headings.
 #[test]
 fn help_teaches() {
-    for command in [&["--help"][..], &["run", "--help"], &["sweep", "--help"], &["scenes", "--help"], &["check", "--help"], &["merge", "--help"], &["form-factors", "--help"]] {
+    for command in [
+        &["--help"][..],
+        &["run", "--help"],
+        &["sweep", "--help"],
+        &["scenes", "--help"],
+        &["check", "--help"],
+        &["merge", "--help"],
+        &["form-factors", "--help"],
+    ] {
         let o = penumbra(command);
         assert!(o.status.success());
         let text = String::from_utf8_lossy(&o.stdout);
-        assert!(text.contains("Examples:"), "{command:?} has no examples:\n{text}");
+        assert!(
+            text.contains("Examples:"),
+            "{command:?} has no examples:\n{text}"
+        );
     }
     let text = String::from_utf8_lossy(&penumbra(&["run", "--help"]).stdout).into_owned();
-    for heading in ["Mesh:", "Adaptive refinement:", "Solver:", "Output and render:", "Limits:"] {
+    for heading in [
+        "Mesh:",
+        "Adaptive refinement:",
+        "Solver:",
+        "Output and render:",
+        "Limits:",
+    ] {
         assert!(text.contains(heading), "no {heading} in run --help");
     }
 }

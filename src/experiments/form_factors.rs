@@ -45,6 +45,46 @@ impl Default for StudyOptions {
     }
 }
 
+/// Most random streams a study averages over: beyond this the tables do not change in their
+/// printed digits, and a run only looks hung.
+pub const MAX_STREAMS: usize = 1024;
+
+/// Most triangles of the unit cube's mesh: its dense solve holds a matrix of their vertices'
+/// square.
+pub const MAX_CUBE_ELEMENTS: usize = 20_000;
+
+impl StudyOptions {
+    /// Checks every option's range before anything is measured; names as
+    /// [`crate::RunOptions::validate`] gives them.
+    pub fn validate(&self) -> Result<(), crate::InvalidOption> {
+        let bad = |option, reason: String| Err(crate::InvalidOption { option, reason });
+        if !(1..=MAX_STREAMS).contains(&self.streams) {
+            return bad(
+                "streams",
+                format!("must be from 1 to {MAX_STREAMS}, not {}", self.streams),
+            );
+        }
+        if !(12..=MAX_CUBE_ELEMENTS).contains(&self.cube_elements) {
+            return bad(
+                "cube elements",
+                format!(
+                    "must be from 12 (two per face) to {MAX_CUBE_ELEMENTS}, not {}",
+                    self.cube_elements
+                ),
+            );
+        }
+        for c in MethodConfig::all(self) {
+            SolverOptions {
+                form_factors: c.method,
+                visibility_rays: self.rays,
+                ..SolverOptions::default()
+            }
+            .validate()?;
+        }
+        Ok(())
+    }
+}
+
 /// One method with its setting, and how it is named in the tables.
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct MethodConfig {
@@ -250,6 +290,9 @@ impl Setup {
 /// Errors of the study (its scenes are built in, so these mean a bad option).
 #[derive(Debug, thiserror::Error)]
 pub enum StudyError {
+    /// An option of the study out of its range ([`StudyOptions::validate`]).
+    #[error(transparent)]
+    InvalidOption(#[from] crate::InvalidOption),
     /// The solver failed, or refused a method's setting.
     #[error(transparent)]
     Solve(#[from] SolveError),
@@ -405,16 +448,9 @@ fn point_cases() -> Vec<(Scene, Probe, PointCase)> {
 /// Runs the whole study: every method and setting of `options` on the point cases, the
 /// aliasing squares, the 1 × 2 × 3 box and the unit cube.
 pub fn run_study(options: &StudyOptions) -> Result<Study, StudyError> {
+    options.validate()?;
     let configs = MethodConfig::all(options);
-    for c in &configs {
-        SolverOptions {
-            form_factors: c.method,
-            visibility_rays: options.rays,
-            ..SolverOptions::default()
-        }
-        .validate()?;
-    }
-    let streams = options.streams.max(1);
+    let streams = options.streams;
     let cases = point_cases();
     let setups = cases
         .iter()

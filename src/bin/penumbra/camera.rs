@@ -74,7 +74,8 @@ fn point(text: &str) -> Result<DVec3, String> {
 fn camera_of(text: &str, scene: &Scene) -> Result<Camera, String> {
     let parts: Vec<&str> = text.split(':').collect();
     let at = |part: &str, what: &str| -> Result<DVec3, String> {
-        point(part).map_err(|_| format!("the {what} must be three finite numbers x,y,z, not {part:?}"))
+        point(part)
+            .map_err(|_| format!("the {what} must be three finite numbers x,y,z, not {part:?}"))
     };
     let (eye, target, fov) = match parts.as_slice() {
         [eye, target] => (at(eye, "eye")?, at(target, "target")?, None),

@@ -48,6 +48,8 @@ pub(crate) enum Command {
     Run,
     /// `sweep`: `--budgets`, `--initial-fraction`, ...
     Sweep,
+    /// `form-factors`: `--samples`, `--resolutions`, ...
+    FormFactors,
 }
 
 /// The flag that sets an option the library names in words, in `command`.
@@ -57,6 +59,10 @@ fn flag(option: &str, command: Command) -> Option<&'static str> {
         ("initial elements", Command::Sweep) => "--initial-fraction",
         ("max elements", Command::Run) => "--max-elements",
         ("initial elements", Command::Run) => "--initial-elements",
+        ("form-factor samples", Command::FormFactors) => "--samples",
+        ("hemicube resolution", Command::FormFactors) => "--resolutions",
+        ("streams", _) => "--streams",
+        ("cube elements", _) => "--cube-elements",
         ("epsilon", _) => "--epsilon",
         ("link tolerance", _) => "--link-tol",
         ("visibility rays", _) => "--rays",
@@ -66,6 +72,7 @@ fn flag(option: &str, command: Command) -> Option<&'static str> {
         ("form factors", _) => "--form-factors",
         ("solver", Command::Run) => "--solver",
         ("solver", Command::Sweep) => "--solvers",
+        ("solver", Command::FormFactors) => return None,
         ("direct only", _) => "--direct-only",
         ("refine indirect", _) => "--refine-indirect",
         ("refine tolerance", _) => "--refine-tol",
@@ -112,21 +119,28 @@ pub(crate) fn run_failure(e: RunError, command: Command) -> Failure {
 }
 
 /// A run too large for memory, with the flags that would make it fit.
-fn memory_message(needed: u64, limit: u64, suggestion: Option<usize>, link_tol: Option<f64>) -> String {
+fn memory_message(
+    needed: u64,
+    limit: u64,
+    suggestion: Option<usize>,
+    link_tol: Option<f64>,
+) -> String {
     use penumbra::memory::human;
     let head = format!(
         "this run would need about {} of memory, and {} is available",
         human(needed),
         human(limit)
     );
-    let links = link_tol.map_or(String::new(), |t| format!(", or --link-tol {t:.1e} or more"));
+    let links = link_tol.map_or(String::new(), |t| {
+        format!(", or --link-tol {t:.1e} or more")
+    });
     match (suggestion, link_tol) {
         (Some(n), _) => format!(
             "{head}; use --max-elements {n} or fewer{links} (or --memory-limit, if more is free)"
         ),
-        (None, Some(t)) => format!(
-            "{head}; use --link-tol {t:.1e} or more (or --memory-limit, if more is free)"
-        ),
+        (None, Some(t)) => {
+            format!("{head}; use --link-tol {t:.1e} or more (or --memory-limit, if more is free)")
+        }
         (None, None) => format!(
             "{head}; even the coarsest mesh of this scene does not fit (options: --direct-only, \
              --solver progressive, smaller --width/--height, or a machine with more memory)"
@@ -172,5 +186,7 @@ fn budget_message(e: &RunError, command: Command) -> Option<String> {
             "--initial-fraction: the starting mesh of adaptive refinement, {max_elements} \
              triangles, is too small: {need}; use a larger --initial-fraction, or larger budgets"
         ),
+        // The study meshes built-in scenes of its own choosing.
+        (Command::FormFactors, _) => return None,
     })
 }

@@ -5,10 +5,12 @@ use std::path::PathBuf;
 use anyhow::Context;
 use penumbra_solver::SolverOptions;
 
-use crate::failure::{Failure, usage};
+use crate::failure::{Command, Failure, invalid_option};
 
 #[derive(clap::Args, Debug)]
-#[command(after_help = "Examples:\n  penumbra form-factors                         every method, the default ladders\n  penumbra form-factors --samples 64,1024 --resolutions 64,256 --out ff")]
+#[command(
+    after_help = "Examples:\n  penumbra form-factors                         every method, the default ladders\n  penumbra form-factors --samples 64,1024 --resolutions 64,256 --out ff"
+)]
 pub(crate) struct FormFactorArgs {
     /// Output directory (created if missing).
     #[arg(long, default_value = "out/form-factors")]
@@ -38,7 +40,14 @@ pub(crate) fn form_factors(args: &FormFactorArgs) -> Result<(), Failure> {
         streams: args.streams,
         cube_elements: args.cube_elements,
     };
-    let study = penumbra::experiments::form_factors::run_study(&options).map_err(usage)?;
+    use penumbra::experiments::form_factors::{StudyError, run_study};
+    let study = run_study(&options).map_err(|e| match e {
+        StudyError::InvalidOption(e) => invalid_option(&e, Command::FormFactors),
+        StudyError::Solve(e @ penumbra_solver::SolveError::InvalidOption { .. }) => {
+            invalid_option(&penumbra::InvalidOption::from(e), Command::FormFactors)
+        }
+        e => Failure::from(e),
+    })?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
     let path = args.out.join("form-factors.json");

@@ -76,14 +76,18 @@ enum Command {
     /// render.png and the shards' SVGs.
     Merge(MergeArgs),
     /// List the built-in scenes, or print one as JSON to start a scene of your own from.
-    #[command(after_help = "Examples:\n  penumbra scenes\n  penumbra scenes --dump textbook > my.json")]
+    #[command(
+        after_help = "Examples:\n  penumbra scenes\n  penumbra scenes --dump textbook > my.json"
+    )]
     Scenes {
         /// Print this built-in scene as JSON (the scene format of `penumbra run`) instead.
         #[arg(long, value_name = "NAME")]
         dump: Option<String>,
     },
     /// Load and validate a scene, reporting every problem at once.
-    #[command(after_help = "Examples:\n  penumbra check my.json\n  penumbra check model.obj --no-merge")]
+    #[command(
+        after_help = "Examples:\n  penumbra check my.json\n  penumbra check model.obj --no-merge"
+    )]
     Check {
         /// A .json or .obj file, or the name of a built-in scene.
         scene: String,
@@ -93,7 +97,6 @@ enum Command {
         no_merge: bool,
     },
 }
-
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
@@ -129,7 +132,10 @@ pub(crate) fn obj_options(no_merge: bool) -> ObjOptions {
     }
 }
 
-pub(crate) fn load(spec: &str, options: ObjOptions) -> Result<penumbra_scenes::LoadedScene, Failure> {
+pub(crate) fn load(
+    spec: &str,
+    options: ObjOptions,
+) -> Result<penumbra_scenes::LoadedScene, Failure> {
     // Every scene error (unreadable, malformed, invalid) is the input's: exit code 2.
     load_scene_with(spec, &options).map_err(|e| {
         // What loading repaired often explains what validation then refused.

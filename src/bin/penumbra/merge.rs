@@ -8,7 +8,9 @@ use crate::failure::{Failure, usage};
 use crate::obj_options;
 
 #[derive(clap::Args, Debug)]
-#[command(after_help = "Examples:\n  penumbra run boxworld-1000 --direct-only --shard 0/2 --out s0\n  penumbra run boxworld-1000 --direct-only --shard 1/2 --out s1\n  penumbra merge s0 s1 --out whole")]
+#[command(
+    after_help = "Examples:\n  penumbra run boxworld-1000 --direct-only --shard 0/2 --out s0\n  penumbra run boxworld-1000 --direct-only --shard 1/2 --out s1\n  penumbra merge s0 s1 --out whole"
+)]
 pub(crate) struct MergeArgs {
     /// The output directories of the shards (`run --shard I/N --out DIR`), every shard once.
     #[arg(required = true)]

@@ -75,10 +75,7 @@ fn refuse_other_options(given: &RunArgs) -> Result<(), Failure> {
         args: RunArgs,
     }
     let plain = Plain::parse_from(["run", "--replay", "report.json"]).args;
-    let (given, plain) = (
-        serde_json::to_value(given)?,
-        serde_json::to_value(&plain)?,
-    );
+    let (given, plain) = (serde_json::to_value(given)?, serde_json::to_value(&plain)?);
     let extra: Vec<String> = given
         .as_object()
         .into_iter()

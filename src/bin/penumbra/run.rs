@@ -2,9 +2,9 @@
 
 use std::process::ExitCode;
 
+use crate::progress_bar::Bars;
 use anyhow::Context;
 use penumbra::outputs::{Invocation, SvgSelection, write_outputs};
-use crate::progress_bar::Bars;
 use penumbra_solver::Interrupt;
 
 use crate::failure::{Command, Failure, invalid_option, run_failure, usage};
@@ -101,7 +101,9 @@ fn run_with(args: &RunArgs, fingerprint: Option<&str>) -> Result<ExitCode, Failu
     options.shard = shard;
     let spec = args.scene.as_deref().unwrap_or_default();
     let mut loaded = load(spec, obj_options(args.no_merge))?;
-    if let Some(camera) = crate::camera::camera(args, &loaded.scene).map_err(|e| usage(anyhow::anyhow!(e)))? {
+    if let Some(camera) =
+        crate::camera::camera(args, &loaded.scene).map_err(|e| usage(anyhow::anyhow!(e)))?
+    {
         loaded.scene.camera = Some(camera);
     }
     if !args.quiet {
@@ -150,7 +152,9 @@ fn run_with(args: &RunArgs, fingerprint: Option<&str>) -> Result<ExitCode, Failu
         let origin = penumbra::shard::SceneOrigin {
             spec: spec.to_owned(),
             no_merge: args.no_merge,
-            camera: camera_given(args).then_some(result.loaded.scene.camera).flatten(),
+            camera: camera_given(args)
+                .then_some(result.loaded.scene.camera)
+                .flatten(),
         };
         let written = penumbra::shard::write_shard(&result, shard, origin, &args.out, &svgs)?;
         if !args.quiet {
@@ -224,7 +228,6 @@ fn run_with(args: &RunArgs, fingerprint: Option<&str>) -> Result<ExitCode, Failu
     }
     Ok(ExitCode::SUCCESS)
 }
-
 
 /// Whether the arguments set the render's camera.
 fn camera_given(args: &RunArgs) -> bool {

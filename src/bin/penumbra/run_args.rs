@@ -280,21 +280,26 @@ impl RunArgs {
                 penumbra::default_budget(method, self.direct_only),
                 ElementBudget::AtMost,
             ),
-            penumbra_density: self.penumbra_density.unwrap_or(if self.refine_tol.is_some() {
-                1.0
-            } else {
-                DEFAULT_PENUMBRA_DENSITY
-            }),
+            penumbra_density: self
+                .penumbra_density
+                .unwrap_or(if self.refine_tol.is_some() {
+                    1.0
+                } else {
+                    DEFAULT_PENUMBRA_DENSITY
+                }),
             time_budget: self.time_budget,
-            refine: self.refine_tol.map(|tolerance| penumbra::adaptive::RefineOptions {
-                tolerance,
-                initial_elements: self.initial_elements.unwrap_or(
-                    (self.max_elements.unwrap_or(DEFAULT_MAX_ELEMENTS) as f64
-                        * penumbra::adaptive::INITIAL_FRACTION) as usize,
-                ),
-                max_rounds: self.refine_rounds,
-                indirect: self.refine_indirect.into(),
-            }),
+            refine: self
+                .refine_tol
+                .map(|tolerance| penumbra::adaptive::RefineOptions {
+                    tolerance,
+                    initial_elements: self.initial_elements.unwrap_or(
+                        (self.max_elements.unwrap_or(DEFAULT_MAX_ELEMENTS) as f64
+                            * penumbra::adaptive::INITIAL_FRACTION)
+                            as usize,
+                    ),
+                    max_rounds: self.refine_rounds,
+                    indirect: self.refine_indirect.into(),
+                }),
             discontinuity: DiscontinuityOptions {
                 eee: !self.no_eee,
                 events: match self.events {

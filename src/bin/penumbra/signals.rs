@@ -29,7 +29,11 @@ impl Signals {
         let received = Arc::new(AtomicUsize::new(0));
         for signal in [SIGINT, SIGTERM] {
             // Registered first, so it sees the flag as it was before this signal set it.
-            signal_hook::flag::register_conditional_shutdown(signal, 128 + signal, interrupt.flag())?;
+            signal_hook::flag::register_conditional_shutdown(
+                signal,
+                128 + signal,
+                interrupt.flag(),
+            )?;
             signal_hook::flag::register(signal, interrupt.flag())?;
             signal_hook::flag::register_usize(signal, Arc::clone(&received), signal as usize)?;
         }
@@ -65,7 +69,12 @@ fn status(received: &AtomicUsize) -> u8 {
 }
 
 /// Waits for a signal; then gives the run [`GRACE`] to stop computing, and ends it if it has not.
-fn watch(interrupt: &Interrupt, received: &AtomicUsize, writing: &AtomicBool, out: &std::path::Path) {
+fn watch(
+    interrupt: &Interrupt,
+    received: &AtomicUsize,
+    writing: &AtomicBool,
+    out: &std::path::Path,
+) {
     while !interrupt.is_set() {
         std::thread::sleep(POLL);
     }

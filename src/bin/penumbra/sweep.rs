@@ -2,8 +2,8 @@
 
 use std::path::PathBuf;
 
-use anyhow::Context;
 use crate::progress_bar::Bars;
+use anyhow::Context;
 use penumbra_scenes::ObjOptions;
 use penumbra_solver::SolverOptions;
 
@@ -12,7 +12,9 @@ use crate::load;
 use crate::run_args::SolverArg;
 
 #[derive(clap::Args, Debug)]
-#[command(after_help = "Examples:\n  penumbra sweep textbook --direct-only                  exact direct light, four meshes, five budgets\n  penumbra sweep cornell --budgets 5000,10000,20000 --methods discontinuity \\\n      --solvers progressive,hierarchical                 solvers against a path-traced reference\n  penumbra sweep cornell --direct-only --surfaces floor  the floor's error alone")]
+#[command(
+    after_help = "Examples:\n  penumbra sweep textbook --direct-only                  exact direct light, four meshes, five budgets\n  penumbra sweep cornell --budgets 5000,10000,20000 --methods discontinuity \\\n      --solvers progressive,hierarchical                 solvers against a path-traced reference\n  penumbra sweep cornell --direct-only --surfaces floor  the floor's error alone"
+)]
 pub(crate) struct SweepArgs {
     /// A .json or .obj file, or the name of a built-in scene.
     scene: String,
@@ -104,7 +106,9 @@ pub(crate) fn sweep(args: &SweepArgs) -> Result<(), Failure> {
         .validate()
         .map_err(|e| invalid_option(&e, Command::Sweep))?;
     if args.reference_paths == 0 {
-        return Err(usage(anyhow::anyhow!("--reference-paths must be at least 1")));
+        return Err(usage(anyhow::anyhow!(
+            "--reference-paths must be at least 1"
+        )));
     }
     let loaded = load(&args.scene, ObjOptions::default())?;
     let mut surfaces = Vec::new();
@@ -119,8 +123,13 @@ pub(crate) fn sweep(args: &SweepArgs) -> Result<(), Failure> {
         .with_context(|| format!("cannot create {}", args.out.display()))?;
     let scene = &loaded.scene;
     let visibility = penumbra_scenes::Visibility::build(scene);
-    let samples =
-        penumbra::experiments::sweep::sample_points(scene, &visibility, &surfaces, sample_count, args.seed);
+    let samples = penumbra::experiments::sweep::sample_points(
+        scene,
+        &visibility,
+        &surfaces,
+        sample_count,
+        args.seed,
+    );
     if samples.is_empty() {
         return Err(usage(anyhow::anyhow!(
             "no sample points: the surfaces scored must not all be emitters"
@@ -137,8 +146,9 @@ pub(crate) fn sweep(args: &SweepArgs) -> Result<(), Failure> {
         )?)
     };
     let bars = Bars::new(args.quiet);
-    let result = penumbra::experiments::sweep::sweep(&loaded, &options, &samples, &reference, &bars)
-        .map_err(|e| run_failure(e, Command::Sweep))?;
+    let result =
+        penumbra::experiments::sweep::sweep(&loaded, &options, &samples, &reference, &bars)
+            .map_err(|e| run_failure(e, Command::Sweep))?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
     let csv = penumbra::experiments::sweep::sweep_csv(&result);
