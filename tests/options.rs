@@ -101,6 +101,16 @@ fn bad_values_name_their_own_flag() {
     );
     refused(&["run", "textbook", "--fov", "180"], "--fov");
     refused(&["form-factors", "--streams", "100000000"], "--streams");
+    // Starting this many threads took longer than any run.
+    refused(&["run", "textbook", "--threads", "100000"], "--threads");
+    refused(
+        &["sweep", "textbook", "--samples", "100000000000"],
+        "--samples",
+    );
+    refused(
+        &["sweep", "cornell", "--reference-paths", "0"],
+        "--reference-paths",
+    );
     refused(&["form-factors", "--resolutions", "3"], "--resolutions");
     refused(&["form-factors", "--samples", "0"], "--samples");
 }

@@ -289,6 +289,7 @@ impl Setup {
 
 /// Errors of the study (its scenes are built in, so these mean a bad option).
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum StudyError {
     /// An option of the study out of its range ([`StudyOptions::validate`]).
     #[error(transparent)]

@@ -121,6 +121,9 @@ pub struct SweepOptions {
     pub solvers: Vec<SolverMethod>,
 }
 
+/// Most sample points a sweep scores at: the error of the error is long below a percent there.
+pub const MAX_SAMPLES: usize = 10_000_000;
+
 impl SweepOptions {
     /// Checks every option's range before anything is computed (a path-traced reference takes
     /// minutes), with the same names as [`RunOptions::validate`].
@@ -132,8 +135,11 @@ impl SweepOptions {
                 "every budget must be at least 1 triangle".into(),
             );
         }
-        if self.samples == 0 {
-            return bad("samples", "must be at least 1".into());
+        if !(1..=MAX_SAMPLES).contains(&self.samples) {
+            return bad(
+                "samples",
+                format!("must be from 1 to {MAX_SAMPLES}, not {}", self.samples),
+            );
         }
         if !(self.refine_tol > 0.0 && self.refine_tol <= 1.0) {
             return bad(

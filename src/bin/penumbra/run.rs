@@ -66,6 +66,9 @@ fn shard_of(text: &str, args: &RunArgs) -> Result<penumbra::shard::Shard, Failur
     Ok(shard)
 }
 
+/// Most worker threads: more than any machine's cores only costs their stacks.
+const MAX_THREADS: usize = 1024;
+
 /// `penumbra run`, or `penumbra run --replay REPORT`.
 pub(crate) fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
     match &args.replay {
@@ -80,8 +83,10 @@ pub(crate) fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
 /// A run; `fingerprint` is the scene's as a replayed report recorded it.
 fn run_with(args: &RunArgs, fingerprint: Option<&str>) -> Result<ExitCode, Failure> {
     if let Some(n) = args.threads {
-        if n == 0 {
-            return Err(usage(anyhow::anyhow!("--threads must be at least 1")));
+        if !(1..=MAX_THREADS).contains(&n) {
+            return Err(usage(anyhow::anyhow!(
+                "--threads must be from 1 to {MAX_THREADS}, not {n}"
+            )));
         }
         rayon::ThreadPoolBuilder::new()
             .num_threads(n)
