@@ -894,7 +894,16 @@ fn one_signal_stops_a_run_promptly() {
     let dir = tempfile::tempdir().expect("temp dir");
     let out = dir.path().join("out");
     let child = Command::new(env!("CARGO_BIN_EXE_penumbra"))
-        .args(["run", "boxworld-3000", "--width", "64", "--height", "64", "--svg", "none"])
+        .args([
+            "run",
+            "boxworld-3000",
+            "--width",
+            "64",
+            "--height",
+            "64",
+            "--svg",
+            "none",
+        ])
         .args(["--quiet", "--out", out.to_str().expect("utf-8")])
         .stderr(std::process::Stdio::piped())
         .spawn()
