@@ -1,34 +1,10 @@
 //! The command line as a user meets it: outputs, exit codes, messages, determinism.
 
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Command;
 
-fn penumbra(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_penumbra"))
-        .args(args)
-        .output()
-        .expect("the penumbra binary runs")
-}
-
-/// `penumbra run SCENE --out OUT --quiet` with `extra` options; fails the test unless it succeeds.
-fn run_quietly(scene: &str, out: &Path, extra: &[&str]) -> Output {
-    let mut args = vec![
-        "run",
-        scene,
-        "--out",
-        out.to_str().expect("utf-8"),
-        "--quiet",
-    ];
-    args.extend(extra);
-    let o = penumbra(&args);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    o
-}
-
-fn json(path: &Path) -> serde_json::Value {
-    let text = std::fs::read_to_string(path).expect("output file exists");
-    serde_json::from_str(&text).expect("output is valid JSON")
-}
+mod common;
+use common::{json, penumbra, run_quietly};
 
 /// Every radiosity in a solution is finite and non-negative; returns how many there are.
 fn check_radiosity(solution: &serde_json::Value) -> usize {

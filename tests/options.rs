@@ -3,26 +3,12 @@
 //! camera flags and the help's examples.
 
 use std::path::Path;
-use std::process::{Command, Output};
+
+mod common;
+use common::{json, penumbra, stderr};
 
 use penumbra::{RunError, RunOptions};
 use penumbra_scenes::builtin;
-
-fn penumbra(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_penumbra"))
-        .args(args)
-        .output()
-        .expect("the penumbra binary runs")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn json(path: &Path) -> serde_json::Value {
-    let text = std::fs::read_to_string(path).expect("output file exists");
-    serde_json::from_str(&text).expect("output is valid JSON")
-}
 
 /// Refused with exit 2 and a message naming `flag`, and nothing written.
 fn refused(args: &[&str], flag: &str) {

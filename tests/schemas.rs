@@ -8,7 +8,9 @@
 //! docs/schemas/; the failure names the path in the document that has no entry.
 
 use std::path::Path;
-use std::process::{Command, Output};
+
+mod common;
+use common::{json, succeeds};
 
 use serde_json::{Value, json};
 
@@ -57,25 +59,6 @@ fn assert_matches(name: &str, document: &Value, origin: &str) {
     );
 }
 
-fn read_json(path: &Path) -> Value {
-    let text = std::fs::read_to_string(path)
-        .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
-    serde_json::from_str(&text).unwrap_or_else(|e| panic!("{} is not JSON: {e}", path.display()))
-}
-
-fn penumbra(args: &[&str]) -> Output {
-    let o = Command::new(env!("CARGO_BIN_EXE_penumbra"))
-        .args(args)
-        .output()
-        .expect("the penumbra binary runs");
-    assert!(
-        o.status.success(),
-        "penumbra {args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    o
-}
-
 /// `penumbra run SCENE --out OUT` with a small render and `extra` options.
 fn run(scene: &str, out: &Path, extra: &[&str]) {
     let mut args = vec![
@@ -90,7 +73,7 @@ fn run(scene: &str, out: &Path, extra: &[&str]) {
         "48",
     ];
     args.extend(extra);
-    penumbra(&args);
+    succeeds(&args);
 }
 
 /// What a schema cannot say of a solution: one radiosity per vertex, triangles that index this
@@ -118,11 +101,11 @@ fn check_solution_shape(solution: &Value, origin: &str) {
 
 /// Validates `DIR/solution.json` and `DIR/report.json`; returns the report.
 fn check_outputs(dir: &Path) -> Value {
-    let solution = read_json(&dir.join("solution.json"));
+    let solution = json(&dir.join("solution.json"));
     let origin = dir.join("solution.json").display().to_string();
     assert_matches(SOLUTION_SCHEMA, &solution, &origin);
     check_solution_shape(&solution, &origin);
-    let report = read_json(&dir.join("report.json"));
+    let report = json(&dir.join("report.json"));
     let origin = dir.join("report.json").display().to_string();
     assert_matches(REPORT_SCHEMA, &report, &origin);
     report
@@ -208,7 +191,7 @@ fn unknown_fields_and_wrong_values_are_rejected_where_they_are() {
         &["--direct-only", "--max-elements", "300"],
     );
     let report = check_outputs(&out);
-    let solution = read_json(&out.join("solution.json"));
+    let solution = json(&out.join("solution.json"));
 
     let rejected = |name: &str, document: &Value, at: &str, words: &[&str]| {
         let found = violations(name, document);
@@ -409,7 +392,7 @@ fn shards_and_their_merge_match_the_schemas() {
             &out,
             &["--direct-only", "--max-elements", "500", "--shard", &shard],
         );
-        let file = read_json(&out.join("shard.json"));
+        let file = json(&out.join("shard.json"));
         let origin = format!("{}: report", out.join("shard.json").display());
         assert_matches(REPORT_SCHEMA, &file["report"], &origin);
         let surfaces: Vec<Value> = file["surfaces"]
@@ -439,7 +422,7 @@ fn shards_and_their_merge_match_the_schemas() {
     let merged = dir.path().join("merged");
     let mut args = vec!["merge", "--quiet", "--out", merged.to_str().expect("utf-8")];
     args.extend(dirs.iter().map(String::as_str));
-    penumbra(&args);
+    succeeds(&args);
     let report = check_outputs(&merged);
     assert_eq!(report["shards"]["count"], 2);
     assert!(report["times_seconds"]["merge"].is_number());

@@ -2,24 +2,10 @@
 //! byte; mixed, missing and duplicate shards are refused.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-fn penumbra(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_penumbra"))
-        .args(args)
-        .output()
-        .expect("the penumbra binary runs")
-}
-
-fn succeeds(args: &[&str]) -> Output {
-    let o = penumbra(args);
-    assert!(
-        o.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    o
-}
+mod common;
+use common::{path, penumbra, succeeds};
+use std::process::Output;
 
 /// Fails with exit 2 and a message holding every one of `words`; returns the message.
 fn refused(args: &[&str], words: &[&str]) -> String {
@@ -30,10 +16,6 @@ fn refused(args: &[&str], words: &[&str]) -> String {
         assert!(stderr.contains(w), "{args:?}: {w:?} not in {stderr}");
     }
     stderr
-}
-
-fn path(p: &Path) -> &str {
-    p.to_str().expect("utf-8")
 }
 
 /// A budget that keeps a run small, and spreads it over all surfaces (so that every shard meshes

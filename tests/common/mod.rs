@@ -1,0 +1,46 @@
+//! What the command-line tests share: running the binary, and reading what it says and writes.
+//! Each test file uses its own part of it.
+#![allow(dead_code)]
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+/// `penumbra ARGS`, whatever its exit status.
+pub fn penumbra(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_penumbra"))
+        .args(args)
+        .output()
+        .expect("the penumbra binary runs")
+}
+
+/// `penumbra ARGS`; fails the test unless it succeeds.
+pub fn succeeds(args: &[&str]) -> Output {
+    let o = penumbra(args);
+    assert!(o.status.success(), "penumbra {args:?}: {}", stderr(&o));
+    o
+}
+
+/// `penumbra run SCENE --out OUT --quiet` with `extra` options; fails the test unless it
+/// succeeds.
+pub fn run_quietly(scene: &str, out: &Path, extra: &[&str]) -> Output {
+    let mut args = vec!["run", scene, "--out", path(out), "--quiet"];
+    args.extend(extra);
+    succeeds(&args)
+}
+
+/// What a run said on standard error.
+pub fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// A JSON file the run wrote.
+pub fn json(path: &Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(path)
+        .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
+    serde_json::from_str(&text).unwrap_or_else(|e| panic!("{} is not JSON: {e}", path.display()))
+}
+
+/// A path as a command-line argument.
+pub fn path(p: &Path) -> &str {
+    p.to_str().expect("utf-8")
+}
