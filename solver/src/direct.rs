@@ -117,6 +117,9 @@ enum Blocking<'a> {
     /// The occluder's plane holds the point (occluder index): what it hides depends on the side
     /// the receiving surface lies on ([`contact_shadow`]).
     Touching(usize),
+    /// A face of one of a group's own surfaces whose plane misses the point (occluder index):
+    /// it shadows the group's other receivers only ([`Viewer::Group`]).
+    Own(usize),
     /// A touching occluder's hidden regions, for one receiver: intersections of half-planes.
     Contact(Vec<Vec<HalfPlane>>),
     /// The occluder clipped to the shaft and projected onto the emitter's plane; with the
@@ -205,6 +208,30 @@ pub struct DirectLight<'a> {
 #[derive(Clone, Copy, Debug)]
 struct TooComplex;
 
+/// Whose point a shaft starts from.
+#[derive(Clone, Copy, Debug)]
+enum Viewer<'s> {
+    /// One receiver's: its own surface casts no shadow on it.
+    Receiver(SurfaceId),
+    /// A group of receivers', on these surfaces (sorted): every one of them passes through the
+    /// point, whether or not its plane does within the contact distance (a polygon is planar
+    /// only to the validation's tolerance, and its mesh lies in the plane through one of its
+    /// corners). What one of them hides depends on the receiver ([`PieceView`]).
+    Group(&'s [SurfaceId]),
+}
+
+impl Viewer<'_> {
+    /// Whether faces of `surface` are no occluders at all.
+    fn ignores(self, surface: SurfaceId) -> bool {
+        matches!(self, Viewer::Receiver(r) if r == surface)
+    }
+
+    /// Whether `surface` is one of a group's own.
+    fn owns(self, surface: SurfaceId) -> bool {
+        matches!(self, Viewer::Group(surfaces) if surfaces.binary_search(&surface).is_ok())
+    }
+}
+
 impl std::fmt::Debug for DirectLight<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("DirectLight")
@@ -236,14 +263,25 @@ impl<'a> DirectLight<'a> {
             .collect();
 
         // Occluders are whole convex surfaces where possible (fewer, larger pieces fragment the
-        // visible region less), else the visibility index's own triangles.
+        // visible region less), else the visibility index's own triangles. A whole surface must
+        // be flat to the contact distance, since its plane decides which points lie on it
+        // (`ConvexPiece::holds`): a polygon planar only to the validation's tolerance (an OBJ
+        // corner rounded to six decimals) has corners that far off the plane through its first
+        // corner, as are its neighbours' vertices along their junctions with it, while its
+        // triangles pass through its corners.
+        let tol = visibility.contact_distance();
         let orientation = closed_solid_orientation(scene);
         let mut corners = CornerIds::default();
         let mut occluders = Vec::new();
         let mut whole: Vec<Option<usize>> = vec![None; scene.surfaces.len()];
         for (surface, s) in scene.surfaces.iter().enumerate() {
             let pieces = convex_pieces(&s.polygon);
-            if pieces.len() == 1 {
+            let normal = s.normal();
+            let flat = s
+                .polygon
+                .iter()
+                .all(|&p| normal.dot(p - s.polygon[0]).abs() <= tol);
+            if pieces.len() == 1 && flat {
                 whole[surface] = Some(occluders.len());
                 occluders.push(ConvexPiece::new(
                     surface,
@@ -283,7 +321,7 @@ impl<'a> DirectLight<'a> {
             emitters,
             occluders,
             tree,
-            tol: visibility.contact_distance(),
+            tol,
             sequential_shadows: SEQUENTIAL_SHADOWS,
             window_faces: WINDOW_FACES,
             overlay_limit: OverlayLimit::NONE,
@@ -343,17 +381,21 @@ impl<'a> DirectLight<'a> {
 
     /// The irradiance at receivers that share the point `at` (the faces of a mesh meeting at a
     /// vertex, each at its own rounding of `at`), each as [`Self::irradiance`] gives it to
-    /// rounding. What the occluders other than the faces through `at` hide of each light is
-    /// found once for all of them; each receiver then keeps the part in front of it and loses
-    /// what the faces through the point hide on its side. A receiver's value depends on `at` and
+    /// rounding. What the occluders other than the faces through `at` and the receivers' own
+    /// surfaces hide of each light is found once for all of them; each receiver then keeps the
+    /// part in front of it and loses what the faces through the point hide on its side, and
+    /// what the other receivers' surfaces hide of it. A receiver's value depends on `at` and
     /// itself, not on the others.
     pub fn irradiance_group(&self, at: DVec3, group: &[(ReceivingPoint, SurfaceId)]) -> Vec<Rgb> {
         let mut out = vec![Rgb::ZERO; group.len()];
         if group.is_empty() {
             return out;
         }
+        let mut surfaces: SmallVec<[SurfaceId; 8]> = group.iter().map(|&(_, r)| r).collect();
+        surfaces.sort_unstable();
+        surfaces.dedup();
         for (k, e) in self.emitters.iter().enumerate() {
-            let shared = self.shared_view(at, e);
+            let shared = self.shared_view(at, &surfaces, e);
             for ((x, r), h) in group.iter().zip(&mut out) {
                 let sees =
                     *r != e.surface && x.in_front_of(e.frame.origin, e.frame.normal, self.tol);
@@ -370,8 +412,14 @@ impl<'a> DirectLight<'a> {
 
     /// What the occluders not through `point` leave visible of each piece of emitter `e`, when
     /// enough of them are in the way to be subtracted at once (else `None`: each receiver is
-    /// evaluated on its own, one shadow at a time).
-    fn shared_view(&self, point: DVec3, e: &Emitter) -> Result<Option<Vec<PieceView>>, TooComplex> {
+    /// evaluated on its own, one shadow at a time). `surfaces` are the receivers' own, sorted:
+    /// they pass through the point.
+    fn shared_view(
+        &self,
+        point: DVec3,
+        surfaces: &[SurfaceId],
+        e: &Emitter,
+    ) -> Result<Option<Vec<PieceView>>, TooComplex> {
         let h_x = e.frame.height(point);
         if h_x <= self.tol {
             return Ok(None);
@@ -383,44 +431,50 @@ impl<'a> DirectLight<'a> {
             if signed_area_2d(&piece) < 0.0 {
                 piece.reverse();
             }
-            let (visible, touching) = match self.blockings(point, None, e, full, h_x, &piece, true)
+            let Some(Blocked { blockings, start }) =
+                self.blockings(point, Viewer::Group(surfaces), e, full, h_x, &piece, true)
+            else {
+                views.push(PieceView {
+                    piece,
+                    visible: Vec::new(),
+                    touching: Vec::new(),
+                    own: Vec::new(),
+                });
+                continue;
+            };
+            if start.is_none()
+                && blockings.len() <= self.sequential_shadows
+                && !blockings
+                    .iter()
+                    .any(|b| matches!(b, Blocking::Outline { .. }))
             {
-                None => (Vec::new(), Vec::new()),
-                Some(Blocked { blockings, start }) => {
-                    if start.is_none()
-                        && blockings.len() <= self.sequential_shadows
-                        && !blockings
-                            .iter()
-                            .any(|b| matches!(b, Blocking::Outline { .. }))
-                    {
-                        return Ok(None);
-                    }
-                    let touching = blockings
-                        .iter()
-                        .filter_map(|b| match b {
-                            Blocking::Touching(index) => Some(*index),
-                            _ => None,
-                        })
-                        .collect();
-                    let visible = match subtract_at_once(
-                        &piece,
-                        start,
-                        &blockings,
-                        e,
-                        min_width,
-                        &self.overlay_limit,
-                    ) {
-                        Ok(visible) => visible,
-                        Err(Refusal::NotFinite) => return Ok(None),
-                        Err(Refusal::TooComplex) => return Err(TooComplex),
-                    };
-                    (visible, touching)
+                return Ok(None);
+            }
+            let (mut touching, mut own) = (Vec::new(), Vec::new());
+            for b in &blockings {
+                match *b {
+                    Blocking::Touching(index) => touching.push(index),
+                    Blocking::Own(index) => own.push(index),
+                    _ => {}
                 }
+            }
+            let visible = match subtract_at_once(
+                &piece,
+                start,
+                &blockings,
+                e,
+                min_width,
+                &self.overlay_limit,
+            ) {
+                Ok(visible) => visible,
+                Err(Refusal::NotFinite) => return Ok(None),
+                Err(Refusal::TooComplex) => return Err(TooComplex),
             };
             views.push(PieceView {
                 piece,
                 visible,
                 touching,
+                own,
             });
         }
         Ok(Some(views))
@@ -450,12 +504,17 @@ impl<'a> DirectLight<'a> {
         };
         let mut total = 0.0;
         for view in views {
-            // What the faces through x hide on the receiver's side.
-            let hidden: Vec<Vec<DVec2>> = view
-                .touching
-                .iter()
-                .filter(|&&index| self.occluders[index].surface != receiver)
-                .flat_map(|&index| contact_shadow(x, &self.occluders[index], e, tol))
+            // What the faces through x hide on the receiver's side, and the shadows of the other
+            // receivers' faces whose planes miss x, as the receiver on its own sees them.
+            let others = |list: &'_ [usize]| {
+                list.iter()
+                    .map(|&index| &self.occluders[index])
+                    .filter(|occ| occ.surface != receiver)
+                    .collect::<Vec<_>>()
+            };
+            let mut hidden: Vec<Vec<DVec2>> = others(&view.touching)
+                .into_iter()
+                .flat_map(|occ| contact_shadow(x, occ, e, tol))
                 .map(|region| {
                     region
                         .iter()
@@ -463,6 +522,12 @@ impl<'a> DirectLight<'a> {
                 })
                 .filter(|part| part.len() >= 3)
                 .collect();
+            hidden.extend(
+                others(&view.own)
+                    .into_iter()
+                    .flat_map(|occ| self.own_shadow(x, occ, e, &view.piece))
+                    .filter(|part| part.len() >= 3),
+            );
             let seen: Vec<Vec<DVec2>> = if hidden.is_empty() {
                 view.visible
                     .iter()
@@ -627,7 +692,15 @@ impl<'a> DirectLight<'a> {
         let Some(Blocked {
             mut blockings,
             start,
-        }) = self.blockings(x.point, Some(receiver), e, front, h_x, &piece, narrow)
+        }) = self.blockings(
+            x.point,
+            Viewer::Receiver(receiver),
+            e,
+            front,
+            h_x,
+            &piece,
+            narrow,
+        )
         else {
             return Ok(Vec::new());
         };
@@ -668,7 +741,7 @@ impl<'a> DirectLight<'a> {
     fn blockings(
         &self,
         point: DVec3,
-        receiver: Option<SurfaceId>,
+        viewer: Viewer,
         e: &Emitter,
         front: &[DVec3],
         h_x: f64,
@@ -681,15 +754,15 @@ impl<'a> DirectLight<'a> {
         // Faces wholly between the two planes and not too close to x are projected whole.
         let reach = h_x * (1.0 - 1.0 / PROJECTION_REACH);
         let project = |p: DVec3| project_onto(e, point, h_x, p);
-        let (mut candidates, mut outlines) = self.reached(point, receiver, e, &sides, reach);
+        let (mut candidates, mut outlines) = self.reached(point, viewer, e, &sides, reach);
         let mut start = None;
         if narrow && candidates.len() > self.window_faces {
-            match self.window(point, e, h_x, reach, piece, &candidates, &outlines) {
+            match self.window(point, viewer, e, h_x, reach, piece, &candidates, &outlines) {
                 Window::Covered => return None,
                 Window::Narrowed { visible, hull } => {
                     let corners: Vec<DVec3> = hull.iter().map(|&q| e.frame.to_3d(q)).collect();
                     sides = shaft_sides(point, &corners);
-                    (candidates, outlines) = self.reached(point, receiver, e, &sides, reach);
+                    (candidates, outlines) = self.reached(point, viewer, e, &sides, reach);
                     start = Some((visible, hull));
                 }
                 Window::Wide => {}
@@ -712,39 +785,15 @@ impl<'a> DirectLight<'a> {
                 blockings.push(Blocking::Touching(index));
                 continue;
             }
-            // Wholly outside one side of the shaft, or beyond the emitter's plane: no shadow.
-            let (lowest, highest) = e.height_range(&occ.polygon);
-            if highest < 0.0
-                || sides
-                    .iter()
-                    .any(|m| occ.polygon.iter().all(|&p| m.dot(p - point) < 0.0))
-            {
+            if viewer.owns(occ.surface) {
+                blockings.push(Blocking::Own(index));
                 continue;
             }
-            let inside = lowest >= 0.0
-                && occ
-                    .polygon
-                    .iter()
-                    .all(|&p| sides.iter().all(|m| m.dot(p - point) >= 0.0));
-            // Shadows subtracted at once may reach past the piece: a face between the two
-            // planes and not too close to x is projected whole, keeping its own corners.
-            let whole = inside || (at_once && lowest >= 0.0 && highest <= reach);
-            let poly = if whole {
-                std::borrow::Cow::Borrowed(&occ.polygon)
-            } else {
-                let mut poly = clip_polygon_3d(&occ.polygon, |p| e.frame.height(p));
-                for &m in &sides {
-                    if poly.len() < 3 {
-                        break;
-                    }
-                    poly = clip_polygon_3d(&poly, |p| m.dot(p - point));
-                }
-                std::borrow::Cow::Owned(poly)
+            let Some((corners, whole)) =
+                self.shadow(occ, point, e, h_x, &sides, at_once.then_some(reach))
+            else {
+                continue;
             };
-            if poly.len() < 3 {
-                continue;
-            }
-            let corners: FaceCorners = poly.iter().map(|&p| project(p)).collect();
             // Only a shadow whose box holds the piece's can cover it; most are far smaller.
             if box_holds(&corners, piece)
                 && tidy_shadow(&corners, e, min_width).is_some_and(|shadow| covers(&shadow, piece))
@@ -757,6 +806,90 @@ impl<'a> DirectLight<'a> {
             });
         }
         Some(Blocked { blockings, start })
+    }
+
+    /// The shadow of `occ` from `point` (at height `h_x` above the emitter's plane) in the shaft
+    /// with these `sides`, projected onto the emitter's plane, and whether the face went whole
+    /// (keeping its own corners: faces between the two planes within `reach` of the emitter,
+    /// when given, and faces wholly inside the shaft); `None` when it casts none there.
+    fn shadow(
+        &self,
+        occ: &ConvexPiece,
+        point: DVec3,
+        e: &Emitter,
+        h_x: f64,
+        sides: &[DVec3],
+        reach: Option<f64>,
+    ) -> Option<(FaceCorners, bool)> {
+        // Wholly outside one side of the shaft, or beyond the emitter's plane: no shadow.
+        let (lowest, highest) = e.height_range(&occ.polygon);
+        if highest < 0.0
+            || sides
+                .iter()
+                .any(|m| occ.polygon.iter().all(|&p| m.dot(p - point) < 0.0))
+        {
+            return None;
+        }
+        let inside = lowest >= 0.0
+            && occ
+                .polygon
+                .iter()
+                .all(|&p| sides.iter().all(|m| m.dot(p - point) >= 0.0));
+        // Shadows subtracted at once may reach past the piece: a face between the two planes
+        // and not too close to x is projected whole, keeping its own corners.
+        let whole = inside || reach.is_some_and(|reach| lowest >= 0.0 && highest <= reach);
+        let poly = if whole {
+            std::borrow::Cow::Borrowed(&occ.polygon)
+        } else {
+            let mut poly = clip_polygon_3d(&occ.polygon, |p| e.frame.height(p));
+            for &m in sides {
+                if poly.len() < 3 {
+                    break;
+                }
+                poly = clip_polygon_3d(&poly, |p| m.dot(p - point));
+            }
+            std::borrow::Cow::Owned(poly)
+        };
+        if poly.len() < 3 {
+            return None;
+        }
+        let corners = poly
+            .iter()
+            .map(|&p| project_onto(e, point, h_x, p))
+            .collect();
+        Some((corners, whole))
+    }
+
+    /// What a face of another receiver's surface, whose plane misses the shared point, hides of
+    /// `piece` (in the emitter's 2D frame) from x: as for x on its own ([`Self::blockings`]),
+    /// what it hides on x's side where its plane holds x, else its shadow.
+    fn own_shadow(
+        &self,
+        x: &ReceivingPoint,
+        occ: &ConvexPiece,
+        e: &Emitter,
+        piece: &[DVec2],
+    ) -> Vec<Vec<DVec2>> {
+        let h_x = e.frame.height(x.point);
+        if occ.holds(x.point, self.tol) {
+            return contact_shadow(x, occ, e, self.tol)
+                .iter()
+                .map(|region| {
+                    region
+                        .iter()
+                        .fold(piece.to_vec(), |part, h| clip_half_plane(&part, h))
+                })
+                .collect();
+        }
+        if h_x <= self.tol {
+            return Vec::new();
+        }
+        let corners: Vec<DVec3> = piece.iter().map(|&q| e.frame.to_3d(q)).collect();
+        let sides = shaft_sides(x.point, &corners);
+        self.shadow(occ, x.point, e, h_x, &sides, None)
+            .and_then(|(corners, _)| tidy_shadow(&corners, e, e.sliver_width(x.point)))
+            .into_iter()
+            .collect()
     }
 
     /// A sheet's outline, turned as its faces face x, with each edge's first corner projected.
@@ -779,7 +912,7 @@ impl<'a> DirectLight<'a> {
     fn reached(
         &self,
         point: DVec3,
-        receiver: Option<SurfaceId>,
+        viewer: Viewer,
         e: &Emitter,
         sides: &[DVec3],
         reach: f64,
@@ -806,7 +939,7 @@ impl<'a> DirectLight<'a> {
         candidates.retain(|&index| {
             let occ = &self.occluders[index];
             // A face of a closed solid turned away from x is behind another face of it.
-            Some(occ.surface) != receiver
+            !viewer.ignores(occ.surface)
                 && occ.surface != e.surface
                 && !occ
                     .outward
@@ -822,6 +955,7 @@ impl<'a> DirectLight<'a> {
     fn window(
         &self,
         point: DVec3,
+        viewer: Viewer,
         e: &Emitter,
         h_x: f64,
         reach: f64,
@@ -852,7 +986,11 @@ impl<'a> DirectLight<'a> {
             // Faces through x, or not wholly between the planes within reach, wait for the
             // full pass.
             let (lowest, highest) = e.height_range(&occ.polygon);
-            if lowest < 0.0 || highest > reach || occ.holds(point, self.tol) {
+            if lowest < 0.0
+                || highest > reach
+                || occ.holds(point, self.tol)
+                || viewer.owns(occ.surface)
+            {
                 continue;
             }
             let corners: Vec<DVec2> = occ.polygon.iter().map(|&p| project(p)).collect();
@@ -937,11 +1075,14 @@ fn shaft_sides(point: DVec3, front: &[DVec3]) -> Vec<DVec3> {
 }
 
 /// One convex piece of an emitter seen from a point: what the occluders not through the point
-/// leave of it (shapes of an outline and holes), and the occluders through the point.
+/// leave of it (shapes of an outline and holes), the occluders through the point, and the faces
+/// of the receivers' own surfaces whose planes miss it ([`Viewer::Group`]): each receiver
+/// loses what the others' hide on its side, or their shadows as it sees them on its own.
 struct PieceView {
     piece: Vec<DVec2>,
     visible: Vec<VisibleShape>,
     touching: Vec<usize>,
+    own: Vec<usize>,
 }
 
 /// Lambert's contour sum over contours on an emitter's plane, each counted with the sign of its
@@ -1033,7 +1174,7 @@ fn subtract_one_by_one(
     for blocking in blockings {
         let mut next = Vec::with_capacity(visible.len() + 4);
         match blocking {
-            Blocking::Touching(_) => {}
+            Blocking::Touching(_) | Blocking::Own(_) => {}
             Blocking::Contact(regions) => {
                 for region in regions {
                     next.clear();
@@ -1084,7 +1225,7 @@ fn subtract_at_once(
     );
     for blocking in blockings {
         match blocking {
-            Blocking::Touching(_) => {}
+            Blocking::Touching(_) | Blocking::Own(_) => {}
             Blocking::Contact(regions) => {
                 for region in regions {
                     let mut hidden = piece.to_vec();
@@ -1427,14 +1568,16 @@ mod tests {
         let h_x = e.frame.height(x.point);
         let reach = h_x * (1.0 - 1.0 / PROJECTION_REACH);
         let sides = shaft_sides(x.point, &e.pieces[0]);
-        let (all, nodes) = narrow.reached(x.point, None, e, &sides, reach);
+        // A viewer that leaves no surface out.
+        let anyone = Viewer::Group(&[]);
+        let (all, nodes) = narrow.reached(x.point, anyone, e, &sides, reach);
         let Window::Narrowed { hull, .. } =
-            narrow.window(x.point, e, h_x, reach, &piece, &all, &nodes)
+            narrow.window(x.point, anyone, e, h_x, reach, &piece, &all, &nodes)
         else {
             panic!("the tiles narrow the shaft");
         };
         let hull3: Vec<DVec3> = hull.iter().map(|&q| e.frame.to_3d(q)).collect();
-        let (kept, _) = narrow.reached(x.point, None, e, &shaft_sides(x.point, &hull3), reach);
+        let (kept, _) = narrow.reached(x.point, anyone, e, &shaft_sides(x.point, &hull3), reach);
         assert!(
             kept.len() * 2 < all.len(),
             "{} of {} faces kept",
