@@ -110,6 +110,20 @@ fn a_missing_file_is_named_once_with_its_cause() {
     assert_eq!(e.matches("os error 2").count(), 1, "{e}");
 }
 
+/// An output directory named like a built-in scene does not hide the scene.
+#[test]
+fn a_directory_does_not_hide_a_built_in_scene() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    std::fs::create_dir(dir.path().join("textbook")).expect("mkdir");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_penumbra"))
+        .args(["check", "textbook"])
+        .current_dir(dir.path())
+        .output()
+        .expect("the penumbra binary runs");
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("builtin:textbook"));
+}
+
 /// Library callers get the same checks, with errors that describe the value and name no flag.
 #[test]
 fn library_options_are_checked_without_flags() {

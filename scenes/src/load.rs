@@ -36,14 +36,15 @@ pub fn load_scene_with(spec: &str, options: &ObjOptions) -> Result<LoadedScene, 
     let looks_like_path = spec.contains(std::path::MAIN_SEPARATOR)
         || spec.contains('/')
         || path.extension().is_some();
-    let builtin_scene = if path.exists() {
+    // A directory named like a built-in scene (an output directory, say) does not hide it.
+    let builtin_scene = if path.is_file() {
         None
     } else {
         builtin::builtin(spec)
     };
     let (scene, source, warnings) = if let Some(scene) = builtin_scene {
         (scene, format!("builtin:{spec}"), Vec::new())
-    } else if path.exists() || looks_like_path {
+    } else if path.is_file() || looks_like_path {
         let (scene, warnings) = read_scene_file_with(path, options)?;
         (scene, path.display().to_string(), warnings)
     } else {

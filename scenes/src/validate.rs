@@ -179,7 +179,8 @@ impl fmt::Display for Problem {
             ),
             NoEmitter => write!(
                 f,
-                "no surface emits light; give at least one surface a positive \"emission\""
+                "no surface emits light; give at least one surface a positive \"emission\" (in OBJ files, \
+                 a material with a positive Ke)"
             ),
             BadCamera { reason } => write!(f, "camera: {reason}"),
         }

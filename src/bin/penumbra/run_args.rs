@@ -185,7 +185,9 @@ pub(crate) struct RunArgs {
     /// faces are half as tall).
     #[arg(help_heading = SOLVER, long, default_value_t = 128)]
     pub(crate) hemicube_resolution: usize,
-    /// Stop shooting when the unshot power is below this fraction of the emitted power.
+    /// The solver's stopping tolerance: progressive refinement stops when the unshot power is
+    /// below this fraction of the emitted power; the other solvers when their relative residual
+    /// (hierarchical: the relative change of a sweep) is below it.
     #[arg(help_heading = SOLVER, long, default_value_t = DEFAULT_EPSILON)]
     pub(crate) epsilon: f64,
     /// Stop after this many patch shots, converged or not.

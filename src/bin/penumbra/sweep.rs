@@ -22,7 +22,11 @@ pub(crate) struct SweepArgs {
     #[arg(long, default_value = "sweep")]
     out: PathBuf,
     /// Element budgets, comma-separated.
-    #[arg(long, value_delimiter = ',', default_values_t = [2500, 5000, 10000, 20000, 30000])]
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "2500,5000,10000,20000,30000"
+    )]
     budgets: Vec<usize>,
     /// Tolerance of the adaptive runs at the first budget, relative to the mean reflected
     /// radiosity (as `run --refine-tol`); it shrinks in proportion as the budget grows, so that larger budgets are spent.
@@ -59,7 +63,8 @@ pub(crate) struct SweepArgs {
     /// graded: refinement finds the penumbrae).
     #[arg(long, default_value_t = penumbra::adaptive::INITIAL_FRACTION)]
     initial_fraction: f64,
-    /// Stop shooting when the unshot power falls below this fraction of the emitted power.
+    /// The solvers' stopping tolerance, as `run --epsilon`: the unshot fraction of the emitted
+    /// power for progressive refinement, the relative residual for the others.
     #[arg(long, default_value_t = SolverOptions::default().epsilon)]
     epsilon: f64,
     /// Rays per vertex–patch pair for visibility.
