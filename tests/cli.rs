@@ -815,6 +815,25 @@ fn hemicube_form_factors_run_and_refuse_refinement() {
     }
 }
 
+/// `penumbra ARGS` sent `signal` (`INT`, `TERM`) after `seconds`: what it wrote to stderr, its
+/// exit status, and the seconds it took to end once signalled.
+fn signalled(args: &[&str], signal: &str, seconds: f64) -> (std::process::Output, f64) {
+    let child = Command::new(env!("CARGO_BIN_EXE_penumbra"))
+        .args(args)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("the penumbra binary runs");
+    std::thread::sleep(std::time::Duration::from_secs_f64(seconds));
+    let sent = Command::new("kill")
+        .args([format!("-{signal}"), child.id().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(sent.success());
+    let at = std::time::Instant::now();
+    let o = child.wait_with_output().expect("the run ends");
+    (o, at.elapsed().as_secs_f64())
+}
+
 /// A real SIGINT or SIGTERM to a real run: it stops shooting, writes its solution so far (valid,
 /// marked partial, stop "interrupted") and exits 130 or 143, the statuses of the signals.
 #[test]
@@ -823,8 +842,8 @@ fn interrupted_runs_write_their_partial_solution() {
     for (signal, code) in [("INT", 130), ("TERM", 143)] {
         let out = dir.path().join(signal);
         // Converging this far takes minutes; the signal comes after two seconds.
-        let child = Command::new(env!("CARGO_BIN_EXE_penumbra"))
-            .args([
+        let (o, _) = signalled(
+            &[
                 "run",
                 "cornell",
                 "--solver",
@@ -836,17 +855,10 @@ fn interrupted_runs_write_their_partial_solution() {
                 "--quiet",
                 "--out",
                 out.to_str().expect("utf-8"),
-            ])
-            .stderr(std::process::Stdio::piped())
-            .spawn()
-            .expect("the penumbra binary runs");
-        std::thread::sleep(std::time::Duration::from_secs(2));
-        let sent = Command::new("kill")
-            .args([format!("-{signal}"), child.id().to_string()])
-            .status()
-            .expect("kill runs");
-        assert!(sent.success());
-        let o = child.wait_with_output().expect("the run ends");
+            ],
+            signal,
+            2.0,
+        );
         let stderr = String::from_utf8_lossy(&o.stderr);
         assert_eq!(o.status.code(), Some(code), "{stderr}");
         assert!(stderr.contains("interrupted"), "{stderr}");
@@ -869,8 +881,8 @@ fn interrupted_runs_write_their_partial_solution() {
 fn one_signal_stops_a_run_promptly() {
     let dir = tempfile::tempdir().expect("temp dir");
     let out = dir.path().join("out");
-    let child = Command::new(env!("CARGO_BIN_EXE_penumbra"))
-        .args([
+    let (o, waited) = signalled(
+        &[
             "run",
             "boxworld-3000",
             "--width",
@@ -879,20 +891,13 @@ fn one_signal_stops_a_run_promptly() {
             "64",
             "--svg",
             "none",
-        ])
-        .args(["--quiet", "--out", out.to_str().expect("utf-8")])
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .expect("the penumbra binary runs");
-    std::thread::sleep(std::time::Duration::from_secs(9));
-    let sent = Command::new("kill")
-        .args(["-TERM".to_owned(), child.id().to_string()])
-        .status()
-        .expect("kill runs");
-    assert!(sent.success());
-    let signalled = std::time::Instant::now();
-    let o = child.wait_with_output().expect("the run ends");
-    let waited = signalled.elapsed().as_secs_f64();
+            "--quiet",
+            "--out",
+            out.to_str().expect("utf-8"),
+        ],
+        "TERM",
+        9.0,
+    );
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(143), "{stderr}");
     // A second to stop computing, then the time to write a large partial solution.
@@ -912,19 +917,19 @@ fn runs_interrupted_before_a_solution_leave_the_output_alone() {
     std::fs::create_dir(&out).expect("mkdir");
     std::fs::write(out.join("report.json"), b"old").expect("writes");
     // Finding and meshing the shadows of 3,000 boxes takes seconds; the signal comes at one.
-    let child = Command::new(env!("CARGO_BIN_EXE_penumbra"))
-        .args(["run", "boxworld-3000", "--max-elements", "200000"])
-        .args(["--quiet", "--out", out.to_str().expect("utf-8")])
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .expect("the penumbra binary runs");
-    std::thread::sleep(std::time::Duration::from_secs(1));
-    let sent = Command::new("kill")
-        .args(["-INT".to_owned(), child.id().to_string()])
-        .status()
-        .expect("kill runs");
-    assert!(sent.success());
-    let o = child.wait_with_output().expect("the run ends");
+    let (o, _) = signalled(
+        &[
+            "run",
+            "boxworld-3000",
+            "--max-elements",
+            "200000",
+            "--quiet",
+            "--out",
+            out.to_str().expect("utf-8"),
+        ],
+        "INT",
+        1.0,
+    );
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(130), "{stderr}");
     assert!(stderr.contains("nothing written"), "{stderr}");
