@@ -113,6 +113,23 @@ pub struct RefineReport {
     pub residual: ResidualSummary,
 }
 
+impl RefineReport {
+    fn new(
+        options: &RefineOptions,
+        rounds: Vec<RefineRound>,
+        stop: RefineStop,
+        residual: ResidualSummary,
+    ) -> RefineReport {
+        RefineReport {
+            tolerance: options.tolerance,
+            tolerance_relative_to: TOLERANCE_RELATIVE_TO,
+            rounds,
+            stop,
+            residual,
+        }
+    }
+}
+
 /// Refines `mesh` adaptively within `max_elements` triangles, solving as it goes; returns what
 /// it did and the solution on the final mesh (shot to `solver.epsilon`).
 pub fn refine_adaptively(
@@ -148,13 +165,7 @@ pub fn refine_adaptively(
         }
     }
     solver.shoot(solver_options.epsilon, progress);
-    let report = RefineReport {
-        tolerance: options.tolerance,
-        tolerance_relative_to: TOLERANCE_RELATIVE_TO,
-        rounds,
-        stop,
-        residual,
-    };
+    let report = RefineReport::new(options, rounds, stop, residual);
     Ok((report, solver.solution()))
 }
 
@@ -227,13 +238,7 @@ pub fn refine_hierarchically(
         s.rays_cast += early.rays_cast;
         solution
     };
-    let report = RefineReport {
-        tolerance: options.tolerance,
-        tolerance_relative_to: TOLERANCE_RELATIVE_TO,
-        rounds,
-        stop,
-        residual,
-    };
+    let report = RefineReport::new(options, rounds, stop, residual);
     Ok((report, solution))
 }
 

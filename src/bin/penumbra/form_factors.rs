@@ -43,9 +43,6 @@ pub(crate) fn form_factors(args: &FormFactorArgs) -> Result<(), Failure> {
     use penumbra::experiments::form_factors::{StudyError, run_study};
     let study = run_study(&options).map_err(|e| match e {
         StudyError::InvalidOption(e) => invalid_option(&e, Command::FormFactors),
-        StudyError::Solve(e @ penumbra_solver::SolveError::InvalidOption { .. }) => {
-            invalid_option(&penumbra::InvalidOption::from(e), Command::FormFactors)
-        }
         e => Failure::from(e),
     })?;
     std::fs::create_dir_all(&args.out)

@@ -106,10 +106,11 @@ fn run_with(args: &RunArgs, fingerprint: Option<&str>) -> Result<ExitCode, Failu
     options.shard = shard;
     let spec = args.scene.as_deref().unwrap_or_default();
     let mut loaded = load(spec, obj_options(args.no_merge))?;
-    if let Some(camera) =
-        crate::camera::camera(args, &loaded.scene).map_err(|e| usage(anyhow::anyhow!(e)))?
-    {
-        loaded.scene.camera = Some(camera);
+    // The camera the options give, if any: it replaces the scene's, and a shard records it.
+    let camera =
+        crate::camera::camera(args, &loaded.scene).map_err(|e| usage(anyhow::anyhow!(e)))?;
+    if camera.is_some() {
+        loaded.scene.camera = camera;
     }
     if !args.quiet {
         for w in &loaded.warnings {
@@ -157,9 +158,7 @@ fn run_with(args: &RunArgs, fingerprint: Option<&str>) -> Result<ExitCode, Failu
         let origin = penumbra::shard::SceneOrigin {
             spec: spec.to_owned(),
             no_merge: args.no_merge,
-            camera: camera_given(args)
-                .then_some(result.loaded.scene.camera)
-                .flatten(),
+            camera,
         };
         let written = penumbra::shard::write_shard(&result, shard, origin, &args.out, &svgs)?;
         if !args.quiet {
@@ -232,15 +231,6 @@ fn run_with(args: &RunArgs, fingerprint: Option<&str>) -> Result<ExitCode, Failu
         return Ok(signals.status());
     }
     Ok(ExitCode::SUCCESS)
-}
-
-/// Whether the arguments set the render's camera.
-fn camera_given(args: &RunArgs) -> bool {
-    args.camera.is_some()
-        || args.eye.is_some()
-        || args.target.is_some()
-        || args.up.is_some()
-        || args.fov.is_some()
 }
 
 /// The command line of this run, for `report.json`.
