@@ -123,7 +123,8 @@ pub mod pipeline;
 pub mod shard;
 
 pub use options::{
-    DEFAULT_BUDGET, DEFAULT_MAX_ELEMENTS, HIERARCHICAL_MAX_ELEMENTS, InvalidOption, MeshMethod,
-    RunOptions, default_budget,
+    DEFAULT_BUDGET, DEFAULT_FF_SAMPLES, DEFAULT_HEMICUBE_RESOLUTION, DEFAULT_MAX_ELEMENTS,
+    HIERARCHICAL_MAX_ELEMENTS, InvalidOption, MeshMethod, RunOptions, default_budget,
+    default_initial_elements, default_penumbra_density,
 };
 pub use pipeline::{RunError, RunResult, run};

@@ -49,6 +49,30 @@ pub fn default_budget(method: SolverMethod, direct_only: bool) -> ElementBudget 
     }
 }
 
+/// The penumbra density of a run when none is given: [`DEFAULT_PENUMBRA_DENSITY`], or 1 (no
+/// grading) with adaptive refinement, which finds the penumbrae itself.
+pub fn default_penumbra_density(refining: bool) -> f64 {
+    if refining {
+        1.0
+    } else {
+        DEFAULT_PENUMBRA_DENSITY
+    }
+}
+
+/// The starting mesh of adaptive refinement when none is given: a fraction
+/// ([`crate::adaptive::INITIAL_FRACTION`]) of the element cap, or of [`DEFAULT_MAX_ELEMENTS`]
+/// without one (the run raises it to the scene's least mesh if that is more).
+pub fn default_initial_elements(max_elements: Option<usize>) -> usize {
+    (max_elements.unwrap_or(DEFAULT_MAX_ELEMENTS) as f64 * crate::adaptive::INITIAL_FRACTION)
+        as usize
+}
+
+/// Monte Carlo form factors' samples per vertex and patch when none are given.
+pub const DEFAULT_FF_SAMPLES: usize = 256;
+
+/// Hemicube form factors' pixels across the top face when none are given.
+pub const DEFAULT_HEMICUBE_RESOLUTION: usize = 128;
+
 /// Penumbra densities accepted: 1 (no grading) up to this.
 pub const MAX_PENUMBRA_DENSITY: f64 = 1e6;
 

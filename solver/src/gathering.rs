@@ -381,6 +381,7 @@ pub fn solve_gathering(
         Solution {
             radiosity: disc.per_surface(&radiosity),
             irradiance: disc.per_surface(&h),
+            direct_irradiance: disc.per_surface(&system.direct),
             ambient: Rgb::ZERO,
             stats,
             convergence: history.clone(),

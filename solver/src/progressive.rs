@@ -222,6 +222,10 @@ pub struct Solution {
     pub radiosity: Vec<Vec<Rgb>>,
     /// Irradiance H at each vertex, per surface: B = E + ρ H.
     pub irradiance: Vec<Vec<Rgb>>,
+    /// The part of `irradiance` that comes straight from the emitters, per surface: exact by
+    /// backprojection (or estimated by rays where [`SolveStats::direct_estimated`] says so).
+    /// The reflected light's part is `irradiance - direct_irradiance`.
+    pub direct_irradiance: Vec<Vec<Rgb>>,
     /// Cohen et al.'s ambient term for display: an estimate of the light not yet shot, spread
     /// evenly. Never part of the radiosity.
     pub ambient: Rgb,
@@ -982,6 +986,7 @@ impl<'a> ProgressiveSolver<'a> {
         Solution {
             radiosity: self.radiosity(),
             irradiance: disc.per_surface(&self.irradiance),
+            direct_irradiance: disc.per_surface(&self.direct_irradiance),
             ambient,
             stats,
             convergence: self.convergence.clone(),

@@ -298,6 +298,7 @@ pub fn solve_hierarchical_refining(
     let solution = Solution {
         radiosity: disc.per_surface(&radiosity),
         irradiance: disc.per_surface(&irradiance),
+        direct_irradiance: disc.per_surface(&current.direct),
         ambient: Rgb::ZERO,
         stats: SolveStats {
             hierarchy: Some(stats),

@@ -4,9 +4,9 @@
 use std::path::PathBuf;
 
 use clap::ValueEnum;
-use penumbra::{DEFAULT_MAX_ELEMENTS, MeshMethod, RunOptions};
+use penumbra::{MeshMethod, RunOptions};
+use penumbra_meshing::ElementBudget;
 use penumbra_meshing::discontinuity::{DiscontinuityOptions, EventSet};
-use penumbra_meshing::{DEFAULT_PENUMBRA_DENSITY, ElementBudget};
 use penumbra_solver::DEFAULT_EPSILON;
 use penumbra_solver::{Interrupt, SolverOptions};
 use serde::{Deserialize, Serialize};
@@ -179,11 +179,11 @@ pub(crate) struct RunArgs {
     #[arg(help_heading = SOLVER, long, value_enum, default_value_t = FormFactorArg::Analytic)]
     pub(crate) form_factors: FormFactorArg,
     /// With --form-factors monte-carlo: samples per vertex and patch.
-    #[arg(help_heading = SOLVER, long, default_value_t = 256)]
+    #[arg(help_heading = SOLVER, long, default_value_t = penumbra::DEFAULT_FF_SAMPLES)]
     pub(crate) ff_samples: usize,
     /// With --form-factors hemicube: pixels across the hemicube's top face (even; the side
     /// faces are half as tall).
-    #[arg(help_heading = SOLVER, long, default_value_t = 128)]
+    #[arg(help_heading = SOLVER, long, default_value_t = penumbra::DEFAULT_HEMICUBE_RESOLUTION)]
     pub(crate) hemicube_resolution: usize,
     /// The solver's stopping tolerance: progressive refinement stops when the unshot power is
     /// below this fraction of the emitted power; the other solvers when their relative residual
@@ -284,21 +284,17 @@ impl RunArgs {
             ),
             penumbra_density: self
                 .penumbra_density
-                .unwrap_or(if self.refine_tol.is_some() {
-                    1.0
-                } else {
-                    DEFAULT_PENUMBRA_DENSITY
-                }),
+                .unwrap_or(penumbra::default_penumbra_density(
+                    self.refine_tol.is_some(),
+                )),
             time_budget: self.time_budget,
             refine: self
                 .refine_tol
                 .map(|tolerance| penumbra::adaptive::RefineOptions {
                     tolerance,
-                    initial_elements: self.initial_elements.unwrap_or(
-                        (self.max_elements.unwrap_or(DEFAULT_MAX_ELEMENTS) as f64
-                            * penumbra::adaptive::INITIAL_FRACTION)
-                            as usize,
-                    ),
+                    initial_elements: self
+                        .initial_elements
+                        .unwrap_or(penumbra::default_initial_elements(self.max_elements)),
                     max_rounds: self.refine_rounds,
                     indirect: self.refine_indirect.into(),
                 }),

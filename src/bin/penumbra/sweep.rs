@@ -1,5 +1,6 @@
 //! `penumbra sweep`: error against elements and time, over methods and budgets.
 
+use penumbra_solver::path_trace::MAX_PATHS;
 use std::path::PathBuf;
 
 use crate::progress_bar::Bars;
@@ -79,10 +80,6 @@ pub(crate) struct SweepArgs {
     quiet: bool,
 }
 
-/// Most paths per sample of a reference: 1e8 paths give a standard error near 0.01 % on the
-/// Cornell box, and take hours per thousand samples.
-const MAX_REFERENCE_PATHS: usize = 100_000_000;
-
 pub(crate) fn sweep(args: &SweepArgs) -> Result<(), Failure> {
     let sample_count = args
         .samples
@@ -114,9 +111,9 @@ pub(crate) fn sweep(args: &SweepArgs) -> Result<(), Failure> {
     options
         .validate()
         .map_err(|e| invalid_option(&e, Command::Sweep))?;
-    if !(1..=MAX_REFERENCE_PATHS).contains(&args.reference_paths) {
+    if !(1..=MAX_PATHS).contains(&args.reference_paths) {
         return Err(usage(anyhow::anyhow!(
-            "--reference-paths must be from 1 to {MAX_REFERENCE_PATHS}, not {}",
+            "--reference-paths must be from 1 to {MAX_PATHS}, not {}",
             args.reference_paths
         )));
     }

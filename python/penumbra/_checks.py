@@ -1,0 +1,87 @@
+"""Argument checks: every value a caller passes is turned into what the native module takes, or
+refused with a ``TypeError`` (wrong kind) or ``ValueError`` (wrong value) naming the argument."""
+
+from __future__ import annotations
+
+import math
+import numbers
+from typing import Any, Optional, Sequence
+
+import numpy as np
+
+
+def rows3(value: Any, name: str, *, allow_single: bool = False) -> np.ndarray:
+    """An (N, 3) C-contiguous float64 array of finite numbers; with ``allow_single``, a lone
+    row of three is taken as (1, 3)."""
+    try:
+        array = np.asarray(value)
+    except Exception as e:  # ragged lists, objects numpy cannot hold
+        raise TypeError(f"{name} must be an (N, 3) array of numbers: {e}") from None
+    if array.dtype.kind not in "iuf":
+        raise TypeError(f"{name} must hold real numbers, not {array.dtype}")
+    array = array.astype(np.float64, copy=False)
+    if allow_single and array.shape == (3,):
+        array = array.reshape(1, 3)
+    if array.ndim != 2 or array.shape[1] != 3:
+        raise ValueError(f"{name} must have shape (N, 3), not {array.shape}")
+    finite = np.isfinite(array).all(axis=1)
+    if not finite.all():
+        row = int(np.argmin(finite))
+        raise ValueError(f"{name}: row {row} is not finite: {array[row].tolist()}")
+    return np.ascontiguousarray(array)
+
+
+def count(value: Any, name: str, *, minimum: int = 1) -> Optional[int]:
+    """A whole number of at least ``minimum``, or None."""
+    if value is None:
+        return None
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
+        raise TypeError(f"{name} must be a whole number, not {type(value).__name__}")
+    if value < minimum:
+        raise ValueError(f"{name} must be at least {minimum}, not {value}")
+    return int(value)
+
+
+def number(value: Any, name: str, *, positive: bool = False) -> Optional[float]:
+    """A finite real number (positive, if asked), or None."""
+    if value is None:
+        return None
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        raise TypeError(f"{name} must be a number, not {type(value).__name__}")
+    value = float(value)
+    if not math.isfinite(value):
+        raise ValueError(f"{name} must be finite, not {value}")
+    if positive and value <= 0:
+        raise ValueError(f"{name} must be positive, not {value}")
+    return value
+
+
+def flag(value: Any, name: str) -> bool:
+    """True or False."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise TypeError(f"{name} must be True or False, not {type(value).__name__}")
+    return bool(value)
+
+
+def choice(value: Any, name: str, choices: Sequence[str]) -> Optional[str]:
+    """One of ``choices``, or None."""
+    if value is None:
+        return None
+    if not isinstance(value, str):
+        raise TypeError(f"{name} must be a string, not {type(value).__name__}")
+    if value not in choices:
+        listed = ", ".join(repr(c) for c in choices)
+        raise ValueError(f"{name} must be one of {listed}, not {value!r}")
+    return value
+
+
+def surface_ids(value: Any, name: str, points: int) -> Optional[list[int]]:
+    """One surface id per point (-1: none), or None."""
+    if value is None:
+        return None
+    array = np.asarray(value)
+    if array.dtype.kind not in "iu":
+        raise TypeError(f"{name} must hold whole numbers, not {array.dtype}")
+    if array.shape != (points,):
+        raise ValueError(f"{name} must have shape ({points},), one id per point, not {array.shape}")
+    return [int(i) for i in array]

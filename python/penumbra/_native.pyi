@@ -1,0 +1,115 @@
+"""Type stubs of penumbra's native module (the Rust half). Use the public API in `penumbra`."""
+
+from typing import Any, Optional, Sequence, Union
+
+import numpy as np
+
+__version__: str
+
+class SceneError(ValueError):
+    """A scene that cannot be read or is not valid."""
+
+    problems: list[str]
+    """Every problem validation found, as `penumbra check` reports them."""
+    warnings: list[str]
+    """What loading repaired first (OBJ files), one line each."""
+
+class Scene:
+    @staticmethod
+    def load(path: str, merge: bool = True) -> Scene: ...
+    @staticmethod
+    def builtin(name: str) -> Scene: ...
+    @staticmethod
+    def from_json(text: str) -> Scene: ...
+    @staticmethod
+    def from_arrays(
+        name: str,
+        names: list[str],
+        corners: np.ndarray,
+        counts: list[int],
+        reflectance: np.ndarray,
+        emission: np.ndarray,
+        camera: Optional[tuple[Any, ...]] = None,
+    ) -> Scene: ...
+    def to_json(self) -> str: ...
+    @property
+    def name(self) -> str: ...
+    @property
+    def source(self) -> str: ...
+    @property
+    def warnings(self) -> list[str]: ...
+    @property
+    def surface_names(self) -> list[str]: ...
+    @property
+    def polygons(self) -> list[np.ndarray]: ...
+    @property
+    def reflectance(self) -> np.ndarray: ...
+    @property
+    def emission(self) -> np.ndarray: ...
+    @property
+    def normals(self) -> np.ndarray: ...
+    @property
+    def areas(self) -> list[float]: ...
+    @property
+    def camera(
+        self,
+    ) -> Optional[tuple[list[float], list[float], list[float], float]]: ...
+    @property
+    def fingerprint(self) -> str: ...
+    def __len__(self) -> int: ...
+
+class Interrupt:
+    """Asks the runs given it to stop, from any thread: `run` then returns the best solution
+    so far, marked partial."""
+
+    def __init__(self) -> None: ...
+    def set(self) -> None: ...
+    @property
+    def is_set(self) -> bool: ...
+
+class RunOutput:
+    def arrays(self) -> dict[str, Any]: ...
+    def report_json(self, svg: Union[str, Sequence[str], None] = None) -> str: ...
+    def solution_json(self) -> str: ...
+    def write(
+        self, directory: str, svg: Union[str, list[str]], convergence: bool = False
+    ) -> list[str]: ...
+    def render(self) -> np.ndarray: ...
+    @property
+    def scene(self) -> Scene: ...
+    @property
+    def triangle_count(self) -> int: ...
+
+def builtin_scenes() -> list[tuple[str, str]]: ...
+def run(
+    scene: Scene,
+    arguments: dict[str, Any],
+    threads: Optional[int] = None,
+    interrupt: Optional[Interrupt] = None,
+) -> tuple[Optional[RunOutput], bool]: ...
+def direct_light(
+    scene: Scene,
+    points: np.ndarray,
+    normals: np.ndarray,
+    surfaces: Optional[list[int]] = None,
+    threads: Optional[int] = None,
+) -> np.ndarray: ...
+def discontinuities(
+    scene: Scene,
+    eee: bool = True,
+    events: Optional[str] = "complete",
+    event_tol: Optional[float] = None,
+    max_elements: Optional[int] = None,
+    threads: Optional[int] = None,
+) -> dict[str, Any]: ...
+def reference(
+    scene: Scene,
+    points: np.ndarray,
+    surfaces: Optional[list[int]] = None,
+    paths: Optional[int] = 4096,
+    seed: Optional[int] = 1,
+    threads: Optional[int] = None,
+) -> tuple[np.ndarray, np.ndarray]: ...
+def locate(
+    scene: Scene, points: np.ndarray, normals: Optional[np.ndarray] = None
+) -> np.ndarray: ...

@@ -1,0 +1,123 @@
+"""``penumbra.run``: the command line's ``penumbra run``, from Python."""
+
+from __future__ import annotations
+
+from typing import Literal, Optional
+
+from . import _checks, _native
+from ._scene import Scene
+from ._solution import Solution
+
+Interrupt = _native.Interrupt
+
+MeshMethod = Literal["auto", "uniform", "discontinuity"]
+SolverMethod = Literal["hierarchical", "progressive", "jacobi", "gauss-seidel", "direct"]
+FormFactors = Literal["analytic", "monte-carlo", "hemicube"]
+
+_MESHES = ("auto", "uniform", "discontinuity")
+_SOLVERS = ("hierarchical", "progressive", "jacobi", "gauss-seidel", "direct")
+_FORM_FACTORS = ("analytic", "monte-carlo", "hemicube")
+
+
+class RunInterrupted(KeyboardInterrupt):
+    """A run stopped by Ctrl-C, or by an :class:`Interrupt` before any solution existed.
+    ``solution`` holds the best solution so far (marked ``partial``), or None."""
+
+    def __init__(self, solution: Optional[Solution]) -> None:
+        state = "with a partial solution" if solution is not None else "before a solution existed"
+        super().__init__(f"the run was interrupted {state}")
+        self.solution = solution
+
+
+def run(
+    scene: Scene,
+    *,
+    mesh: MeshMethod = "auto",
+    max_elements: Optional[int] = None,
+    penumbra_density: Optional[float] = None,
+    eee: bool = True,
+    events: Literal["complete", "extremal"] = "complete",
+    event_tol: Optional[float] = None,
+    refine_tol: Optional[float] = None,
+    initial_elements: Optional[int] = None,
+    refine_indirect: Literal["gradient", "gathered"] = "gradient",
+    refine_rounds: Optional[int] = None,
+    solver: SolverMethod = "hierarchical",
+    link_tol: Optional[float] = None,
+    form_factors: FormFactors = "analytic",
+    ff_samples: Optional[int] = None,
+    hemicube_resolution: Optional[int] = None,
+    epsilon: Optional[float] = None,
+    max_shots: Optional[int] = None,
+    direct_only: bool = False,
+    rays: Optional[int] = None,
+    elements_per_patch: Optional[int] = None,
+    seed: Optional[int] = None,
+    time_budget: Optional[float] = None,
+    threads: Optional[int] = None,
+    memory_limit: Optional[float] = None,
+    width: Optional[int] = None,
+    height: Optional[int] = None,
+    interrupt: Optional[Interrupt] = None,
+) -> Solution:
+    """Meshes, lights and solves ``scene`` as ``penumbra run`` does, with the same options and
+    defaults (``penumbra run --help``, ``docs/cli.md``); the same options give the same
+    ``solution.json``, to the bit.
+
+    The main options: ``mesh`` ``"auto"`` (discontinuity where the scene casts shadows, else
+    uniform), ``"uniform"`` or ``"discontinuity"``; ``max_elements`` caps the triangles for the
+    whole scene (default 25,000 with the hierarchical solver, 10,000 with the others and
+    ``direct_only``, or what the scene needs if more); ``solver`` ``"hierarchical"``,
+    ``"progressive"``, ``"jacobi"``, ``"gauss-seidel"`` or ``"direct"``; ``direct_only``
+    solves one exact bounce; ``refine_tol`` turns on adaptive refinement from
+    ``initial_elements`` up to ``max_elements``; ``time_budget`` (seconds) stops early with the
+    best solution so far; ``threads`` workers (default one per core; results do not depend on
+    it); ``seed`` seeds the visibility sampling; ``width`` and ``height`` size the render.
+    ``None`` means the command line's default.
+
+    The GIL is released while the run computes. Ctrl-C stops it and raises
+    :class:`RunInterrupted` carrying the partial solution; ``interrupt.set()`` from another
+    thread stops it and ``run`` returns the partial solution (``solution.partial``).
+
+    Raises ``ValueError`` for an option out of range (naming it), ``TypeError`` for a value of
+    the wrong kind, ``MemoryError`` when the run would not fit in memory (saying what would)."""
+    if not isinstance(scene, Scene):
+        raise TypeError(f"scene must be a penumbra.Scene, not {type(scene).__name__}")
+    if interrupt is not None and not isinstance(interrupt, Interrupt):
+        raise TypeError(f"interrupt must be a penumbra.Interrupt, not {type(interrupt).__name__}")
+    arguments = {
+        "mesh": _checks.choice(mesh, "mesh", _MESHES),
+        "max_elements": _checks.count(max_elements, "max_elements"),
+        "penumbra_density": _checks.number(penumbra_density, "penumbra_density"),
+        "eee": _checks.flag(eee, "eee"),
+        "events": _checks.choice(events, "events", ("complete", "extremal")),
+        "event_tol": _checks.number(event_tol, "event_tol"),
+        "refine_tol": _checks.number(refine_tol, "refine_tol"),
+        "initial_elements": _checks.count(initial_elements, "initial_elements"),
+        "refine_indirect": _checks.choice(refine_indirect, "refine_indirect", ("gradient", "gathered")),
+        "refine_rounds": _checks.count(refine_rounds, "refine_rounds"),
+        "solver": _checks.choice(solver, "solver", _SOLVERS),
+        "link_tol": _checks.number(link_tol, "link_tol"),
+        "form_factors": _checks.choice(form_factors, "form_factors", _FORM_FACTORS),
+        "ff_samples": _checks.count(ff_samples, "ff_samples"),
+        "hemicube_resolution": _checks.count(hemicube_resolution, "hemicube_resolution"),
+        "epsilon": _checks.number(epsilon, "epsilon"),
+        "max_shots": _checks.count(max_shots, "max_shots", minimum=0),
+        "direct_only": _checks.flag(direct_only, "direct_only"),
+        "rays": _checks.count(rays, "rays"),
+        "elements_per_patch": _checks.count(elements_per_patch, "elements_per_patch"),
+        "seed": _checks.count(seed, "seed", minimum=0),
+        "time_budget": _checks.number(time_budget, "time_budget", positive=True),
+        "memory_limit": _checks.number(memory_limit, "memory_limit", positive=True),
+        "width": _checks.count(width, "width"),
+        "height": _checks.count(height, "height"),
+    }
+    if arguments["seed"] is not None and arguments["seed"] >= 2**64:
+        raise ValueError(f"seed must be below 2**64, not {seed}")
+    output, signalled = _native.run(
+        scene._native, arguments, _checks.count(threads, "threads"), interrupt
+    )
+    solution = Solution(output) if output is not None else None
+    if signalled or solution is None:
+        raise RunInterrupted(solution)
+    return solution

@@ -1,0 +1,193 @@
+"""``penumbra.Solution``: a run's mesh and light as numpy arrays, whole and per surface."""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import Any, Optional, Sequence, Union
+
+import numpy as np
+
+from . import _native
+from ._scene import Scene
+
+
+def _frozen(array: np.ndarray) -> np.ndarray:
+    array.flags.writeable = False
+    return array
+
+
+class Discontinuities:
+    """Discontinuity segments of the direct light: where its value (order 0), slope (1) or
+    curvature (2) jumps on a surface.
+
+    ``segments`` (K, 2, 3) float64 ends in scene coordinates; ``surface_id`` (K,) the surface
+    each lies on; ``emitter`` (K,) the light whose light changes across it; ``event`` (K,) str:
+    ``EV``, ``VE``, ``EEE``, ``contact``, ``blocker-EV`` or ``horizon``; ``boundary`` (K,) str:
+    ``umbra`` (one side sees none of the light), ``penumbra`` (one side sees all of it) or
+    ``inner``; ``order`` (K,) uint8. ``stats`` holds the search's figures when it came from
+    :func:`penumbra.discontinuities`."""
+
+    __slots__ = ("segments", "surface_id", "emitter", "event", "boundary", "order", "stats")
+
+    def __init__(self, arrays: dict[str, Any], stats: Optional[dict[str, Any]] = None) -> None:
+        self.segments: np.ndarray = _frozen(arrays["segments"])
+        self.surface_id: np.ndarray = _frozen(arrays["surface_id"])
+        self.emitter: np.ndarray = _frozen(arrays["emitter"])
+        self.event: np.ndarray = _frozen(np.array(arrays["event"], dtype=str).reshape(-1))
+        self.boundary: np.ndarray = _frozen(np.array(arrays["boundary"], dtype=str).reshape(-1))
+        self.order: np.ndarray = _frozen(arrays["order"])
+        self.stats: Optional[dict[str, Any]] = stats
+
+    def where(self, mask: np.ndarray) -> "Discontinuities":
+        """The segments ``mask`` (a (K,) bool array) keeps, e.g. ``d.where(d.order == 0)``."""
+        mask = np.asarray(mask, dtype=bool)
+        if mask.shape != self.order.shape:
+            raise ValueError(f"mask must have shape {self.order.shape}, not {mask.shape}")
+        return Discontinuities(
+            {
+                "segments": self.segments[mask],
+                "surface_id": self.surface_id[mask],
+                "emitter": self.emitter[mask],
+                "event": self.event[mask].tolist(),
+                "boundary": self.boundary[mask].tolist(),
+                "order": self.order[mask],
+            },
+            self.stats,
+        )
+
+    def __len__(self) -> int:
+        return len(self.order)
+
+    def __repr__(self) -> str:
+        counts = ", ".join(f"{n} of order {o}" for o, n in zip(*np.unique(self.order, return_counts=True)))
+        return f"<penumbra.Discontinuities: {len(self)} segments{': ' + counts if counts else ''}>"
+
+
+class SurfaceSolution:
+    """One surface of a :class:`Solution`: its mesh, with indices into its own ``vertices``,
+    and its light; the arrays are views of the whole scene's (read-only)."""
+
+    __slots__ = (
+        "index", "name", "vertices", "triangles", "radiosity", "direct", "indirect",
+        "irradiance", "discontinuities",
+    )
+
+    def __init__(self, solution: "Solution", index: int) -> None:
+        v0, v1 = solution._vertex_offsets[index : index + 2]
+        t0, t1 = solution._triangle_offsets[index : index + 2]
+        self.index: int = index
+        self.name: str = solution.scene.surface_names[index]
+        self.vertices: np.ndarray = solution.vertices[v0:v1]
+        self.triangles: np.ndarray = _frozen(solution.triangles[t0:t1] - np.uint32(v0))
+        self.radiosity: np.ndarray = solution.radiosity[v0:v1]
+        self.direct: np.ndarray = solution.direct[v0:v1]
+        self.indirect: np.ndarray = solution.indirect[v0:v1]
+        self.irradiance: np.ndarray = solution.irradiance[v0:v1]
+        d = solution.discontinuities
+        self.discontinuities: Discontinuities = d.where(d.surface_id == index)
+
+    def __repr__(self) -> str:
+        return (
+            f"<penumbra.SurfaceSolution {self.index} {self.name!r}: {len(self.vertices)} vertices, "
+            f"{len(self.triangles)} triangles, {len(self.discontinuities)} discontinuity segments>"
+        )
+
+
+class Solution:
+    """A run's result: the mesh of every surface and the light at its vertices.
+
+    Whole-scene arrays, surface after surface in the scene's order (all read-only):
+
+    - ``vertices`` (N, 3) float64, ``triangles`` (M, 3) uint32 (indices into ``vertices``,
+      counter-clockwise seen from the surface's front), ``surface_id`` (N,) uint32 per vertex,
+      ``triangle_surface_id`` (M,) uint32;
+    - ``radiosity`` (N, 3) float64: B in W/m² per channel, the surface's own emission included,
+      equal to the bit to ``solution.json``'s;
+    - ``direct`` (N, 3): the light reflected straight from the lights, ρ·H_direct (exact);
+      ``indirect`` (N, 3): the light reflected after more bounces, ρ·(H − H_direct); so
+      ``radiosity = emission + direct + indirect`` (to rounding). ``irradiance`` (N, 3): H;
+    - ``discontinuities``: the segments built into the mesh (:class:`Discontinuities`).
+
+    ``surfaces`` (or ``solution[name]``) gives the same per surface. ``report`` is
+    ``report.json`` as a dict; ``partial`` says the run stopped early (time budget, interrupt)
+    with the best solution so far; :meth:`write` writes the command line's files."""
+
+    def __init__(self, native: _native.RunOutput) -> None:
+        self._native = native
+        arrays = native.arrays()
+        self.scene: Scene = Scene(native.scene)
+        self.vertices: np.ndarray = _frozen(arrays["vertices"])
+        self.triangles: np.ndarray = _frozen(arrays["triangles"])
+        self.surface_id: np.ndarray = _frozen(arrays["surface_id"])
+        self.triangle_surface_id: np.ndarray = _frozen(arrays["triangle_surface_id"])
+        self.radiosity: np.ndarray = _frozen(arrays["radiosity"])
+        self.direct: np.ndarray = _frozen(arrays["direct"])
+        self.indirect: np.ndarray = _frozen(arrays["indirect"])
+        self.irradiance: np.ndarray = _frozen(arrays["irradiance"])
+        self.discontinuities: Discontinuities = Discontinuities(arrays["discontinuities"])
+        self._vertex_offsets = arrays["vertex_offsets"]
+        self._triangle_offsets = arrays["triangle_offsets"]
+        self.report: dict[str, Any] = json.loads(native.report_json())
+        self._surfaces: Optional[list[SurfaceSolution]] = None
+
+    @property
+    def partial(self) -> bool:
+        """Whether the run stopped early (a time budget, an interrupt) and this is the best
+        solution it had."""
+        return bool(self.report["partial"])
+
+    @property
+    def surfaces(self) -> list[SurfaceSolution]:
+        """One :class:`SurfaceSolution` per surface, in the scene's order."""
+        if self._surfaces is None:
+            self._surfaces = [SurfaceSolution(self, i) for i in range(len(self.scene))]
+        return self._surfaces
+
+    def __getitem__(self, key: Union[int, str]) -> SurfaceSolution:
+        """A surface by index or by name."""
+        if isinstance(key, str):
+            key = self.scene.surface_id(key)
+        if isinstance(key, bool) or not isinstance(key, (int, np.integer)):
+            raise TypeError(f"surfaces are found by index or name, not {type(key).__name__}")
+        return self.surfaces[key]
+
+    @property
+    def triangle_count(self) -> int:
+        return len(self.triangles)
+
+    def render(self) -> np.ndarray:
+        """The image from the scene's camera, as ``render.png`` holds it: (height, width, 3)
+        uint8 sRGB."""
+        return self._native.render()
+
+    def solution_json(self) -> str:
+        """``solution.json``, as text."""
+        return self._native.solution_json()
+
+    def write(
+        self,
+        directory: Union[str, "os.PathLike[str]"],
+        *,
+        svg: Union[str, Sequence[str]] = "auto",
+        convergence: bool = False,
+    ) -> list[Path]:
+        """Writes the files ``penumbra run`` writes into ``directory`` (created if needed), all or
+        nothing: ``solution.json``, ``report.json``, ``render.png`` and SVGs of the surfaces
+        ``svg`` chooses (``"auto"``, ``"all"``, ``"none"`` or a list of names) in
+        ``surfaces/``; with ``convergence``, the solver's residual history too. Returns the
+        paths written."""
+        if not isinstance(directory, (str, os.PathLike)):
+            raise TypeError(f"directory must be a str or a path, not {type(directory).__name__}")
+        if not isinstance(svg, str):
+            svg = list(svg)
+        return [Path(p) for p in self._native.write(os.fspath(directory), svg, bool(convergence))]
+
+    def __repr__(self) -> str:
+        solver = self.report.get("method", {}).get("solver", "?")
+        return (
+            f"<penumbra.Solution of {self.scene.name!r}: {len(self.vertices)} vertices, "
+            f"{len(self.triangles)} triangles, {len(self.discontinuities)} discontinuity segments, "
+            f"solver {solver}{', partial' if self.partial else ''}>"
+        )

@@ -1,0 +1,329 @@
+//! `penumbra.run`: the command line's run, its options and defaults, with the GIL released
+//! while it computes and Ctrl-C or an [`Interrupt`] stopping it with the best solution so far.
+
+use std::sync::mpsc;
+use std::time::Duration;
+
+use penumbra::adaptive::{DEFAULT_MAX_ROUNDS, RefineOptions};
+use penumbra::{MeshMethod, RunOptions};
+use penumbra_meshing::ElementBudget;
+use penumbra_meshing::discontinuity::{DEFAULT_EVENT_TOLERANCE, DiscontinuityOptions, EventSet};
+use penumbra_solver::coupling::FormFactorMethod;
+use penumbra_solver::estimate::IndirectEstimate;
+use penumbra_solver::hierarchical::DEFAULT_LINK_TOL;
+use penumbra_solver::{NoProgress, SolveError, SolverMethod, SolverOptions};
+use penumbra_viz::RenderOptions;
+use pyo3::exceptions::PyRuntimeError;
+use pyo3::prelude::*;
+
+use crate::errors::{bad_argument, invalid_option, run_error};
+use crate::scene::Scene;
+use crate::solution::RunOutput;
+
+/// Asks a run to stop, from any thread: the run then returns the best solution so far, marked
+/// partial.
+#[pyclass(module = "penumbra._native", frozen)]
+#[derive(Clone, Default)]
+pub(crate) struct Interrupt(penumbra_solver::Interrupt);
+
+#[pymethods]
+impl Interrupt {
+    #[new]
+    fn new() -> Interrupt {
+        Interrupt::default()
+    }
+
+    /// Asks the runs given this interrupt to stop.
+    fn set(&self) {
+        self.0.set();
+    }
+
+    /// Whether `set` was called.
+    #[getter]
+    fn is_set(&self) -> bool {
+        self.0.is_set()
+    }
+}
+
+/// `penumbra.run`'s keyword arguments, checked for type on the Python side; `None` is the
+/// command line's default.
+#[derive(FromPyObject)]
+#[pyo3(from_item_all)]
+pub(crate) struct RunArguments {
+    mesh: Option<String>,
+    max_elements: Option<usize>,
+    penumbra_density: Option<f64>,
+    eee: bool,
+    events: Option<String>,
+    event_tol: Option<f64>,
+    refine_tol: Option<f64>,
+    initial_elements: Option<usize>,
+    refine_indirect: Option<String>,
+    refine_rounds: Option<usize>,
+    solver: Option<String>,
+    link_tol: Option<f64>,
+    form_factors: Option<String>,
+    ff_samples: Option<usize>,
+    hemicube_resolution: Option<usize>,
+    epsilon: Option<f64>,
+    max_shots: Option<usize>,
+    direct_only: bool,
+    rays: Option<usize>,
+    elements_per_patch: Option<usize>,
+    seed: Option<u64>,
+    time_budget: Option<f64>,
+    memory_limit: Option<f64>,
+    width: Option<u32>,
+    height: Option<u32>,
+}
+
+/// One of an argument's names, or a `ValueError` listing them.
+fn choice<T: Copy>(
+    name: &str,
+    value: Option<&str>,
+    default: T,
+    choices: &[(&str, T)],
+) -> PyResult<T> {
+    let Some(value) = value else {
+        return Ok(default);
+    };
+    match choices.iter().find(|(n, _)| *n == value) {
+        Some(&(_, t)) => Ok(t),
+        None => {
+            let names: Vec<String> = choices.iter().map(|(n, _)| format!("{n:?}")).collect();
+            Err(bad_argument(
+                name,
+                format!("must be one of {}, not {value:?}", names.join(", ")),
+            ))
+        }
+    }
+}
+
+impl RunArguments {
+    /// The run options these arguments ask for, as `penumbra run` resolves its flags.
+    fn options(&self, interrupt: &penumbra_solver::Interrupt) -> PyResult<RunOptions> {
+        let method = choice(
+            "solver",
+            self.solver.as_deref(),
+            SolverMethod::Hierarchical,
+            &[
+                ("hierarchical", SolverMethod::Hierarchical),
+                ("progressive", SolverMethod::Progressive),
+                ("jacobi", SolverMethod::Jacobi),
+                ("gauss-seidel", SolverMethod::GaussSeidel),
+                ("direct", SolverMethod::Direct),
+            ],
+        )?;
+        let mesh = choice(
+            "mesh",
+            self.mesh.as_deref(),
+            MeshMethod::Auto,
+            &[
+                ("auto", MeshMethod::Auto),
+                ("uniform", MeshMethod::Uniform),
+                ("discontinuity", MeshMethod::Discontinuity),
+            ],
+        )?;
+        let events = choice(
+            "events",
+            self.events.as_deref(),
+            EventSet::Complete,
+            &[
+                ("complete", EventSet::Complete),
+                ("extremal", EventSet::Extremal),
+            ],
+        )?;
+        let indirect = choice(
+            "refine_indirect",
+            self.refine_indirect.as_deref(),
+            IndirectEstimate::GradientJumps,
+            &[
+                ("gradient", IndirectEstimate::GradientJumps),
+                ("gathered", IndirectEstimate::Gathered),
+            ],
+        )?;
+        let refine = self.refine_tol.map(|tolerance| RefineOptions {
+            tolerance,
+            initial_elements: self
+                .initial_elements
+                .unwrap_or(penumbra::default_initial_elements(self.max_elements)),
+            max_rounds: self.refine_rounds.unwrap_or(DEFAULT_MAX_ROUNDS),
+            indirect,
+        });
+        let render = RenderOptions::default();
+        Ok(RunOptions {
+            mesh,
+            max_elements: self.max_elements.map_or(
+                penumbra::default_budget(method, self.direct_only),
+                ElementBudget::AtMost,
+            ),
+            penumbra_density: self
+                .penumbra_density
+                .unwrap_or(penumbra::default_penumbra_density(refine.is_some())),
+            discontinuity: DiscontinuityOptions {
+                eee: self.eee,
+                events,
+                event_tolerance: self.event_tol.unwrap_or(DEFAULT_EVENT_TOLERANCE),
+                ..DiscontinuityOptions::default()
+            },
+            refine,
+            time_budget: self.time_budget,
+            solver: self.solver_options(interrupt)?,
+            method,
+            render: RenderOptions {
+                width: self.width.unwrap_or(render.width),
+                height: self.height.unwrap_or(render.height),
+                ..render
+            },
+            memory_limit: match self.memory_limit {
+                None => None,
+                Some(mib) if mib > 0.0 && mib.is_finite() => Some((mib * 1024.0 * 1024.0) as u64),
+                Some(mib) => {
+                    return Err(bad_argument(
+                        "memory_limit",
+                        format!("must be a positive number of MiB, not {mib}"),
+                    ));
+                }
+            },
+            shard: None,
+        })
+    }
+
+    fn solver_options(&self, interrupt: &penumbra_solver::Interrupt) -> PyResult<SolverOptions> {
+        let defaults = SolverOptions::default();
+        let form_factors = choice(
+            "form_factors",
+            self.form_factors.as_deref(),
+            "analytic",
+            &[
+                ("analytic", "analytic"),
+                ("monte-carlo", "monte-carlo"),
+                ("hemicube", "hemicube"),
+            ],
+        )?;
+        Ok(SolverOptions {
+            epsilon: self.epsilon.unwrap_or(defaults.epsilon),
+            max_shots: self.max_shots.unwrap_or(defaults.max_shots),
+            visibility_rays: self.rays.unwrap_or(defaults.visibility_rays),
+            link_tol: self.link_tol.unwrap_or(DEFAULT_LINK_TOL),
+            form_factors: match form_factors {
+                "monte-carlo" => FormFactorMethod::MonteCarlo {
+                    samples: self.ff_samples.unwrap_or(penumbra::DEFAULT_FF_SAMPLES),
+                },
+                "hemicube" => FormFactorMethod::Hemicube {
+                    resolution: self
+                        .hemicube_resolution
+                        .unwrap_or(penumbra::DEFAULT_HEMICUBE_RESOLUTION),
+                },
+                _ => FormFactorMethod::Analytic,
+            },
+            elements_per_patch: self
+                .elements_per_patch
+                .unwrap_or(defaults.elements_per_patch),
+            direct_only: self.direct_only,
+            seed: self.seed.unwrap_or(defaults.seed),
+            interrupt: Some(interrupt.clone()),
+            ..defaults
+        })
+    }
+}
+
+/// Most worker threads, as on the command line.
+const MAX_THREADS: usize = 1024;
+
+/// How often a waiting run looks for Ctrl-C.
+const SIGNAL_POLL: Duration = Duration::from_millis(100);
+
+/// A worker pool of `threads` threads, or `None` for rayon's global pool (one per core).
+pub(crate) fn thread_pool(threads: Option<usize>) -> PyResult<Option<rayon::ThreadPool>> {
+    let Some(n) = threads else {
+        return Ok(None);
+    };
+    if !(1..=MAX_THREADS).contains(&n) {
+        return Err(bad_argument(
+            "threads",
+            format!("must be from 1 to {MAX_THREADS}, not {n}"),
+        ));
+    }
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(n)
+        .build()
+        .map(Some)
+        .map_err(|e| PyRuntimeError::new_err(format!("cannot start {n} worker threads: {e}")))
+}
+
+/// Runs `work` on `pool` (or the global one) on a thread of its own with the GIL released,
+/// looking for Ctrl-C meanwhile: on a signal, `interrupt` is set and the work is waited for.
+/// Returns the work's result and the signal's exception, if one came. A panic in the work is a
+/// `RuntimeError`, never the interpreter's end.
+pub(crate) fn without_gil<T: Send>(
+    py: Python<'_>,
+    pool: Option<&rayon::ThreadPool>,
+    interrupt: &penumbra_solver::Interrupt,
+    work: impl FnOnce() -> T + Send,
+) -> PyResult<(T, Option<PyErr>)> {
+    let (result, signal) = py.detach(|| {
+        std::thread::scope(|scope| {
+            let (done, finished) = mpsc::channel();
+            let worker = scope.spawn(move || {
+                let result = match pool {
+                    Some(pool) => pool.install(work),
+                    None => work(),
+                };
+                // The receiver waits for this; if it is gone there is no one to tell.
+                let _ = done.send(());
+                result
+            });
+            let mut signal = None;
+            while let Err(mpsc::RecvTimeoutError::Timeout) = finished.recv_timeout(SIGNAL_POLL) {
+                if signal.is_none()
+                    && let Err(e) = Python::attach(|py| py.check_signals())
+                {
+                    interrupt.set();
+                    signal = Some(e);
+                }
+            }
+            (worker.join(), signal)
+        })
+    });
+    match result {
+        Ok(value) => Ok((value, signal)),
+        Err(panic) => {
+            let what = panic
+                .downcast_ref::<&str>()
+                .map(ToString::to_string)
+                .or_else(|| panic.downcast_ref::<String>().cloned())
+                .unwrap_or_default();
+            Err(PyRuntimeError::new_err(format!(
+                "penumbra failed inside (a bug; please report it with the scene): {what}"
+            )))
+        }
+    }
+}
+
+/// Runs the pipeline on `scene`. Returns the run's output (`None` when it was stopped before a
+/// solution existed) and whether Ctrl-C stopped it (the Python side raises `RunInterrupted`).
+#[pyfunction]
+#[pyo3(signature = (scene, arguments, threads = None, interrupt = None))]
+pub(crate) fn run(
+    py: Python<'_>,
+    scene: &Scene,
+    arguments: RunArguments,
+    threads: Option<usize>,
+    interrupt: Option<&Interrupt>,
+) -> PyResult<(Option<RunOutput>, bool)> {
+    let interrupt = interrupt.cloned().unwrap_or_default().0;
+    let options = arguments.options(&interrupt)?;
+    options.validate().map_err(|e| invalid_option(&e))?;
+    let pool = thread_pool(threads)?;
+    let loaded = scene.loaded.clone();
+    let (outcome, signal) = without_gil(py, pool.as_ref(), &interrupt, || {
+        penumbra::run(loaded, &options, &NoProgress)
+    })?;
+    let signalled = signal.is_some();
+    match outcome {
+        Ok(result) => Ok((Some(RunOutput::new(result)), signalled)),
+        Err(penumbra::RunError::Solve(SolveError::Interrupted)) => Ok((None, signalled)),
+        Err(e) => Err(run_error(e)),
+    }
+}

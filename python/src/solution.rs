@@ -1,0 +1,183 @@
+//! `penumbra.Solution`'s native half: a finished run, its arrays, its JSON and its files.
+
+use std::path::PathBuf;
+
+use numpy::{PyArray1, PyArrayMethods};
+use penumbra::RunResult;
+use penumbra::outputs::{SvgSelection, write_outputs};
+use penumbra_scenes::Rgb;
+use pyo3::exceptions::{PyOSError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::arrays::{array3, index_array, rgb_array, segment_arrays};
+
+/// A finished run, held for its arrays, its report and its files.
+#[pyclass(module = "penumbra._native", frozen)]
+pub(crate) struct RunOutput {
+    result: RunResult,
+}
+
+impl RunOutput {
+    pub(crate) fn new(result: RunResult) -> RunOutput {
+        RunOutput { result }
+    }
+}
+
+/// The whole scene's mesh and light, surface after surface in the scene's order.
+#[derive(Default)]
+struct Concatenated {
+    vertices: Vec<[f64; 3]>,
+    triangles: Vec<[u32; 3]>,
+    vertex_surface: Vec<u32>,
+    triangle_surface: Vec<u32>,
+    vertex_offsets: Vec<u64>,
+    triangle_offsets: Vec<u64>,
+    radiosity: Vec<Rgb>,
+    direct: Vec<Rgb>,
+    indirect: Vec<Rgb>,
+    irradiance: Vec<Rgb>,
+    direct_irradiance: Vec<Rgb>,
+}
+
+impl Concatenated {
+    fn of(result: &RunResult) -> Concatenated {
+        let scene = &result.loaded.scene;
+        let solution = &result.solution;
+        let mut all = Concatenated::default();
+        for (s, mesh) in result.mesh.surfaces.iter().enumerate() {
+            let first = all.vertices.len() as u32;
+            all.vertex_offsets.push(u64::from(first));
+            all.triangle_offsets.push(all.triangles.len() as u64);
+            all.vertices
+                .extend(mesh.points3.iter().map(|p| p.to_array()));
+            all.triangles
+                .extend(mesh.triangles.iter().map(|t| t.map(|i| i + first)));
+            all.vertex_surface
+                .extend(std::iter::repeat_n(s as u32, mesh.points3.len()));
+            all.triangle_surface
+                .extend(std::iter::repeat_n(s as u32, mesh.triangles.len()));
+            let rho = scene.surfaces[mesh.surface].reflectance;
+            let (h, hd) = (&solution.irradiance[s], &solution.direct_irradiance[s]);
+            all.radiosity.extend_from_slice(&solution.radiosity[s]);
+            all.irradiance.extend_from_slice(h);
+            all.direct_irradiance.extend_from_slice(hd);
+            all.direct.extend(hd.iter().map(|&d| rho.mul_rgb(d)));
+            all.indirect
+                .extend(h.iter().zip(hd).map(|(&h, &d)| rho.mul_rgb(h - d)));
+        }
+        all.vertex_offsets.push(all.vertices.len() as u64);
+        all.triangle_offsets.push(all.triangles.len() as u64);
+        all
+    }
+}
+
+/// `"auto"`, `"all"`, `"none"` or surface names: which surfaces get an SVG.
+fn svg_selection(result: &RunResult, svg: &Bound<'_, PyAny>) -> PyResult<SvgSelection> {
+    if let Ok(word) = svg.extract::<String>() {
+        return match word.as_str() {
+            "auto" => Ok(SvgSelection::Auto),
+            "all" => Ok(SvgSelection::All),
+            "none" => Ok(SvgSelection::None),
+            _ => Err(PyValueError::new_err(format!(
+                "svg: must be \"auto\", \"all\", \"none\" or a list of surface names, not {word:?}"
+            ))),
+        };
+    }
+    let names: Vec<String> = svg.extract()?;
+    SvgSelection::named(&result.loaded.scene, &names).map_err(|unknown| {
+        PyValueError::new_err(format!(
+            "svg: the scene has no surface named {}",
+            unknown.join(", ")
+        ))
+    })
+}
+
+#[pymethods]
+impl RunOutput {
+    /// Every array of the solution, as a dict (see `penumbra.Solution`).
+    fn arrays<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let all = Concatenated::of(&self.result);
+        let dict = PyDict::new(py);
+        dict.set_item("vertices", array3(py, &all.vertices))?;
+        dict.set_item("triangles", index_array(py, &all.triangles))?;
+        dict.set_item("surface_id", PyArray1::from_vec(py, all.vertex_surface))?;
+        dict.set_item(
+            "triangle_surface_id",
+            PyArray1::from_vec(py, all.triangle_surface),
+        )?;
+        dict.set_item("vertex_offsets", PyArray1::from_vec(py, all.vertex_offsets))?;
+        dict.set_item(
+            "triangle_offsets",
+            PyArray1::from_vec(py, all.triangle_offsets),
+        )?;
+        dict.set_item("radiosity", rgb_array(py, &all.radiosity))?;
+        dict.set_item("direct", rgb_array(py, &all.direct))?;
+        dict.set_item("indirect", rgb_array(py, &all.indirect))?;
+        dict.set_item("irradiance", rgb_array(py, &all.irradiance))?;
+        dict.set_item("direct_irradiance", rgb_array(py, &all.direct_irradiance))?;
+        dict.set_item(
+            "discontinuities",
+            segment_arrays(py, &self.result.mesh.discontinuities)?,
+        )?;
+        Ok(dict)
+    }
+
+    /// `report.json`, as text.
+    #[pyo3(signature = (svg = None))]
+    fn report_json(&self, svg: Option<&Bound<'_, PyAny>>) -> PyResult<String> {
+        let svgs = match svg {
+            Some(svg) => svg_selection(&self.result, svg)?,
+            None => SvgSelection::Auto,
+        };
+        Ok(penumbra::outputs::report_json(&self.result, &svgs))
+    }
+
+    /// `solution.json`, as text.
+    fn solution_json(&self) -> String {
+        penumbra::outputs::solution_json(&self.result)
+    }
+
+    /// Writes the command line's files into `directory`, all or nothing; returns their paths.
+    #[pyo3(signature = (directory, svg, convergence = false))]
+    fn write(
+        &self,
+        py: Python<'_>,
+        directory: PathBuf,
+        svg: &Bound<'_, PyAny>,
+        convergence: bool,
+    ) -> PyResult<Vec<PathBuf>> {
+        let svgs = svg_selection(&self.result, svg)?;
+        let result = &self.result;
+        py.detach(|| {
+            let extra = match convergence {
+                true => penumbra::outputs::convergence_files(result)?,
+                false => Vec::new(),
+            };
+            write_outputs(result, &directory, &svgs, extra)
+        })
+        .map_err(|e| PyOSError::new_err(format!("{e:#}")))
+    }
+
+    /// The render from the scene's camera, (height, width, 3) uint8 sRGB.
+    fn render<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let image = &self.result.render.image;
+        let (width, height) = (image.width() as usize, image.height() as usize);
+        let pixels = PyArray1::from_vec(py, image.as_raw().clone());
+        Ok(pixels.reshape([height, width, 3])?.into_any())
+    }
+
+    /// The scene that was run.
+    #[getter]
+    fn scene(&self) -> crate::scene::Scene {
+        crate::scene::Scene {
+            loaded: self.result.loaded.clone(),
+        }
+    }
+
+    /// The mesh's triangles, for the whole scene.
+    #[getter]
+    fn triangle_count(&self) -> usize {
+        self.result.mesh.triangle_count()
+    }
+}
