@@ -31,14 +31,20 @@ def rows3(value: Any, name: str, *, allow_single: bool = False) -> np.ndarray:
     return np.ascontiguousarray(array)
 
 
-def count(value: Any, name: str, *, minimum: int = 1) -> Optional[int]:
-    """A whole number of at least ``minimum``, or None."""
+# The largest whole number the native side takes (64 bits, unsigned).
+MAX_COUNT = 2**64 - 1
+
+
+def count(value: Any, name: str, *, minimum: int = 1, maximum: int = MAX_COUNT) -> Optional[int]:
+    """A whole number from ``minimum`` to ``maximum``, or None."""
     if value is None:
         return None
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
         raise TypeError(f"{name} must be a whole number, not {type(value).__name__}")
     if value < minimum:
         raise ValueError(f"{name} must be at least {minimum}, not {value}")
+    if value > maximum:
+        raise ValueError(f"{name} must be at most {maximum}, not {value}")
     return int(value)
 
 

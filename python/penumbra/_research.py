@@ -121,8 +121,6 @@ def reference(
     at = _checks.rows3(points, "points")
     ids = _checks.surface_ids(surfaces, "surfaces", len(at))
     seed = _checks.count(seed, "seed", minimum=0)
-    if seed is not None and seed >= 2**64:
-        raise ValueError(f"seed must be below 2**64, not {seed}")
     radiosity, error = _native.reference(
         scene._native,
         at,

@@ -109,11 +109,9 @@ def run(
         "seed": _checks.count(seed, "seed", minimum=0),
         "time_budget": _checks.number(time_budget, "time_budget", positive=True),
         "memory_limit": _checks.number(memory_limit, "memory_limit", positive=True),
-        "width": _checks.count(width, "width"),
-        "height": _checks.count(height, "height"),
+        "width": _checks.count(width, "width", maximum=2**32 - 1),
+        "height": _checks.count(height, "height", maximum=2**32 - 1),
     }
-    if arguments["seed"] is not None and arguments["seed"] >= 2**64:
-        raise ValueError(f"seed must be below 2**64, not {seed}")
     output, signalled = _native.run(
         scene._native, arguments, _checks.count(threads, "threads"), interrupt
     )

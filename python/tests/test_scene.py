@@ -1,0 +1,123 @@
+"""Scenes from files, built-in names, arrays and JSON, and SceneError carrying every problem as
+`penumbra check` reports them."""
+
+from __future__ import annotations
+
+import subprocess
+
+import numpy as np
+import pytest
+
+import penumbra
+from conftest import run_cli
+
+LIGHT = [[-0.5, -0.5, 2], [-0.5, 0.5, 2], [0.5, 0.5, 2], [0.5, -0.5, 2]]
+FLOOR = [[-2, -2, 0], [2, -2, 0], [2, 2, 0], [-2, 2, 0]]
+
+
+def two_surfaces(**changes):
+    arguments = dict(
+        names=["light", "floor"],
+        reflectance=[[0, 0, 0], [0.7, 0.6, 0.5]],
+        emission=[[10, 10, 10], [0, 0, 0]],
+    )
+    arguments.update(changes)
+    polygons = arguments.pop("polygons", [LIGHT, FLOOR])
+    return penumbra.Scene.from_polygons(polygons, **arguments)
+
+
+def test_builtin_scenes_are_the_command_lines(cli, tmp_path):
+    names = penumbra.builtin_scenes()
+    assert {"cornell", "textbook", "furnace"} <= set(names)
+    for name in ("cornell", "textbook", "cie-5.8"):
+        dumped = run_cli(cli, "scenes", "--dump", name, cwd=tmp_path).stdout
+        assert penumbra.Scene.builtin(name).to_json() == dumped
+
+
+def test_from_polygons_reads_back_through_json():
+    scene = two_surfaces(camera={"eye": [0, -4, 1.8], "target": [0, 0, 0.7]})
+    assert len(scene) == 2 and scene.surface_names == ["light", "floor"]
+    assert np.array_equal(scene.polygons[1], np.array(FLOOR, dtype=float))
+    assert np.array_equal(scene.reflectance, [[0, 0, 0], [0.7, 0.6, 0.5]])
+    assert np.array_equal(scene.emission, [[10, 10, 10], [0, 0, 0]])
+    assert np.allclose(scene.normals, [[0, 0, -1], [0, 0, 1]])
+    assert np.allclose(scene.areas, [1, 16])
+    assert scene.camera == {"eye": [0, -4, 1.8], "target": [0, 0, 0.7], "up": [0, 0, 1], "fov_deg": 45.0}
+    again = penumbra.Scene.from_json(scene.to_json())
+    assert again == scene and again.fingerprint == scene.fingerprint
+
+
+def test_numpy_arrays_and_lists_make_the_same_scene():
+    arrays = penumbra.Scene.from_polygons(
+        np.array([LIGHT, FLOOR], dtype=np.float32),
+        names=["light", "floor"],
+        reflectance=np.array([[0, 0, 0], [0.7, 0.6, 0.5]]),
+        emission=np.array([[10, 10, 10], [0, 0, 0]], dtype=np.int64),
+    )
+    assert arrays == two_surfaces()
+
+
+def test_files_load_as_the_command_line_loads_them(cli, tmp_path):
+    (tmp_path / "room.json").write_text(two_surfaces().to_json())
+    loaded = penumbra.Scene.load(tmp_path / "room.json")
+    assert loaded == two_surfaces() and loaded.source.endswith("room.json")
+    (tmp_path / "lamp.obj").write_text(
+        "mtllib lamp.mtl\n"
+        "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n"
+        "v -0.2 -0.2 1\nv -0.2 0.2 1\nv 0.2 0.2 1\nv 0.2 -0.2 1\n"
+        "usemtl grey\nf 1 2 3\nf 1 3 4\nusemtl lamp\nf 5 6 7 8\n"
+    )
+    (tmp_path / "lamp.mtl").write_text("newmtl grey\nKd 0.5 0.5 0.5\nnewmtl lamp\nKd 0 0 0\nKe 5 5 5\n")
+    merged = penumbra.Scene.load(str(tmp_path / "lamp.obj"))
+    assert len(merged) == 2  # the floor's two triangles merge into one square
+    assert len(penumbra.Scene.load(tmp_path / "lamp.obj", merge=False)) == 3
+    run_cli(cli, "run", "lamp.obj", "--direct-only", "--out", "out", "--quiet", cwd=tmp_path)
+    assert penumbra.run(merged, direct_only=True).solution_json() == (tmp_path / "out" / "solution.json").read_text()
+
+
+def test_scene_errors_carry_every_problem_as_check_reports_them(cli, tmp_path):
+    # A repeated name, a degenerate triangle and a reflectance above 1.
+    scene_json = (
+        '{"name": "bad", "surfaces": ['
+        '{"name": "light", "polygon": [[-0.5,-0.5,2],[-0.5,0.5,2],[0.5,0.5,2],[0.5,-0.5,2]],'
+        ' "emission": [10,10,10], "reflectance": [0,0,0]},'
+        '{"name": "light", "polygon": [[0,0,0],[1,0,0],[2,0,0]], "reflectance": [1.5,0.5,0.5]}]}'
+    )
+    (tmp_path / "bad.json").write_text(scene_json)
+    check = subprocess.run([str(cli), "check", "bad.json"], cwd=tmp_path, capture_output=True, text=True)
+    assert check.returncode == 2
+    with pytest.raises(penumbra.SceneError) as raised:
+        penumbra.Scene.load(tmp_path / "bad.json")
+    problems = raised.value.problems
+    assert len(problems) >= 3, problems
+    for problem in problems:
+        assert problem in check.stderr
+    assert isinstance(raised.value, ValueError)
+    with pytest.raises(penumbra.SceneError) as again:
+        penumbra.Scene.from_json(scene_json)
+    assert again.value.problems == problems
+    with pytest.raises(penumbra.SceneError) as built:
+        two_surfaces(polygons=[LIGHT, [[0, 0, 0], [1, 0, 0], [2, 0, 0]]], names=["light", "light"],
+                     reflectance=[[0, 0, 0], [1.5, 0.5, 0.5]])
+    assert built.value.problems == problems
+
+
+def test_unknown_and_missing_scenes_say_so(tmp_path):
+    with pytest.raises(penumbra.SceneError, match="built-in scenes are: cornell"):
+        penumbra.Scene.builtin("cornel")
+    with pytest.raises(FileNotFoundError, match="nowhere.json"):
+        penumbra.Scene.load(tmp_path / "nowhere.json")
+    (tmp_path / "scene.txt").write_text("{}")
+    with pytest.raises(penumbra.SceneError, match="unsupported file type"):
+        penumbra.Scene.load(tmp_path / "scene.txt")
+    with pytest.raises(penumbra.SceneError, match=r"<json>:1:\d+"):
+        penumbra.Scene.from_json("{not json")
+    # A file called like a built-in scene is a file, and the name alone is not a path.
+    with pytest.raises(FileNotFoundError):
+        penumbra.Scene.load("cornell")
+
+
+def test_locate_finds_the_surface_a_point_lies_on():
+    scene = two_surfaces()
+    ids = scene.locate([[0.3, 0.2, 0], [0, 0, 2], [0, 0, 1], [3, 0, 0], [2, 2, 0]])
+    assert ids.tolist() == [1, 0, -1, -1, 1]
