@@ -4,6 +4,9 @@
 //! back as numpy arrays. Errors become the package's exceptions here, told in the Python
 //! arguments' names.
 
+// pyo3 hands `#[pyfunction]` arguments over by value, whether or not they are consumed.
+#![allow(clippy::needless_pass_by_value)]
+
 mod arrays;
 mod errors;
 mod primitives;

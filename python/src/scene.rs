@@ -12,6 +12,9 @@ use pyo3::prelude::*;
 use crate::arrays::{array3, points, rgb_array, rows3};
 use crate::errors::{bad_argument, scene_error};
 
+/// A camera as Python gives it: eye, target, up and the vertical field of view in degrees.
+type CameraParts = ([f64; 3], [f64; 3], [f64; 3], f64);
+
 /// A validated scene. Immutable: every constructor validates, so every `Scene` can be run.
 #[pyclass(module = "penumbra._native", frozen)]
 #[derive(Clone)]
@@ -107,7 +110,7 @@ impl Scene {
         counts: Vec<usize>,
         reflectance: PyReadonlyArray2<'_, f64>,
         emission: PyReadonlyArray2<'_, f64>,
-        camera: Option<([f64; 3], [f64; 3], [f64; 3], f64)>,
+        camera: Option<CameraParts>,
     ) -> PyResult<Scene> {
         let corners = points(&corners, "polygons")?;
         let reflectance = rows3(&reflectance, "reflectance")?;
@@ -230,7 +233,7 @@ impl Scene {
 
     /// The camera as (eye, target, up, fov_deg), if the scene has one.
     #[getter]
-    fn camera(&self) -> Option<([f64; 3], [f64; 3], [f64; 3], f64)> {
+    fn camera(&self) -> Option<CameraParts> {
         self.data().camera.map(|c| {
             (
                 c.eye.to_array(),
