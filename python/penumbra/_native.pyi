@@ -1,6 +1,6 @@
 """Type stubs of penumbra's native module (the Rust half). Use the public API in `penumbra`."""
 
-from typing import Any, Optional, Sequence, Union
+from typing import Any, Callable, Optional, Sequence, Union
 
 import numpy as np
 
@@ -86,6 +86,7 @@ def run(
     arguments: dict[str, Any],
     threads: Optional[int] = None,
     interrupt: Optional[Interrupt] = None,
+    progress: Optional[Callable[[str, int, int], object]] = None,
 ) -> tuple[Optional[RunOutput], bool]: ...
 def direct_light(
     scene: Scene,

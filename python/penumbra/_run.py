@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from typing import Literal, Optional
+import sys
+from typing import Callable, Literal, Optional, Union
 
 from . import _checks, _native
 from ._scene import Scene
@@ -17,6 +18,22 @@ FormFactors = Literal["analytic", "monte-carlo", "hemicube"]
 _MESHES = ("auto", "uniform", "discontinuity")
 _SOLVERS = ("hierarchical", "progressive", "jacobi", "gauss-seidel", "direct")
 _FORM_FACTORS = ("analytic", "monte-carlo", "hemicube")
+
+
+ProgressCallback = Callable[[str, int, int], object]
+
+
+class _StderrProgress:
+    """``progress=True``: one line on stderr per stage, its percentage updated in place."""
+
+    def __init__(self) -> None:
+        self._stage: Optional[str] = None
+
+    def __call__(self, stage: str, done: int, total: int) -> None:
+        percent = 100.0 * done / total if total else 100.0
+        end = "\n" if done >= total else ""
+        sys.stderr.write(f"\r{stage:>16} {percent:5.1f}%{end}")
+        sys.stderr.flush()
 
 
 class RunInterrupted(KeyboardInterrupt):
@@ -59,6 +76,7 @@ def run(
     width: Optional[int] = None,
     height: Optional[int] = None,
     interrupt: Optional[Interrupt] = None,
+    progress: Union[bool, ProgressCallback, None] = None,
 ) -> Solution:
     """Meshes, lights and solves ``scene`` as ``penumbra run`` does, with the same options and
     defaults (``penumbra run --help``, ``docs/cli.md``); the same options give the same
@@ -74,6 +92,11 @@ def run(
     best solution so far; ``threads`` workers (default one per core; results do not depend on
     it); ``seed`` seeds the visibility sampling; ``width`` and ``height`` size the render.
     ``None`` means the command line's default.
+
+    ``progress=True`` shows each stage's progress on stderr; a callable gets
+    ``progress(stage, done, total)`` from the worker threads as a stage starts, a few times a
+    second while it runs, and as it ends (``done == total``); it may feed a tqdm bar. An
+    exception it raises stops the reports and is raised when the run ends.
 
     The GIL is released while the run computes. Ctrl-C stops it and raises
     :class:`RunInterrupted` carrying the partial solution; ``interrupt.set()`` from another
@@ -112,8 +135,14 @@ def run(
         "width": _checks.count(width, "width", maximum=2**32 - 1),
         "height": _checks.count(height, "height", maximum=2**32 - 1),
     }
+    if progress is True:
+        progress = _StderrProgress()
+    elif progress is False:
+        progress = None
+    if progress is not None and not callable(progress):
+        raise TypeError(f"progress must be True, False, None or a callable, not {type(progress).__name__}")
     output, signalled = _native.run(
-        scene._native, arguments, _checks.count(threads, "threads"), interrupt
+        scene._native, arguments, _checks.count(threads, "threads"), interrupt, progress
     )
     solution = Solution(output) if output is not None else None
     if signalled or solution is None:

@@ -10,6 +10,7 @@
 mod arrays;
 mod errors;
 mod primitives;
+mod progress;
 mod run;
 mod scene;
 mod solution;

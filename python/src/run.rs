@@ -17,6 +17,7 @@ use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 
 use crate::errors::{bad_argument, invalid_option, run_error};
+use crate::progress::Callback;
 use crate::scene::Scene;
 use crate::solution::RunOutput;
 
@@ -304,22 +305,28 @@ pub(crate) fn without_gil<T: Send>(
 /// Runs the pipeline on `scene`. Returns the run's output (`None` when it was stopped before a
 /// solution existed) and whether Ctrl-C stopped it (the Python side raises `RunInterrupted`).
 #[pyfunction]
-#[pyo3(signature = (scene, arguments, threads = None, interrupt = None))]
+#[pyo3(signature = (scene, arguments, threads = None, interrupt = None, progress = None))]
 pub(crate) fn run(
     py: Python<'_>,
     scene: &Scene,
     arguments: RunArguments,
     threads: Option<usize>,
     interrupt: Option<&Interrupt>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<(Option<RunOutput>, bool)> {
     let interrupt = interrupt.cloned().unwrap_or_default().0;
     let options = arguments.options(&interrupt)?;
     options.validate().map_err(|e| invalid_option(&e))?;
     let pool = thread_pool(threads)?;
     let loaded = scene.loaded.clone();
-    let (outcome, signal) = without_gil(py, pool.as_ref(), &interrupt, || {
-        penumbra::run(loaded, &options, &NoProgress)
+    let callback = progress.map(Callback::new);
+    let (outcome, signal) = without_gil(py, pool.as_ref(), &interrupt, || match &callback {
+        Some(callback) => penumbra::run(loaded, &options, callback),
+        None => penumbra::run(loaded, &options, &NoProgress),
     })?;
+    if let Some(e) = callback.and_then(|c| c.error()) {
+        return Err(e);
+    }
     let signalled = signal.is_some();
     match outcome {
         Ok(result) => Ok((Some(RunOutput::new(result)), signalled)),

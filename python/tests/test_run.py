@@ -132,3 +132,33 @@ def test_a_time_budget_gives_a_partial_solution():
                             epsilon=1e-12, time_budget=1.0)
     assert solution.partial
     assert np.isfinite(solution.radiosity).all() and (solution.radiosity >= 0).all()
+
+
+def test_progress_reports_each_stage_from_start_to_end():
+    reports = []
+    penumbra.run(penumbra.Scene.builtin("cornell"), max_elements=4000,
+                 progress=lambda stage, done, total: reports.append((stage, done, total)))
+    stages = [r[0] for r in reports]
+    assert {"discontinuities", "meshing", "direct light"} <= set(stages)
+    # Each stage: a report at 0 first, its steps never going back, and one at its total last.
+    runs, current = [], []
+    for report in reports:
+        if report[1] == 0 and current and current[-1][1] == current[-1][2]:
+            runs.append(current)
+            current = []
+        current.append(report)
+    runs.append(current)
+    for stage in runs:
+        assert stage[0][1] == 0 and stage[-1][1] == stage[-1][2], stage
+        assert len({name for name, _, _ in stage}) == 1, stage
+        assert [d for _, d, _ in stage] == sorted(d for _, d, _ in stage), stage
+
+
+def test_an_exception_in_the_progress_callback_is_raised():
+    def failing(stage, done, total):
+        raise ZeroDivisionError(f"in {stage}")
+
+    with pytest.raises(ZeroDivisionError, match="in discontinuities"):
+        penumbra.run(penumbra.Scene.builtin("cornell"), max_elements=2000, progress=failing)
+    with pytest.raises(TypeError, match="progress"):
+        penumbra.run(penumbra.Scene.builtin("cornell"), progress="yes")
