@@ -48,8 +48,9 @@ path = png_path(parser.parse_args().out, "direct_light_points.png")
 scene = penumbra.Scene.builtin("cornell")
 f = scene.surface_id("floor")
 up, rho = scene.normals[f], scene.reflectance[f]  # the floor faces +y
-(x0, z0), (x1, z1) = scene.polygons[f][:, [0, 2]].min(axis=0), scene.polygons[f][:, [0, 2]].max(axis=0)
-x, z = np.meshgrid(np.linspace(x0, x1, 601)[1::2], np.linspace(z0, z1, 601)[1::2])  # pixel centres
+corners = scene.polygons[f][:, [0, 2]]  # the floor in x and z
+(x0, z0), (x1, z1) = corners.min(axis=0), corners.max(axis=0)
+x, z = np.meshgrid(np.linspace(x0, x1, 601)[1::2], np.linspace(z0, z1, 601)[1::2])  # centres
 grid = np.c_[x.ravel(), np.zeros(x.size), z.ravel()]
 h = penumbra.direct_light(scene, grid, up, surfaces=np.full(len(grid), f)).mean(axis=1)
 
