@@ -9,7 +9,7 @@ from typing import Any, Optional, Sequence, Union
 
 import numpy as np
 
-from . import _native
+from . import _checks, _native
 from ._scene import Scene
 
 
@@ -152,6 +152,38 @@ class Solution:
         if isinstance(key, bool) or not isinstance(key, (int, np.integer)):
             raise TypeError(f"surfaces are found by index or name, not {type(key).__name__}")
         return self.surfaces[key]
+
+    def interpolate(
+        self,
+        points: Any,
+        *,
+        surfaces: Any = None,
+        quantity: str = "radiosity",
+    ) -> np.ndarray:
+        """The solution between its vertices: ``quantity`` (``"radiosity"``, ``"direct"``,
+        ``"indirect"`` or ``"irradiance"``) at ``points`` (N, 3), linear over the triangle of
+        the mesh that holds each point, as ``penumbra sweep`` measures a mesh's error. Returns
+        (N, 3) float64, NaN for points on no surface.
+
+        ``surfaces`` (N,) gives each point's surface (-1: none); by default it is found
+        (:meth:`Scene.locate`). Against :func:`penumbra.direct_light` this measures the error
+        of a mesh's interpolation of the exact direct light::
+
+            >>> import numpy as np, penumbra
+            >>> scene = penumbra.Scene.builtin("textbook")
+            >>> solution = penumbra.run(scene, direct_only=True, max_elements=2000)
+            >>> points = np.array([[0.8, 0.1, 0.0], [1.5, -2.0, 0.0]])
+            >>> exact = scene.reflectance[scene.surface_id("floor")] * penumbra.direct_light(
+            ...     scene, points, [0, 0, 1])
+            >>> bool(np.abs(solution.interpolate(points) - exact).max() < 0.01 * exact.max())
+            True
+        """
+        at = _checks.rows3(points, "points", allow_single=True)
+        ids = _checks.surface_ids(surfaces, "surfaces", len(at))
+        if ids is None:
+            ids = self.scene.locate(at).tolist()
+        _checks.choice(quantity, "quantity", ("radiosity", "direct", "indirect", "irradiance"))
+        return self._native.interpolate(at, ids, quantity)
 
     @property
     def triangle_count(self) -> int:

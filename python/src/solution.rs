@@ -2,9 +2,10 @@
 
 use std::path::PathBuf;
 
-use numpy::{PyArray1, PyArrayMethods};
+use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2};
 use penumbra::RunResult;
 use penumbra::outputs::{SvgSelection, write_outputs};
+use penumbra_meshing::TriangleLocator;
 use penumbra_scenes::Rgb;
 use pyo3::exceptions::{PyOSError, PyValueError};
 use pyo3::prelude::*;
@@ -157,6 +158,72 @@ impl RunOutput {
             write_outputs(result, &directory, &svgs, extra)
         })
         .map_err(|e| PyOSError::new_err(format!("{e:#}")))
+    }
+
+    /// `quantity` at `points` on the surfaces `surfaces` names (-1: none, NaN there), linear
+    /// over the mesh's triangles as the sweep measures it.
+    #[pyo3(signature = (points, surfaces, quantity))]
+    fn interpolate<'py>(
+        &self,
+        py: Python<'py>,
+        points: PyReadonlyArray2<'py, f64>,
+        surfaces: Vec<i64>,
+        quantity: &str,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let at = crate::arrays::points(&points, "points")?;
+        if surfaces.len() != at.len() {
+            return Err(PyValueError::new_err(format!(
+                "surfaces: {} ids for {} points",
+                surfaces.len(),
+                at.len()
+            )));
+        }
+        let result = &self.result;
+        let solution = &result.solution;
+        let per_surface: Vec<Vec<Rgb>> = match quantity {
+            "radiosity" => solution.radiosity.clone(),
+            "irradiance" => solution.irradiance.clone(),
+            "direct" | "indirect" => {
+                let direct = quantity == "direct";
+                (0..result.mesh.surfaces.len())
+                    .map(|s| {
+                        let rho = result.loaded.scene.surfaces[s].reflectance;
+                        let (h, hd) = (&solution.irradiance[s], &solution.direct_irradiance[s]);
+                        h.iter()
+                            .zip(hd)
+                            .map(|(&h, &d)| rho.mul_rgb(if direct { d } else { h - d }))
+                            .collect()
+                    })
+                    .collect()
+            }
+            other => {
+                return Err(PyValueError::new_err(format!(
+                    "quantity: must be \"radiosity\", \"direct\", \"indirect\" or \"irradiance\", \
+                     not {other:?}"
+                )));
+            }
+        };
+        let meshes = &result.mesh.surfaces;
+        let count = meshes.len() as i64;
+        if let Some(bad) = surfaces.iter().find(|&&s| s < -1 || s >= count) {
+            return Err(PyValueError::new_err(format!(
+                "surfaces: {bad} is no surface id (0 to {}, or -1)",
+                count - 1
+            )));
+        }
+        let values = py.detach(|| {
+            let locators: Vec<TriangleLocator> = meshes.iter().map(TriangleLocator::new).collect();
+            at.iter()
+                .zip(&surfaces)
+                .map(|(&p, &s)| match usize::try_from(s) {
+                    Ok(s) => locators[s]
+                        .interpolate(&meshes[s], &per_surface[s], p)
+                        .to_array(),
+                    Err(_) => [f64::NAN; 3],
+                })
+                .collect::<Vec<[f64; 3]>>()
+        });
+        Ok(array3(py, &values))
     }
 
     /// The render from the scene's camera, (height, width, 3) uint8 sRGB.
