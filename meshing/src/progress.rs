@@ -42,6 +42,11 @@ impl Interrupt {
         self.0.store(true, Ordering::Relaxed);
     }
 
+    /// Withdraws the request, for work started afterwards.
+    pub fn clear(&self) {
+        self.0.store(false, Ordering::Relaxed);
+    }
+
     /// Whether stopping was asked for.
     pub fn is_set(&self) -> bool {
         self.0.load(Ordering::Relaxed)

@@ -31,7 +31,7 @@ from __future__ import annotations
 from . import _native
 from ._native import SceneError
 from ._research import Reference, direct_light, discontinuities, reference
-from ._run import Interrupt, RunInterrupted, run
+from ._run import Interrupt, RunCancelled, RunInterrupted, run
 from ._scene import Scene
 from ._solution import Discontinuities, Solution, SurfaceSolution
 
@@ -47,6 +47,7 @@ __all__ = [
     "Discontinuities",
     "Interrupt",
     "Reference",
+    "RunCancelled",
     "RunInterrupted",
     "Scene",
     "SceneError",

@@ -37,13 +37,18 @@ class _StderrProgress:
 
 
 class RunInterrupted(KeyboardInterrupt):
-    """A run stopped by Ctrl-C, or by an :class:`Interrupt` before any solution existed.
-    ``solution`` holds the best solution so far (marked ``partial``), or None."""
+    """A run stopped by Ctrl-C. ``solution`` holds the best solution so far (marked
+    ``partial``), or None when none existed yet."""
 
     def __init__(self, solution: Optional[Solution]) -> None:
         state = "with a partial solution" if solution is not None else "before a solution existed"
         super().__init__(f"the run was interrupted {state}")
         self.solution = solution
+
+
+class RunCancelled(RuntimeError):
+    """A run stopped by :meth:`Interrupt.set` before any solution existed (after that, ``run``
+    returns the partial solution)."""
 
 
 def run(
@@ -100,7 +105,8 @@ def run(
 
     The GIL is released while the run computes. Ctrl-C stops it and raises
     :class:`RunInterrupted` carrying the partial solution; ``interrupt.set()`` from another
-    thread stops it and ``run`` returns the partial solution (``solution.partial``).
+    thread stops it and ``run`` returns the partial solution (``solution.partial``), or raises
+    :class:`RunCancelled` if none existed yet; ``interrupt.clear()`` lets it start runs again.
 
     Raises ``ValueError`` for an option out of range (naming it), ``TypeError`` for a value of
     the wrong kind, ``MemoryError`` when the run would not fit in memory (saying what would)."""
@@ -145,6 +151,8 @@ def run(
         scene._native, arguments, _checks.count(threads, "threads"), interrupt, progress
     )
     solution = Solution(output) if output is not None else None
-    if signalled or solution is None:
+    if signalled:
         raise RunInterrupted(solution)
+    if solution is None:
+        raise RunCancelled("the run was interrupted before a solution existed")
     return solution

@@ -114,7 +114,7 @@ class Scene:
                 [len(c) for c in corners],
                 rho,
                 exitance,
-                _camera(camera),
+                None if camera is None else _camera(camera),
             )
         )
 
@@ -133,6 +133,34 @@ class Scene:
         if facing is not None and len(facing) != len(at):
             raise ValueError(f"normals has {len(facing)} rows for {len(at)} points")
         return _native.locate(self._native, at, facing)
+
+    def with_camera(
+        self,
+        eye: Any,
+        target: Any,
+        up: Any = (0.0, 0.0, 1.0),
+        fov_deg: float = 45.0,
+    ) -> "Scene":
+        """The same scene seen through another camera (for :meth:`Solution.render` and
+        ``render.png``), like ``penumbra run --eye --target --up --fov``."""
+        eye, target, up, fov = _camera({"eye": eye, "target": target, "up": up, "fov_deg": fov_deg})
+        return Scene(self._native.with_camera(eye, target, up, fov))
+
+    def frame(self, surface: Union[int, str]) -> dict[str, np.ndarray]:
+        """Surface ``surface``'s plane frame (by index or name): ``origin`` and the unit vectors
+        ``u``, ``v`` (in the plane) and ``normal``, each (3,). A point p of the plane has 2D
+        coordinates ``((p - origin) @ u, (p - origin) @ v)``; :attr:`SurfaceSolution.uv` gives
+        them for a solution's vertices."""
+        index = self.surface_id(surface) if isinstance(surface, str) else surface
+        frames = self._native.frames
+        if isinstance(index, bool) or not isinstance(index, (int, np.integer)):
+            raise TypeError(f"surface must be an index or a name, not {type(surface).__name__}")
+        if not 0 <= index < len(frames):
+            raise IndexError(f"surface {index} out of range: the scene has {len(frames)}")
+        rows = frames[index]
+        if rows is None:  # validation refuses polygons without a plane
+            raise ValueError(f"surface {index} has no plane")
+        return dict(zip(("origin", "u", "v", "normal"), rows))
 
     def surface_id(self, name: str) -> int:
         """The index of the surface called ``name``."""
@@ -195,7 +223,8 @@ class Scene:
 
     @property
     def fingerprint(self) -> str:
-        """A hash of the geometry and materials, as ``report.json`` records it."""
+        """A hash of the whole scene (its JSON form: names, geometry, materials, camera), as
+        ``report.json`` records it."""
         return self._native.fingerprint
 
     def __len__(self) -> int:
@@ -229,9 +258,8 @@ def _per_surface(value: Any, name: str, count: int) -> np.ndarray:
     return array
 
 
-def _camera(camera: Optional[Mapping[str, Any]]) -> Optional[tuple[Any, ...]]:
-    if camera is None:
-        return None
+def _camera(camera: Mapping[str, Any]) -> tuple[Any, ...]:
+    """(eye, target, up, fov_deg) from a camera dict, checked."""
     if not isinstance(camera, Mapping):
         raise TypeError(f"camera must be a dict, not {type(camera).__name__}")
     unknown = set(camera) - {"eye", "target", "up", "fov_deg"}

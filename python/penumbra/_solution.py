@@ -71,7 +71,7 @@ class SurfaceSolution:
 
     __slots__ = (
         "index", "name", "vertices", "triangles", "radiosity", "direct", "indirect",
-        "irradiance", "discontinuities",
+        "irradiance", "direct_irradiance", "discontinuities", "_frame",
     )
 
     def __init__(self, solution: "Solution", index: int) -> None:
@@ -85,8 +85,21 @@ class SurfaceSolution:
         self.direct: np.ndarray = solution.direct[v0:v1]
         self.indirect: np.ndarray = solution.indirect[v0:v1]
         self.irradiance: np.ndarray = solution.irradiance[v0:v1]
+        self.direct_irradiance: np.ndarray = solution.direct_irradiance[v0:v1]
+        self._frame = solution.scene.frame(index)
         d = solution.discontinuities
         self.discontinuities: Discontinuities = d.where(d.surface_id == index)
+
+    @property
+    def uv(self) -> np.ndarray:
+        """(N, 2) float64: the vertices in the surface's plane frame (:meth:`Scene.frame`), for
+        plots and 2D mesh tools."""
+        return self.to_uv(self.vertices)
+
+    def to_uv(self, points: Any) -> np.ndarray:
+        """Points of the surface's plane, (N, 3), in its 2D frame: (N, 2)."""
+        at = _checks.rows3(points, "points", allow_single=True) - self._frame["origin"]
+        return np.column_stack([at @ self._frame["u"], at @ self._frame["v"]])
 
     def __repr__(self) -> str:
         return (
@@ -107,7 +120,9 @@ class Solution:
       equal to the bit to ``solution.json``'s;
     - ``direct`` (N, 3): the light reflected straight from the lights, ρ·H_direct (exact);
       ``indirect`` (N, 3): the light reflected after more bounces, ρ·(H − H_direct); so
-      ``radiosity = emission + direct + indirect`` (to rounding). ``irradiance`` (N, 3): H;
+      ``radiosity = emission + direct + indirect`` (to rounding). ``irradiance`` (N, 3): the
+      irradiance H arriving at each vertex, and ``direct_irradiance`` (N, 3) its part straight
+      from the lights, H_direct (also where ρ is 0, on the lights themselves);
     - ``discontinuities``: the segments built into the mesh (:class:`Discontinuities`).
 
     ``surfaces`` (or ``solution[name]``) gives the same per surface. ``report`` is
@@ -126,6 +141,7 @@ class Solution:
         self.direct: np.ndarray = _frozen(arrays["direct"])
         self.indirect: np.ndarray = _frozen(arrays["indirect"])
         self.irradiance: np.ndarray = _frozen(arrays["irradiance"])
+        self.direct_irradiance: np.ndarray = _frozen(arrays["direct_irradiance"])
         self.discontinuities: Discontinuities = Discontinuities(arrays["discontinuities"])
         self._vertex_offsets = arrays["vertex_offsets"]
         self._triangle_offsets = arrays["triangle_offsets"]
@@ -161,7 +177,7 @@ class Solution:
         quantity: str = "radiosity",
     ) -> np.ndarray:
         """The solution between its vertices: ``quantity`` (``"radiosity"``, ``"direct"``,
-        ``"indirect"`` or ``"irradiance"``) at ``points`` (N, 3), linear over the triangle of
+        ``"indirect"``, ``"irradiance"`` or ``"direct_irradiance"``) at ``points`` (N, 3), linear over the triangle of
         the mesh that holds each point, as ``penumbra sweep`` measures a mesh's error. Returns
         (N, 3) float64, NaN for points on no surface.
 
@@ -182,7 +198,9 @@ class Solution:
         ids = _checks.surface_ids(surfaces, "surfaces", len(at))
         if ids is None:
             ids = self.scene.locate(at).tolist()
-        _checks.choice(quantity, "quantity", ("radiosity", "direct", "indirect", "irradiance"))
+        _checks.choice(
+            quantity, "quantity", ("radiosity", "direct", "indirect", "irradiance", "direct_irradiance")
+        )
         return self._native.interpolate(at, ids, quantity)
 
     @property
@@ -217,7 +235,8 @@ class Solution:
         return [Path(p) for p in self._native.write(os.fspath(directory), svg, bool(convergence))]
 
     def __repr__(self) -> str:
-        solver = self.report.get("method", {}).get("solver", "?")
+        method = self.report.get("method", {})
+        solver = "none (direct light only)" if method.get("direct_only") else method.get("solver", "?")
         return (
             f"<penumbra.Solution of {self.scene.name!r}: {len(self.vertices)} vertices, "
             f"{len(self.triangles)} triangles, {len(self.discontinuities)} discontinuity segments, "

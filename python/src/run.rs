@@ -39,6 +39,11 @@ impl Interrupt {
         self.0.set();
     }
 
+    /// Lets runs given this interrupt go on again (a set interrupt stops the next run at once).
+    fn clear(&self) {
+        self.0.clear();
+    }
+
     /// Whether `set` was called.
     #[getter]
     fn is_set(&self) -> bool {

@@ -5,7 +5,9 @@ use std::path::Path;
 
 use glam::DVec3;
 use numpy::{PyArray2, PyReadonlyArray2};
-use penumbra_scenes::{Camera, LoadedScene, ObjOptions, Rgb, Scene as SceneData, Surface};
+use penumbra_scenes::{
+    Camera, LoadedScene, ObjOptions, PlaneFrame, Rgb, Scene as SceneData, Surface,
+};
 use pyo3::exceptions::PyFileNotFoundError;
 use pyo3::prelude::*;
 
@@ -244,7 +246,42 @@ impl Scene {
         })
     }
 
-    /// A hash of the scene's geometry and materials, as `report.json` records it.
+    /// Each surface's plane frame: origin, u, v (unit, in the plane) and normal, as (4, 3)
+    /// arrays; `None` for a polygon without one (validation refuses those).
+    #[getter]
+    fn frames<'py>(&self, py: Python<'py>) -> Vec<Option<Bound<'py, PyArray2<f64>>>> {
+        self.data()
+            .surfaces
+            .iter()
+            .map(|s| {
+                PlaneFrame::of_polygon(&s.polygon)
+                    .map(|f| array3(py, &[f.origin, f.u, f.v, f.normal].map(|d| d.to_array())))
+            })
+            .collect()
+    }
+
+    /// The same scene, seen through another camera (validated like the scene's own).
+    fn with_camera(
+        &self,
+        py: Python<'_>,
+        eye: [f64; 3],
+        target: [f64; 3],
+        up: [f64; 3],
+        fov_deg: f64,
+    ) -> PyResult<Scene> {
+        let mut scene = self.loaded.scene.clone();
+        scene.camera = Some(Camera {
+            eye: DVec3::from(eye),
+            target: DVec3::from(target),
+            up: DVec3::from(up),
+            fov_deg,
+        });
+        let mut with = Scene::validated(py, scene, self.loaded.source.clone())?;
+        with.loaded.warnings.clone_from(&self.loaded.warnings);
+        Ok(with)
+    }
+
+    /// A hash of the whole scene (its JSON form), as `report.json` records it.
     #[getter]
     fn fingerprint(&self) -> String {
         penumbra::shard::scene_fingerprint(&self.loaded)

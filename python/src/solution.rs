@@ -183,6 +183,7 @@ impl RunOutput {
         let per_surface: Vec<Vec<Rgb>> = match quantity {
             "radiosity" => solution.radiosity.clone(),
             "irradiance" => solution.irradiance.clone(),
+            "direct_irradiance" => solution.direct_irradiance.clone(),
             "direct" | "indirect" => {
                 let direct = quantity == "direct";
                 (0..result.mesh.surfaces.len())
@@ -198,8 +199,8 @@ impl RunOutput {
             }
             other => {
                 return Err(PyValueError::new_err(format!(
-                    "quantity: must be \"radiosity\", \"direct\", \"indirect\" or \"irradiance\", \
-                     not {other:?}"
+                    "quantity: must be \"radiosity\", \"direct\", \"indirect\", \"irradiance\" \
+                     or \"direct_irradiance\", not {other:?}"
                 )));
             }
         };

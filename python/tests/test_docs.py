@@ -27,7 +27,7 @@ def test_interpolation_at_the_vertices_gives_their_values():
     alone = np.sort(first[counts == 1])
     assert len(alone) > 0.8 * len(solution.vertices)
     ids = solution.surface_id[alone].astype(int)
-    for quantity in ("radiosity", "direct", "indirect", "irradiance"):
+    for quantity in ("radiosity", "direct", "indirect", "irradiance", "direct_irradiance"):
         got = solution.interpolate(solution.vertices[alone], surfaces=ids, quantity=quantity)
         expected = getattr(solution, quantity)[alone]
         assert np.allclose(got, expected, rtol=1e-9, atol=1e-9 * np.abs(expected).max()), quantity
@@ -37,3 +37,16 @@ def test_interpolation_at_the_vertices_gives_their_values():
     got = solution.interpolate(centroids, surfaces=solution.triangle_surface_id[:50].astype(int))
     assert np.allclose(got, solution.radiosity[triangles].mean(axis=1), rtol=1e-9, atol=1e-12)
     assert np.isnan(solution.interpolate([[0, -1e4, 0]])).all()  # on no surface
+
+
+def test_surface_coordinates_follow_the_frame():
+    solution = penumbra.run(penumbra.Scene.builtin("cornell"), max_elements=3000)
+    floor = solution["floor"]
+    frame = solution.scene.frame("floor")
+    back = frame["origin"] + floor.uv[:, :1] * frame["u"] + floor.uv[:, 1:] * frame["v"]
+    assert np.allclose(back, floor.vertices, atol=1e-9 * 560)
+    # The lights' own direct irradiance is kept where their reflectance makes `direct` zero.
+    light = solution["light"]
+    assert not light.direct.any() and not light.direct_irradiance.any()  # it faces away from itself
+    lit = solution["floor"]
+    assert np.allclose(lit.direct, solution.scene.reflectance[lit.index] * lit.direct_irradiance)

@@ -37,12 +37,15 @@ def test_an_interrupt_from_another_thread_returns_a_partial_solution():
     _assert_partial(solution)
 
 
-def test_an_interrupt_before_any_solution_raises_without_one():
+def test_an_interrupt_before_any_solution_cancels_the_run():
     interrupt = penumbra.Interrupt()
     interrupt.set()
-    with pytest.raises(penumbra.RunInterrupted) as raised:
-        penumbra.run(penumbra.Scene.builtin("cornell"), interrupt=interrupt, max_elements=2000)
-    assert raised.value.solution is None
+    scene = penumbra.Scene.builtin("cornell")
+    with pytest.raises(penumbra.RunCancelled):
+        penumbra.run(scene, interrupt=interrupt, max_elements=2000)
+    interrupt.clear()
+    assert not interrupt.is_set
+    assert not penumbra.run(scene, interrupt=interrupt, max_elements=2000).partial
 
 
 @pytest.mark.skipif(threading.current_thread() is not threading.main_thread(), reason="signals reach the main thread")

@@ -121,3 +121,24 @@ def test_locate_finds_the_surface_a_point_lies_on():
     scene = two_surfaces()
     ids = scene.locate([[0.3, 0.2, 0], [0, 0, 2], [0, 0, 1], [3, 0, 0], [2, 2, 0]])
     assert ids.tolist() == [1, 0, -1, -1, 1]
+
+
+def test_frames_and_cameras():
+    scene = two_surfaces()
+    frame = scene.frame("floor")
+    assert np.allclose(frame["normal"], [0, 0, 1])
+    assert np.isclose(frame["u"] @ frame["v"], 0) and np.isclose(np.linalg.norm(frame["u"]), 1)
+    assert np.allclose(np.cross(frame["u"], frame["v"]), frame["normal"])
+    assert np.array_equal(scene.frame(1)["origin"], frame["origin"])
+    with pytest.raises(IndexError):
+        scene.frame(2)
+    seen = scene.with_camera([0, -3, 1], [0, 0, 0], fov_deg=60)
+    assert seen.camera == {"eye": [0, -3, 1], "target": [0, 0, 0], "up": [0, 0, 1], "fov_deg": 60.0}
+    assert scene.camera is None and seen.fingerprint != scene.fingerprint  # the camera is part of it
+    with pytest.raises(penumbra.SceneError, match="camera"):
+        scene.with_camera([0, 0, 0], [0, 0, 0])
+    # The render follows the camera: from below the floor it shows the floor's back, black.
+    below = penumbra.run(scene.with_camera([1.5, 0, -1], [0, 0, 0]), direct_only=True, width=32, height=32)
+    above = penumbra.run(scene.with_camera([1.5, 0, 1], [0, 0, 0]), direct_only=True, width=32, height=32)
+    assert below.render().shape == (32, 32, 3)
+    assert below.render().max() == 0 and above.render().max() > 100
