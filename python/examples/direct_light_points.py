@@ -3,10 +3,10 @@
 `penumbra.direct_light` gives the direct irradiance H exactly at any points, with no mesh. Left:
 H on a 300 x 300 grid over the Cornell box's floor (y = 0, in mm), with its umbrae and
 penumbrae. Right: along a line across the tall block's penumbra, the reflected direct light
-rho * H (exact, 577 points), the radiosity B of the default run (linear over its mesh), and B
-path-traced by `penumbra.reference` at 19 of the points (1,024 paths each, error bars 2 standard
-errors); B exceeds rho * H by the indirect light. Values are means of R, G and B. Prints the
-profile at the path-traced points. About 5 s on 2 cores.
+rho * H (exact, 577 points), the radiosity B of the default run (linear over its mesh, by
+`Solution.interpolate`), and B path-traced by `penumbra.reference` at 19 of the points (1,024
+paths each, error bars 2 standard errors); B exceeds rho * H by the indirect light. Values are
+means of R, G and B. Prints the profile at the path-traced points. About 5 s on 2 cores.
 
     python python/examples/direct_light_points.py --out docs/python-direct.png
 """
@@ -19,31 +19,15 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
-from matplotlib.tri import LinearTriInterpolator, Triangulation
 
 import penumbra
 
-
-def png_path(out: str, name: str) -> Path:
-    """``out`` itself, or ``out/name`` when ``out`` is a directory."""
-    path = Path(out) / name if Path(out).is_dir() or out.endswith("/") else Path(out)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    return path
-
-
-def interpolate(uv: np.ndarray, triangles: np.ndarray, values: np.ndarray, at: np.ndarray):
-    """``values`` at a mesh's vertices ``uv`` (2D), linear over its ``triangles``, at the points
-    ``at`` (NaN off the mesh). Across contact lines a mesh has two vertices at one position, one
-    per side; matplotlib's TriFinder refuses those, so triangles are found with them merged."""
-    unique, merged = np.unique(uv, axis=0, return_inverse=True)
-    finder = Triangulation(*unique.T, merged.reshape(-1)[triangles]).get_trifinder()
-    mesh = Triangulation(*uv.T, triangles)
-    return LinearTriInterpolator(mesh, values, trifinder=finder)(*at.T).filled(np.nan)
-
-
 parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-parser.add_argument("--out", default=".", help="PNG file, or directory for direct_light_points.png")
-path = png_path(parser.parse_args().out, "direct_light_points.png")
+parser.add_argument("--out", type=Path, default=Path("."), metavar="DIR",
+                    help="directory for direct_light_points.png, or a .png file")
+out = parser.parse_args().out
+path = out if out.suffix == ".png" else out / "direct_light_points.png"
+path.parent.mkdir(parents=True, exist_ok=True)
 
 scene = penumbra.Scene.builtin("cornell")
 f = scene.surface_id("floor")
@@ -56,12 +40,11 @@ h = penumbra.direct_light(scene, grid, up, surfaces=np.full(len(grid), f)).mean(
 
 # The profile: 577 points from x = 545 to 5 mm at z = 520 mm; every 32nd is path-traced.
 dense = np.c_[np.linspace(545, 5, 577), np.zeros(577), np.full(577, 520.0)]
-sparse = dense[::32]
-direct = (rho * penumbra.direct_light(scene, dense, up, surfaces=np.full(577, f))).mean(axis=1)
-traced = penumbra.reference(scene, sparse, surfaces=np.full(len(sparse), f), paths=1024, seed=1)
-floor = penumbra.run(scene)["floor"]
-solved = interpolate(floor.vertices[:, [0, 2]], floor.triangles, floor.radiosity.mean(axis=1),
-                     dense[:, [0, 2]])
+sparse, on_floor = dense[::32], np.full(577, f)
+direct = (rho * penumbra.direct_light(scene, dense, up, surfaces=on_floor)).mean(axis=1)
+traced = penumbra.reference(scene, sparse, surfaces=on_floor[::32], paths=1024, seed=1)
+# The default run's radiosity between its vertices: linear over the triangle holding each point.
+solved = penumbra.run(scene).interpolate(dense, surfaces=on_floor).mean(axis=1)
 
 fig, (left, right) = plt.subplots(1, 2, figsize=(12, 5), layout="constrained")
 image = left.imshow(h.reshape(x.shape), origin="lower", extent=(x0, x1, z0, z1), cmap="inferno")
