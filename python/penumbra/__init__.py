@@ -23,7 +23,8 @@ Example::
 Errors: :class:`SceneError` (a ``ValueError``) for scenes that are not valid, with every
 problem in ``problems``; ``ValueError`` or ``TypeError`` naming the argument for bad
 arguments; :class:`RunInterrupted` (a ``KeyboardInterrupt``) for Ctrl-C, carrying the partial
-solution.
+solution; :class:`RunCancelled` (a ``RuntimeError``) when an :class:`Interrupt` stops a run
+before any solution exists.
 """
 
 from __future__ import annotations

@@ -57,7 +57,11 @@ class Scene:
     @property
     def frames(self) -> list[Optional[np.ndarray]]: ...
     def with_camera(
-        self, eye: Any, target: Any, up: Any, fov_deg: float
+        self,
+        eye: Optional[tuple[float, float, float]] = None,
+        target: Optional[tuple[float, float, float]] = None,
+        up: Optional[tuple[float, float, float]] = None,
+        fov_deg: Optional[float] = None,
     ) -> Scene: ...
     @property
     def fingerprint(self) -> str: ...

@@ -136,15 +136,33 @@ class Scene:
 
     def with_camera(
         self,
-        eye: Any,
-        target: Any,
-        up: Any = (0.0, 0.0, 1.0),
-        fov_deg: float = 45.0,
+        eye: Any = None,
+        target: Any = None,
+        up: Any = None,
+        fov_deg: Optional[float] = None,
     ) -> "Scene":
         """The same scene seen through another camera (for :meth:`Solution.render` and
-        ``render.png``), like ``penumbra run --eye --target --up --fov``."""
-        eye, target, up, fov = _camera({"eye": eye, "target": target, "up": up, "fov_deg": fov_deg})
-        return Scene(self._native.with_camera(eye, target, up, fov))
+        ``render.png``). Each part given replaces that part of the scene's camera, or of the
+        default view that frames the whole scene, as ``penumbra run --eye --target --up --fov``
+        do. Raises :class:`penumbra.SceneError` for a camera that cannot make a picture."""
+
+        def point(value: Any, name: str) -> Optional[tuple[float, float, float]]:
+            if value is None:
+                return None
+            row = _checks.rows3(value, name, allow_single=True)
+            if len(row) != 1:
+                raise ValueError(f"{name} must be one point, not {len(row)}")
+            x, y, z = row[0].tolist()
+            return (x, y, z)
+
+        return Scene(
+            self._native.with_camera(
+                point(eye, "eye"),
+                point(target, "target"),
+                point(up, "up"),
+                _checks.number(fov_deg, "fov_deg", positive=True),
+            )
+        )
 
     def frame(self, surface: Union[int, str]) -> dict[str, np.ndarray]:
         """Surface ``surface``'s plane frame (by index or name): ``origin`` and the unit vectors
@@ -152,10 +170,10 @@ class Scene:
         coordinates ``((p - origin) @ u, (p - origin) @ v)``; :attr:`SurfaceSolution.uv` gives
         them for a solution's vertices."""
         index = self.surface_id(surface) if isinstance(surface, str) else surface
-        frames = self._native.frames
         if isinstance(index, bool) or not isinstance(index, (int, np.integer)):
             raise TypeError(f"surface must be an index or a name, not {type(surface).__name__}")
-        if not 0 <= index < len(frames):
+        frames = self._native.frames
+        if not -len(frames) <= index < len(frames):
             raise IndexError(f"surface {index} out of range: the scene has {len(frames)}")
         rows = frames[index]
         if rows is None:  # validation refuses polygons without a plane

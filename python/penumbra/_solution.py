@@ -122,7 +122,7 @@ class Solution:
       ``indirect`` (N, 3): the light reflected after more bounces, ρ·(H − H_direct); so
       ``radiosity = emission + direct + indirect`` (to rounding). ``irradiance`` (N, 3): the
       irradiance H arriving at each vertex, and ``direct_irradiance`` (N, 3) its part straight
-      from the lights, H_direct (also where ρ is 0, on the lights themselves);
+      from the lights, H_direct (which ``direct`` loses where ρ is 0);
     - ``discontinuities``: the segments built into the mesh (:class:`Discontinuities`).
 
     ``surfaces`` (or ``solution[name]``) gives the same per surface. ``report`` is
@@ -179,7 +179,7 @@ class Solution:
         """The solution between its vertices: ``quantity`` (``"radiosity"``, ``"direct"``,
         ``"indirect"``, ``"irradiance"`` or ``"direct_irradiance"``) at ``points`` (N, 3), linear over the triangle of
         the mesh that holds each point, as ``penumbra sweep`` measures a mesh's error. Returns
-        (N, 3) float64, NaN for points on no surface.
+        (N, 3) float64, NaN for points on no surface (or off the surface given for them).
 
         ``surfaces`` (N,) gives each point's surface (-1: none); by default it is found
         (:meth:`Scene.locate`). Against :func:`penumbra.direct_light` this measures the error

@@ -17,57 +17,82 @@ use crate::errors::bad_argument;
 use crate::run::{thread_pool, without_gil};
 use crate::scene::Scene;
 
-/// The surface each point lies on (within the scene's contact distance, on the polygon or its
-/// outline), or `None`. Where several do (a point on a shared edge), the one whose normal is
-/// closest to the point's `normal`, else the first in the scene.
-fn surfaces_at(
-    scene: &SceneData,
-    visibility: &Visibility,
-    at: &[DVec3],
-    normals: Option<&[DVec3]>,
-) -> Vec<Option<SurfaceId>> {
-    let tol = visibility.contact_distance();
-    let frames: Vec<Option<PlaneFrame>> = scene
-        .surfaces
-        .iter()
-        .map(|s| PlaneFrame::of_polygon(&s.polygon))
-        .collect();
-    let outlines: Vec<Vec<DVec2>> = scene
-        .surfaces
-        .iter()
-        .zip(&frames)
-        .map(|(s, f)| match f {
-            Some(f) => s.polygon.iter().map(|&p| f.to_2d(p)).collect(),
-            None => Vec::new(),
+/// Finds the surfaces points lie on: within the scene's contact distance of a polygon, inside
+/// it or on its outline.
+pub(crate) struct SurfaceLocator<'s> {
+    scene: &'s SceneData,
+    visibility: &'s Visibility,
+    frames: Vec<Option<PlaneFrame>>,
+    /// Each polygon in its frame.
+    outlines: Vec<Vec<DVec2>>,
+    tol: f64,
+}
+
+impl<'s> SurfaceLocator<'s> {
+    pub(crate) fn new(scene: &'s SceneData, visibility: &'s Visibility) -> SurfaceLocator<'s> {
+        let frames: Vec<Option<PlaneFrame>> = scene
+            .surfaces
+            .iter()
+            .map(|s| PlaneFrame::of_polygon(&s.polygon))
+            .collect();
+        let outlines = scene
+            .surfaces
+            .iter()
+            .zip(&frames)
+            .map(|(s, f)| match f {
+                Some(f) => s.polygon.iter().map(|&p| f.to_2d(p)).collect(),
+                None => Vec::new(),
+            })
+            .collect();
+        SurfaceLocator {
+            scene,
+            visibility,
+            frames,
+            outlines,
+            tol: visibility.contact_distance(),
+        }
+    }
+
+    /// Whether `p` lies on surface `s`.
+    pub(crate) fn holds(&self, s: SurfaceId, p: DVec3) -> bool {
+        self.frames[s].is_some_and(|f| {
+            let q = f.to_2d(p);
+            f.height(p).abs() <= self.tol
+                && penumbra_scenes::polygon::closest_point_in_polygon(&self.outlines[s], q)
+                    .distance(q)
+                    <= self.tol
         })
-        .collect();
-    let triangles = visibility.triangles();
-    at.par_iter()
-        .enumerate()
-        .map(|(i, &p)| {
-            let mut near = Vec::new();
-            let bounds = Bounds::from_points(&[p - DVec3::splat(tol), p + DVec3::splat(tol)]);
-            visibility.triangles_overlapping(bounds, |t| near.push(triangles[t].surface));
-            near.sort_unstable();
-            near.dedup();
-            let on = near.into_iter().filter(|&s| {
-                frames[s].is_some_and(|f| {
-                    let q = f.to_2d(p);
-                    f.height(p).abs() <= tol
-                        && penumbra_scenes::polygon::closest_point_in_polygon(&outlines[s], q)
-                            .distance(q)
-                            <= tol
-                })
+    }
+
+    /// The surface `p` lies on, or `None`. Where several do (a point on a shared edge), the
+    /// one whose normal is closest to `normal`, else the first in the scene.
+    fn surface_at(&self, p: DVec3, normal: Option<DVec3>) -> Option<SurfaceId> {
+        let mut near = Vec::new();
+        let reach = DVec3::splat(self.tol);
+        let triangles = self.visibility.triangles();
+        self.visibility
+            .triangles_overlapping(Bounds::from_points(&[p - reach, p + reach]), |t| {
+                near.push(triangles[t].surface);
             });
-            match normals {
-                None => on.min(),
-                Some(normals) => on
-                    .map(|s| (s, scene.surfaces[s].normal().dot(normals[i])))
-                    .max_by(|a, b| a.1.total_cmp(&b.1).then(b.0.cmp(&a.0)))
-                    .map(|(s, _)| s),
-            }
-        })
-        .collect()
+        near.sort_unstable();
+        near.dedup();
+        let on = near.into_iter().filter(|&s| self.holds(s, p));
+        match normal {
+            None => on.min(),
+            Some(n) => on
+                .map(|s| (s, self.scene.surfaces[s].normal().dot(n)))
+                .max_by(|a, b| a.1.total_cmp(&b.1).then(b.0.cmp(&a.0)))
+                .map(|(s, _)| s),
+        }
+    }
+
+    /// [`Self::surface_at`] for every point.
+    fn surfaces_at(&self, at: &[DVec3], normals: Option<&[DVec3]>) -> Vec<Option<SurfaceId>> {
+        at.par_iter()
+            .enumerate()
+            .map(|(i, &p)| self.surface_at(p, normals.map(|n| n[i])))
+            .collect()
+    }
 }
 
 /// Surface ids from Python (`-1`: none) checked against the scene, or found from the points.
@@ -79,7 +104,7 @@ fn receivers(
     given: Option<Vec<i64>>,
 ) -> PyResult<Vec<Option<SurfaceId>>> {
     let Some(given) = given else {
-        return Ok(surfaces_at(scene, visibility, at, normals));
+        return Ok(SurfaceLocator::new(scene, visibility).surfaces_at(at, normals));
     };
     if given.len() != at.len() {
         return Err(bad_argument(
@@ -146,9 +171,9 @@ pub(crate) fn direct_light<'py>(
     let stop = penumbra_solver::Interrupt::default();
     let data = scene.data();
     let (values, signal) = without_gil(py, pool.as_ref(), &stop, || {
-        let visibility = Visibility::build(data);
-        let on = receivers(data, &visibility, &at, Some(&normals), surfaces)?;
-        let direct = DirectLight::new(data, &visibility);
+        let visibility = scene.visibility();
+        let on = receivers(data, visibility, &at, Some(&normals), surfaces)?;
+        let direct = DirectLight::new(data, visibility);
         // A surface id no surface has: nothing is left out of the occluders.
         let nowhere = data.surfaces.len();
         let values: Vec<Option<Rgb>> = at
@@ -215,7 +240,7 @@ pub(crate) fn discontinuities<'py>(
         ..DiscontinuityOptions::default()
     };
     let (found, signal) = without_gil(py, pool.as_ref(), &stop, || {
-        find_discontinuities(data, &Visibility::build(data), &options)
+        find_discontinuities(data, scene.visibility(), &options)
     })?;
     if signal.is_some() {
         return Err(interrupted(signal));
@@ -263,8 +288,8 @@ pub(crate) fn reference<'py>(
     let stop = penumbra_solver::Interrupt::default();
     let data = scene.data();
     let (values, signal) = without_gil(py, pool.as_ref(), &stop, || {
-        let visibility = Visibility::build(data);
-        let on = receivers(data, &visibility, &at, None, surfaces)?;
+        let visibility = scene.visibility();
+        let on = receivers(data, visibility, &at, None, surfaces)?;
         let located: Vec<(DVec3, SurfaceId)> = at
             .iter()
             .zip(&on)
@@ -278,7 +303,7 @@ pub(crate) fn reference<'py>(
                 })
             })
             .collect::<PyResult<_>>()?;
-        let tracer = PathTracer::new(data, &visibility);
+        let tracer = PathTracer::new(data, visibility);
         Ok::<_, PyErr>(tracer.radiosity(&located, &PathTraceOptions { paths, seed }))
     })?;
     if signal.is_some() {
@@ -293,7 +318,7 @@ pub(crate) fn reference<'py>(
     ))
 }
 
-/// The surface each point lies on (-1: none), as [`surfaces_at`] finds it.
+/// The surface each point lies on (-1: none), as [`SurfaceLocator`] finds it.
 #[pyfunction]
 #[pyo3(signature = (scene, points, normals = None))]
 pub(crate) fn locate<'py>(
@@ -308,7 +333,9 @@ pub(crate) fn locate<'py>(
         None => None,
     };
     let data = scene.data();
-    let found = py.detach(|| surfaces_at(data, &Visibility::build(data), &at, normals.as_deref()));
+    let found = py.detach(|| {
+        SurfaceLocator::new(data, scene.visibility()).surfaces_at(&at, normals.as_deref())
+    });
     let ids: Vec<i64> = found
         .into_iter()
         .map(|s| s.map_or(-1, |s| s as i64))

@@ -2,11 +2,12 @@
 //! arrays.
 
 use std::path::Path;
+use std::sync::{Arc, OnceLock};
 
 use glam::DVec3;
 use numpy::{PyArray2, PyReadonlyArray2};
 use penumbra_scenes::{
-    Camera, LoadedScene, ObjOptions, PlaneFrame, Rgb, Scene as SceneData, Surface,
+    Camera, LoadedScene, ObjOptions, PlaneFrame, Rgb, Scene as SceneData, Surface, Visibility,
 };
 use pyo3::exceptions::PyFileNotFoundError;
 use pyo3::prelude::*;
@@ -22,6 +23,8 @@ type CameraParts = ([f64; 3], [f64; 3], [f64; 3], f64);
 #[derive(Clone)]
 pub(crate) struct Scene {
     pub(crate) loaded: LoadedScene,
+    /// The visibility index, built when first needed and kept (the scene never changes).
+    visibility: OnceLock<Arc<Visibility>>,
 }
 
 impl Scene {
@@ -38,17 +41,28 @@ impl Scene {
                 },
             ));
         }
-        Ok(Scene {
-            loaded: LoadedScene {
-                scene,
-                source,
-                warnings: Vec::new(),
-            },
-        })
+        Ok(Scene::new(LoadedScene {
+            scene,
+            source,
+            warnings: Vec::new(),
+        }))
+    }
+
+    pub(crate) fn new(loaded: LoadedScene) -> Scene {
+        Scene {
+            loaded,
+            visibility: OnceLock::new(),
+        }
     }
 
     pub(crate) fn data(&self) -> &SceneData {
         &self.loaded.scene
+    }
+
+    /// The scene's visibility index (built on first use; call without the GIL).
+    pub(crate) fn visibility(&self) -> &Visibility {
+        self.visibility
+            .get_or_init(|| Arc::new(Visibility::build(&self.loaded.scene)))
     }
 }
 
@@ -70,7 +84,7 @@ impl Scene {
         let loaded = py
             .detach(|| penumbra_scenes::load_scene_with(path, &options))
             .map_err(|e| scene_error(py, e))?;
-        Ok(Scene { loaded })
+        Ok(Scene::new(loaded))
     }
 
     /// The built-in scene called `name`.
@@ -260,21 +274,27 @@ impl Scene {
             .collect()
     }
 
-    /// The same scene, seen through another camera (validated like the scene's own).
+    /// The same scene, seen through another camera: each part given replaces that part of
+    /// the scene's camera (or of the default view that frames the scene), as `penumbra run
+    /// --eye --target --up --fov` do; validated like the scene's own.
+    #[pyo3(signature = (eye = None, target = None, up = None, fov_deg = None))]
     fn with_camera(
         &self,
         py: Python<'_>,
-        eye: [f64; 3],
-        target: [f64; 3],
-        up: [f64; 3],
-        fov_deg: f64,
+        eye: Option<[f64; 3]>,
+        target: Option<[f64; 3]>,
+        up: Option<[f64; 3]>,
+        fov_deg: Option<f64>,
     ) -> PyResult<Scene> {
         let mut scene = self.loaded.scene.clone();
+        let base = scene
+            .camera
+            .unwrap_or_else(|| penumbra_viz::default_camera(&scene));
         scene.camera = Some(Camera {
-            eye: DVec3::from(eye),
-            target: DVec3::from(target),
-            up: DVec3::from(up),
-            fov_deg,
+            eye: eye.map_or(base.eye, DVec3::from),
+            target: target.map_or(base.target, DVec3::from),
+            up: up.map_or(base.up, DVec3::from),
+            fov_deg: fov_deg.unwrap_or(base.fov_deg),
         });
         let mut with = Scene::validated(py, scene, self.loaded.source.clone())?;
         with.loaded.warnings.clone_from(&self.loaded.warnings);

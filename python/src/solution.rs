@@ -1,27 +1,38 @@
 //! `penumbra.Solution`'s native half: a finished run, its arrays, its JSON and its files.
 
 use std::path::PathBuf;
+use std::sync::OnceLock;
 
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2};
 use penumbra::RunResult;
 use penumbra::outputs::{SvgSelection, write_outputs};
 use penumbra_meshing::TriangleLocator;
-use penumbra_scenes::Rgb;
+use penumbra_scenes::{Rgb, Visibility};
 use pyo3::exceptions::{PyOSError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use rayon::prelude::*;
 
 use crate::arrays::{array3, index_array, rgb_array, segment_arrays};
+use crate::primitives::SurfaceLocator;
 
 /// A finished run, held for its arrays, its report and its files.
 #[pyclass(module = "penumbra._native", frozen)]
 pub(crate) struct RunOutput {
     result: RunResult,
+    /// For `interpolate`, built on first use: each surface mesh's triangle finder, and the
+    /// scene's visibility index (which tells whether a point lies on a surface).
+    locators: OnceLock<Vec<TriangleLocator>>,
+    visibility: OnceLock<Visibility>,
 }
 
 impl RunOutput {
     pub(crate) fn new(result: RunResult) -> RunOutput {
-        RunOutput { result }
+        RunOutput {
+            result,
+            locators: OnceLock::new(),
+            visibility: OnceLock::new(),
+        }
     }
 }
 
@@ -160,8 +171,8 @@ impl RunOutput {
         .map_err(|e| PyOSError::new_err(format!("{e:#}")))
     }
 
-    /// `quantity` at `points` on the surfaces `surfaces` names (-1: none, NaN there), linear
-    /// over the mesh's triangles as the sweep measures it.
+    /// `quantity` at `points` on the surfaces `surfaces` names, linear over the mesh's
+    /// triangles as the sweep measures it; NaN for a point off its surface (or given -1).
     #[pyo3(signature = (points, surfaces, quantity))]
     fn interpolate<'py>(
         &self,
@@ -213,14 +224,19 @@ impl RunOutput {
             )));
         }
         let values = py.detach(|| {
-            let locators: Vec<TriangleLocator> = meshes.iter().map(TriangleLocator::new).collect();
-            at.iter()
+            let locators = self
+                .locators
+                .get_or_init(|| meshes.iter().map(TriangleLocator::new).collect());
+            let scene = &result.loaded.scene;
+            let visibility = self.visibility.get_or_init(|| Visibility::build(scene));
+            let on = SurfaceLocator::new(scene, visibility);
+            at.par_iter()
                 .zip(&surfaces)
                 .map(|(&p, &s)| match usize::try_from(s) {
-                    Ok(s) => locators[s]
+                    Ok(s) if on.holds(s, p) => locators[s]
                         .interpolate(&meshes[s], &per_surface[s], p)
                         .to_array(),
-                    Err(_) => [f64::NAN; 3],
+                    _ => [f64::NAN; 3],
                 })
                 .collect::<Vec<[f64; 3]>>()
         });
@@ -238,9 +254,7 @@ impl RunOutput {
     /// The scene that was run.
     #[getter]
     fn scene(&self) -> crate::scene::Scene {
-        crate::scene::Scene {
-            loaded: self.result.loaded.clone(),
-        }
+        crate::scene::Scene::new(self.result.loaded.clone())
     }
 
     /// The mesh's triangles, for the whole scene.

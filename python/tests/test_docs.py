@@ -37,6 +37,9 @@ def test_interpolation_at_the_vertices_gives_their_values():
     got = solution.interpolate(centroids, surfaces=solution.triangle_surface_id[:50].astype(int))
     assert np.allclose(got, solution.radiosity[triangles].mean(axis=1), rtol=1e-9, atol=1e-12)
     assert np.isnan(solution.interpolate([[0, -1e4, 0]])).all()  # on no surface
+    floor = solution.scene.surface_id("floor")
+    off = solution.interpolate([[1000, 0, 100]], surfaces=[floor])  # in the floor's plane, beyond it
+    assert np.isnan(off).all()
 
 
 def test_surface_coordinates_follow_the_frame():

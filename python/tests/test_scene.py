@@ -132,11 +132,16 @@ def test_frames_and_cameras():
     assert np.array_equal(scene.frame(1)["origin"], frame["origin"])
     with pytest.raises(IndexError):
         scene.frame(2)
+    assert np.array_equal(scene.frame(-1)["u"], frame["u"])
     seen = scene.with_camera([0, -3, 1], [0, 0, 0], fov_deg=60)
     assert seen.camera == {"eye": [0, -3, 1], "target": [0, 0, 0], "up": [0, 0, 1], "fov_deg": 60.0}
     assert scene.camera is None and seen.fingerprint != scene.fingerprint  # the camera is part of it
     with pytest.raises(penumbra.SceneError, match="camera"):
         scene.with_camera([0, 0, 0], [0, 0, 0])
+    # Parts not given stay the scene's, as with --eye alone on the command line.
+    cornell = penumbra.Scene.builtin("cornell")
+    closer = cornell.with_camera(eye=[278, 273, -500])
+    assert closer.camera == dict(cornell.camera, eye=[278, 273, -500])
     # The render follows the camera: from below the floor it shows the floor's back, black.
     below = penumbra.run(scene.with_camera([1.5, 0, -1], [0, 0, 0]), direct_only=True, width=32, height=32)
     above = penumbra.run(scene.with_camera([1.5, 0, 1], [0, 0, 0]), direct_only=True, width=32, height=32)
