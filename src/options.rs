@@ -205,11 +205,17 @@ impl RunOptions {
             return Err(InvalidOption::new("memory limit", "must be positive"));
         }
         let (width, height) = (self.render.width, self.render.height);
-        if !(1..=MAX_RENDER_SIZE).contains(&width) || !(1..=MAX_RENDER_SIZE).contains(&height) {
+        let pixels = u64::from(width) * u64::from(height);
+        if !(1..=MAX_RENDER_SIZE).contains(&width)
+            || !(1..=MAX_RENDER_SIZE).contains(&height)
+            || pixels > penumbra_viz::MAX_PIXELS
+        {
             return Err(InvalidOption::new(
                 "render size",
                 format!(
-                    "must be from 1 to {MAX_RENDER_SIZE} pixels a side, not {width} x {height}"
+                    "must be from 1 to {MAX_RENDER_SIZE} pixels a side and {} pixels in all, \
+                     not {width} x {height}",
+                    penumbra_viz::MAX_PIXELS
                 ),
             ));
         }

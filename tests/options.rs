@@ -80,6 +80,11 @@ fn bad_values_name_their_own_flag() {
         "--refine-rounds",
     );
     refused(&["run", "textbook", "--width", "100000"], "--width");
+    // Each side within its cap, the whole beyond the renderer's: refused before the run.
+    refused(
+        &["run", "textbook", "--width", "16384", "--height", "16384"],
+        "--width/--height",
+    );
     refused(&["run", "textbook", "--up", "0,0,0"], "--up");
     refused(
         &["run", "textbook", "--eye", "0,0,0.4", "--target", "0,0,0.4"],

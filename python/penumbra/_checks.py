@@ -81,8 +81,8 @@ def choice(value: Any, name: str, choices: Sequence[str]) -> Optional[str]:
     return value
 
 
-def surface_ids(value: Any, name: str, points: int) -> Optional[list[int]]:
-    """One surface id per point (-1: none), or None."""
+def surface_ids(value: Any, name: str, points: int, surfaces: int) -> Optional[list[int]]:
+    """One surface id per point, from 0 to ``surfaces - 1`` (-1: none), or None."""
     if value is None:
         return None
     array = np.asarray(value)
@@ -90,4 +90,8 @@ def surface_ids(value: Any, name: str, points: int) -> Optional[list[int]]:
         raise TypeError(f"{name} must hold whole numbers, not {array.dtype}")
     if array.shape != (points,):
         raise ValueError(f"{name} must have shape ({points},), one id per point, not {array.shape}")
-    return [int(i) for i in array]
+    ids = [int(i) for i in array]
+    wrong = [i for i in ids if not -1 <= i < surfaces]
+    if wrong:
+        raise ValueError(f"{name}: {wrong[0]} is no surface id; ids run from 0 to {surfaces - 1} (-1: none)")
+    return ids

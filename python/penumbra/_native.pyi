@@ -1,5 +1,6 @@
 """Type stubs of penumbra's native module (the Rust half). Use the public API in `penumbra`."""
 
+from pathlib import Path
 from typing import Any, Callable, Optional, Sequence, Union
 
 import numpy as np
@@ -83,7 +84,7 @@ class RunOutput:
     def solution_json(self) -> str: ...
     def write(
         self, directory: str, svg: Union[str, list[str]], convergence: bool = False
-    ) -> list[str]: ...
+    ) -> list[Path]: ...
     def interpolate(
         self, points: np.ndarray, surfaces: list[int], quantity: str
     ) -> np.ndarray: ...
@@ -100,7 +101,7 @@ def run(
     threads: Optional[int] = None,
     interrupt: Optional[Interrupt] = None,
     progress: Optional[Callable[[str, int, int], object]] = None,
-) -> tuple[Optional[RunOutput], bool]: ...
+) -> tuple[Optional[RunOutput], Optional[BaseException]]: ...
 def direct_light(
     scene: Scene,
     points: np.ndarray,
@@ -111,7 +112,7 @@ def direct_light(
 def discontinuities(
     scene: Scene,
     eee: bool = True,
-    events: Optional[str] = "complete",
+    events: str = "complete",
     event_tol: Optional[float] = None,
     max_elements: Optional[int] = None,
     threads: Optional[int] = None,
@@ -120,8 +121,8 @@ def reference(
     scene: Scene,
     points: np.ndarray,
     surfaces: Optional[list[int]] = None,
-    paths: Optional[int] = 4096,
-    seed: Optional[int] = 1,
+    paths: int = 4096,
+    seed: int = 1,
     threads: Optional[int] = None,
 ) -> tuple[np.ndarray, np.ndarray]: ...
 def locate(

@@ -56,9 +56,11 @@ def direct_light(
         facing = np.repeat(facing, len(at), axis=0)
     if len(facing) != len(at):
         raise ValueError(f"normals has {len(facing)} rows for {len(at)} points")
-    if not (np.abs(facing).max(axis=1, initial=0.0) > 0).all():
+    largest = np.abs(facing).max(axis=1, initial=0.0)
+    if not (largest > 0).all():
         raise ValueError("normals: every normal needs a direction (a zero row has none)")
-    ids = _checks.surface_ids(surfaces, "surfaces", len(at))
+    facing = facing / largest[:, None]  # the same directions, of lengths the native side can square
+    ids = _checks.surface_ids(surfaces, "surfaces", len(at), len(scene))
     return _native.direct_light(
         scene._native, at, facing, ids, _checks.count(threads, "threads")
     )
@@ -84,7 +86,7 @@ def discontinuities(
     found = _native.discontinuities(
         scene._native,
         _checks.flag(eee, "eee"),
-        _checks.choice(events, "events", ("complete", "extremal")),
+        _checks.choice(events, "events", ("complete", "extremal")) or "complete",
         _checks.number(event_tol, "event_tol"),
         _checks.count(max_elements, "max_elements"),
         _checks.count(threads, "threads"),
@@ -105,8 +107,8 @@ def reference(
     points: Any,
     *,
     surfaces: Any = None,
-    paths: int = 4096,
-    seed: int = 1,
+    paths: Optional[int] = 4096,
+    seed: Optional[int] = 1,
     threads: Optional[int] = None,
 ) -> Reference:
     """A Monte Carlo reference for full (multi-bounce) solutions: the radiosity B (W/m² per
@@ -119,14 +121,13 @@ def reference(
     random stream from ``seed``, so results do not depend on ``threads``."""
     scene = _scene(scene)
     at = _checks.rows3(points, "points")
-    ids = _checks.surface_ids(surfaces, "surfaces", len(at))
-    seed = _checks.count(seed, "seed", minimum=0)
+    ids = _checks.surface_ids(surfaces, "surfaces", len(at), len(scene))
     radiosity, error = _native.reference(
         scene._native,
         at,
         ids,
-        _checks.count(paths, "paths"),
-        seed,
+        4096 if paths is None else _checks.count(paths, "paths"),
+        1 if seed is None else _checks.count(seed, "seed", minimum=0),
         _checks.count(threads, "threads"),
     )
     return Reference(radiosity, error)

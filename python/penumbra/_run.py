@@ -104,7 +104,9 @@ def run(
     exception it raises stops the reports and is raised when the run ends.
 
     The GIL is released while the run computes. Ctrl-C stops it and raises
-    :class:`RunInterrupted` carrying the partial solution; ``interrupt.set()`` from another
+    :class:`RunInterrupted` carrying the partial solution (a second Ctrl-C raises at once,
+    leaving the run to end in the background); an exception from another signal handler is
+    raised as it is, with the partial solution as its ``solution`` attribute; ``interrupt.set()`` from another
     thread stops it and ``run`` returns the partial solution (``solution.partial``), or raises
     :class:`RunCancelled` if none existed yet; ``interrupt.clear()`` lets it start runs again.
 
@@ -147,12 +149,20 @@ def run(
         progress = None
     if progress is not None and not callable(progress):
         raise TypeError(f"progress must be True, False, None or a callable, not {type(progress).__name__}")
-    output, signalled = _native.run(
+    output, signal = _native.run(
         scene._native, arguments, _checks.count(threads, "threads"), interrupt, progress
     )
     solution = Solution(output) if output is not None else None
-    if signalled:
-        raise RunInterrupted(solution)
+    if isinstance(signal, KeyboardInterrupt):
+        raise RunInterrupted(solution) from signal
+    if signal is not None:
+        # Another signal handler's exception (a SIGALRM timeout, SystemExit on SIGTERM), as it
+        # was raised, with the best solution so far when it can carry one.
+        try:
+            signal.solution = solution
+        except (AttributeError, TypeError):
+            pass
+        raise signal
     if solution is None:
         raise RunCancelled("the run was interrupted before a solution existed")
     return solution

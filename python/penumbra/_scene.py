@@ -33,7 +33,7 @@ class Scene:
         (2, ['light', 'floor'])
     """
 
-    __slots__ = ("_native",)
+    __slots__ = ("_native", "_names", "_frame_list")
 
     def __init__(self, native: _native.Scene) -> None:
         if not isinstance(native, _native.Scene):
@@ -41,6 +41,16 @@ class Scene:
                 "make a Scene with Scene.load, Scene.builtin, Scene.from_polygons or Scene.from_json"
             )
         self._native = native
+        self._names: Optional[list[str]] = None
+        self._frame_list: Optional[list[dict[str, np.ndarray]]] = None
+
+    def _frames(self) -> list[dict[str, np.ndarray]]:
+        """Every surface's frame (see :meth:`frame`), made once."""
+        if self._frame_list is None:
+            self._frame_list = [
+                dict(zip(("origin", "u", "v", "normal"), rows)) for rows in self._native.frames
+            ]
+        return self._frame_list
 
     @staticmethod
     def load(path: SceneSource, *, merge: bool = True) -> "Scene":
@@ -172,18 +182,17 @@ class Scene:
         index = self.surface_id(surface) if isinstance(surface, str) else surface
         if isinstance(index, bool) or not isinstance(index, (int, np.integer)):
             raise TypeError(f"surface must be an index or a name, not {type(surface).__name__}")
-        frames = self._native.frames
+        frames = self._frames()
         if not -len(frames) <= index < len(frames):
             raise IndexError(f"surface {index} out of range: the scene has {len(frames)}")
-        rows = frames[index]
-        if rows is None:  # validation refuses polygons without a plane
-            raise ValueError(f"surface {index} has no plane")
-        return dict(zip(("origin", "u", "v", "normal"), rows))
+        return {key: value.copy() for key, value in frames[index].items()}
 
     def surface_id(self, name: str) -> int:
         """The index of the surface called ``name``."""
+        if self._names is None:
+            self._names = self._native.surface_names
         try:
-            return self.surface_names.index(name)
+            return self._names.index(name)
         except ValueError:
             raise KeyError(f"the scene has no surface named {name!r}") from None
 
@@ -203,7 +212,9 @@ class Scene:
 
     @property
     def surface_names(self) -> list[str]:
-        return self._native.surface_names
+        if self._names is None:
+            self._names = self._native.surface_names
+        return list(self._names)
 
     @property
     def polygons(self) -> list[np.ndarray]:

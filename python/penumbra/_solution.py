@@ -74,11 +74,18 @@ class SurfaceSolution:
         "irradiance", "direct_irradiance", "discontinuities", "_frame",
     )
 
-    def __init__(self, solution: "Solution", index: int) -> None:
+    def __init__(
+        self,
+        solution: "Solution",
+        index: int,
+        name: str,
+        frame: dict[str, np.ndarray],
+        discontinuities: Discontinuities,
+    ) -> None:
         v0, v1 = solution._vertex_offsets[index : index + 2]
         t0, t1 = solution._triangle_offsets[index : index + 2]
         self.index: int = index
-        self.name: str = solution.scene.surface_names[index]
+        self.name: str = name
         self.vertices: np.ndarray = solution.vertices[v0:v1]
         self.triangles: np.ndarray = _frozen(solution.triangles[t0:t1] - np.uint32(v0))
         self.radiosity: np.ndarray = solution.radiosity[v0:v1]
@@ -86,9 +93,8 @@ class SurfaceSolution:
         self.indirect: np.ndarray = solution.indirect[v0:v1]
         self.irradiance: np.ndarray = solution.irradiance[v0:v1]
         self.direct_irradiance: np.ndarray = solution.direct_irradiance[v0:v1]
-        self._frame = solution.scene.frame(index)
-        d = solution.discontinuities
-        self.discontinuities: Discontinuities = d.where(d.surface_id == index)
+        self._frame = frame
+        self.discontinuities: Discontinuities = discontinuities
 
     @property
     def uv(self) -> np.ndarray:
@@ -158,7 +164,21 @@ class Solution:
     def surfaces(self) -> list[SurfaceSolution]:
         """One :class:`SurfaceSolution` per surface, in the scene's order."""
         if self._surfaces is None:
-            self._surfaces = [SurfaceSolution(self, i) for i in range(len(self.scene))]
+            count = len(self.scene)
+            names, frames = self.scene.surface_names, self.scene._frames()
+            # Segments come surface after surface: each surface's are one slice.
+            d = self.discontinuities
+            bounds = np.searchsorted(d.surface_id, np.arange(count + 1))
+            mask = np.zeros(len(d), dtype=bool)
+
+            def segments_of(i: int) -> Discontinuities:
+                mask[:] = False
+                mask[bounds[i] : bounds[i + 1]] = True
+                return d.where(mask)
+
+            self._surfaces = [
+                SurfaceSolution(self, i, names[i], frames[i], segments_of(i)) for i in range(count)
+            ]
         return self._surfaces
 
     def __getitem__(self, key: Union[int, str]) -> SurfaceSolution:
@@ -195,7 +215,7 @@ class Solution:
             True
         """
         at = _checks.rows3(points, "points", allow_single=True)
-        ids = _checks.surface_ids(surfaces, "surfaces", len(at))
+        ids = _checks.surface_ids(surfaces, "surfaces", len(at), len(self.scene))
         if ids is None:
             ids = self.scene.locate(at).tolist()
         _checks.choice(
@@ -231,6 +251,8 @@ class Solution:
         if not isinstance(directory, (str, os.PathLike)):
             raise TypeError(f"directory must be a str or a path, not {type(directory).__name__}")
         if not isinstance(svg, str):
+            if not isinstance(svg, (list, tuple)) or not all(isinstance(n, str) for n in svg):
+                raise TypeError('svg must be "auto", "all", "none" or a list of surface names')
             svg = list(svg)
         return [Path(p) for p in self._native.write(os.fspath(directory), svg, bool(convergence))]
 

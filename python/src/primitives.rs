@@ -169,9 +169,9 @@ pub(crate) fn direct_light<'py>(
     }
     let pool = thread_pool(threads)?;
     let stop = penumbra_solver::Interrupt::default();
-    let data = scene.data();
-    let (values, signal) = without_gil(py, pool.as_ref(), &stop, || {
-        let visibility = scene.visibility();
+    let (shared, stopping) = (scene.shared(), stop.clone());
+    let (values, signal) = without_gil(py, pool, &stop, move || {
+        let (data, visibility) = (shared.data(), shared.visibility());
         let on = receivers(data, visibility, &at, Some(&normals), surfaces)?;
         let direct = DirectLight::new(data, visibility);
         // A surface id no surface has: nothing is left out of the occluders.
@@ -181,7 +181,7 @@ pub(crate) fn direct_light<'py>(
             .zip(&normals)
             .zip(&on)
             .map(|((&p, &n), s)| {
-                (!stop.is_set()).then(|| {
+                (!stopping.is_set()).then(|| {
                     direct.irradiance(&ReceivingPoint::interior(p, n), s.unwrap_or(nowhere))
                 })
             })
@@ -230,17 +230,17 @@ pub(crate) fn discontinuities<'py>(
     }
     let pool = thread_pool(threads)?;
     let stop = penumbra_solver::Interrupt::default();
-    let data = scene.data();
+    let shared = scene.shared();
     let options = DiscontinuityOptions {
         eee,
         events,
         event_tolerance,
-        element_area: max_elements.map(|n| data.total_area() / n as f64),
+        element_area: max_elements.map(|n| shared.data().total_area() / n as f64),
         interrupt: Some(stop.clone()),
         ..DiscontinuityOptions::default()
     };
-    let (found, signal) = without_gil(py, pool.as_ref(), &stop, || {
-        find_discontinuities(data, scene.visibility(), &options)
+    let (found, signal) = without_gil(py, pool, &stop, move || {
+        find_discontinuities(shared.data(), shared.visibility(), &options)
     })?;
     if signal.is_some() {
         return Err(interrupted(signal));
@@ -286,30 +286,44 @@ pub(crate) fn reference<'py>(
     }
     let pool = thread_pool(threads)?;
     let stop = penumbra_solver::Interrupt::default();
-    let data = scene.data();
-    let (values, signal) = without_gil(py, pool.as_ref(), &stop, || {
-        let visibility = scene.visibility();
+    let (shared, stopping) = (scene.shared(), stop.clone());
+    let (values, signal) = without_gil(py, pool, &stop, move || {
+        let (data, visibility) = (shared.data(), shared.visibility());
+        let given = surfaces.is_some();
         let on = receivers(data, visibility, &at, None, surfaces)?;
+        let surface = SurfaceLocator::new(data, visibility);
         let located: Vec<(DVec3, SurfaceId)> = at
             .iter()
             .zip(&on)
             .enumerate()
-            .map(|(i, (&p, s))| {
-                s.map(|s| (p, s)).ok_or_else(|| {
-                    bad_argument(
-                        "points",
-                        format!("point {i} ({p}) lies on no surface; give its surface in surfaces"),
-                    )
-                })
+            .map(|(i, (&p, s))| match *s {
+                Some(s) if surface.holds(s, p) => Ok((p, s)),
+                Some(s) => Err(bad_argument(
+                    "surfaces",
+                    format!("point {i} ({p}) does not lie on surface {s}"),
+                )),
+                None if given => Err(bad_argument(
+                    "surfaces",
+                    format!(
+                        "point {i} has no surface (-1); the reference needs the one it lies on"
+                    ),
+                )),
+                None => Err(bad_argument(
+                    "points",
+                    format!("point {i} ({p}) lies on no surface; give its surface in surfaces"),
+                )),
             })
             .collect::<PyResult<_>>()?;
         let tracer = PathTracer::new(data, visibility);
-        Ok::<_, PyErr>(tracer.radiosity(&located, &PathTraceOptions { paths, seed }))
+        let options = PathTraceOptions { paths, seed };
+        Ok::<_, PyErr>(tracer.radiosity_unless(&located, &options, Some(&stopping)))
     })?;
+    let Some(values) = values? else {
+        return Err(interrupted(signal));
+    };
     if signal.is_some() {
         return Err(interrupted(signal));
     }
-    let values = values?;
     let radiosity: Vec<Rgb> = values.iter().map(|v| v.radiosity).collect();
     let errors: Vec<f64> = values.iter().map(|v| v.standard_error).collect();
     Ok((
@@ -332,9 +346,9 @@ pub(crate) fn locate<'py>(
         Some(n) => Some(crate::arrays::points(&n, "normals")?),
         None => None,
     };
-    let data = scene.data();
+    let shared = scene.shared();
     let found = py.detach(|| {
-        SurfaceLocator::new(data, scene.visibility()).surfaces_at(&at, normals.as_deref())
+        SurfaceLocator::new(shared.data(), shared.visibility()).surfaces_at(&at, normals.as_deref())
     });
     let ids: Vec<i64> = found
         .into_iter()

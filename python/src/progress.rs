@@ -47,8 +47,10 @@ impl Callback {
         if failed.is_some() {
             return;
         }
-        let called = Python::attach(|py| self.callable.call1(py, (name, done, total)).map(drop));
-        if let Err(e) = called {
+        // `None`: the interpreter is shutting down, and nobody is listening.
+        let called =
+            Python::try_attach(|py| self.callable.call1(py, (name, done, total)).map(drop));
+        if let Some(Err(e)) = called {
             *failed = Some(e);
         }
     }

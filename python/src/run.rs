@@ -1,7 +1,7 @@
 //! `penumbra.run`: the command line's run, its options and defaults, with the GIL released
 //! while it computes and Ctrl-C or an [`Interrupt`] stopping it with the best solution so far.
 
-use std::sync::mpsc;
+use std::sync::{Arc, mpsc};
 use std::time::Duration;
 
 use penumbra::adaptive::{DEFAULT_MAX_ROUNDS, RefineOptions};
@@ -258,57 +258,71 @@ pub(crate) fn thread_pool(threads: Option<usize>) -> PyResult<Option<rayon::Thre
         .map_err(|e| PyRuntimeError::new_err(format!("cannot start {n} worker threads: {e}")))
 }
 
-/// Runs `work` on `pool` (or the global one) on a thread of its own with the GIL released,
-/// looking for Ctrl-C meanwhile: on a signal, `interrupt` is set and the work is waited for.
-/// Returns the work's result and the signal's exception, if one came. A panic in the work is a
+/// Runs `work` on `pool` (or the global one) on a thread of its own, with the GIL released
+/// while the calling thread waits, looking for Ctrl-C every [`SIGNAL_POLL`]. A first signal
+/// sets `interrupt` and the work is waited for (it stops at its next check); a second one is
+/// raised at once, and the work is left to end on its own in the background. Returns the work's
+/// result and the first signal's exception, if one came. A panic in the work is a
 /// `RuntimeError`, never the interpreter's end.
-pub(crate) fn without_gil<T: Send>(
+pub(crate) fn without_gil<T: Send + 'static>(
     py: Python<'_>,
-    pool: Option<&rayon::ThreadPool>,
+    pool: Option<rayon::ThreadPool>,
     interrupt: &penumbra_solver::Interrupt,
-    work: impl FnOnce() -> T + Send,
+    work: impl FnOnce() -> T + Send + 'static,
 ) -> PyResult<(T, Option<PyErr>)> {
-    let (result, signal) = py.detach(|| {
-        std::thread::scope(|scope| {
-            let (done, finished) = mpsc::channel();
-            let worker = scope.spawn(move || {
-                let result = match pool {
-                    Some(pool) => pool.install(work),
-                    None => work(),
-                };
-                // The receiver waits for this; if it is gone there is no one to tell.
-                let _ = done.send(());
-                result
-            });
-            let mut signal = None;
-            while let Err(mpsc::RecvTimeoutError::Timeout) = finished.recv_timeout(SIGNAL_POLL) {
-                if signal.is_none()
-                    && let Err(e) = Python::attach(|py| py.check_signals())
-                {
-                    interrupt.set();
-                    signal = Some(e);
-                }
-            }
-            (worker.join(), signal)
+    let (done, mut finished) = mpsc::channel();
+    let worker = std::thread::Builder::new()
+        .name("penumbra".into())
+        .spawn(move || {
+            let result = match pool {
+                Some(pool) => pool.install(work),
+                None => work(),
+            };
+            // Nobody waits any more after a second Ctrl-C: the result is dropped.
+            let _ = done.send(result);
         })
-    });
-    match result {
-        Ok(value) => Ok((value, signal)),
-        Err(panic) => {
-            let what = panic
-                .downcast_ref::<&str>()
-                .map(ToString::to_string)
-                .or_else(|| panic.downcast_ref::<String>().cloned())
-                .unwrap_or_default();
-            Err(PyRuntimeError::new_err(format!(
-                "penumbra failed inside (a bug; please report it with the scene): {what}"
-            )))
+        .map_err(|e| PyRuntimeError::new_err(format!("cannot start a worker thread: {e}")))?;
+    let mut signal = None;
+    loop {
+        // The waiting thread keeps its own thread state, so that Python can stop it at exit.
+        let (receiver, received) = py.detach(move || {
+            let received = finished.recv_timeout(SIGNAL_POLL);
+            (finished, received)
+        });
+        finished = receiver;
+        match received {
+            Ok(result) => return Ok((result, signal)),
+            Err(mpsc::RecvTimeoutError::Disconnected) => return Err(panicked(worker.join())),
+            Err(mpsc::RecvTimeoutError::Timeout) => {}
+        }
+        if let Err(e) = py.check_signals() {
+            if signal.is_some() {
+                return Err(e);
+            }
+            interrupt.set();
+            signal = Some(e);
         }
     }
 }
 
+/// The error of a worker that ended without a result.
+fn panicked(joined: std::thread::Result<()>) -> PyErr {
+    let what = match joined {
+        Ok(()) => String::from("the worker ended without a result"),
+        Err(panic) => panic
+            .downcast_ref::<&str>()
+            .map(ToString::to_string)
+            .or_else(|| panic.downcast_ref::<String>().cloned())
+            .unwrap_or_default(),
+    };
+    PyRuntimeError::new_err(format!(
+        "penumbra failed inside (a bug; please report it with the scene): {what}"
+    ))
+}
+
 /// Runs the pipeline on `scene`. Returns the run's output (`None` when it was stopped before a
-/// solution existed) and whether Ctrl-C stopped it (the Python side raises `RunInterrupted`).
+/// solution existed) and the exception of the signal that stopped it, if one did (the Python
+/// side raises `RunInterrupted` for Ctrl-C, and a signal handler's own exception as it is).
 #[pyfunction]
 #[pyo3(signature = (scene, arguments, threads = None, interrupt = None, progress = None))]
 pub(crate) fn run(
@@ -318,24 +332,25 @@ pub(crate) fn run(
     threads: Option<usize>,
     interrupt: Option<&Interrupt>,
     progress: Option<Py<PyAny>>,
-) -> PyResult<(Option<RunOutput>, bool)> {
+) -> PyResult<(Option<RunOutput>, Option<Py<PyAny>>)> {
     let interrupt = interrupt.cloned().unwrap_or_default().0;
     let options = arguments.options(&interrupt)?;
     options.validate().map_err(|e| invalid_option(&e))?;
     let pool = thread_pool(threads)?;
-    let loaded = scene.loaded.clone();
-    let callback = progress.map(Callback::new);
-    let (outcome, signal) = without_gil(py, pool.as_ref(), &interrupt, || match &callback {
-        Some(callback) => penumbra::run(loaded, &options, callback),
+    let loaded = scene.loaded().clone();
+    let callback = progress.map(|p| Arc::new(Callback::new(p)));
+    let reporter = callback.clone();
+    let (outcome, signal) = without_gil(py, pool, &interrupt, move || match &reporter {
+        Some(callback) => penumbra::run(loaded, &options, callback.as_ref()),
         None => penumbra::run(loaded, &options, &NoProgress),
     })?;
     if let Some(e) = callback.and_then(|c| c.error()) {
         return Err(e);
     }
-    let signalled = signal.is_some();
+    let signal = signal.map(|e| e.into_value(py).into_any());
     match outcome {
-        Ok(result) => Ok((Some(RunOutput::new(result)), signalled)),
-        Err(penumbra::RunError::Solve(SolveError::Interrupted)) => Ok((None, signalled)),
+        Ok(result) => Ok((Some(RunOutput::new(result)), signal)),
+        Err(penumbra::RunError::Solve(SolveError::Interrupted)) => Ok((None, signal)),
         Err(e) => Err(run_error(e)),
     }
 }

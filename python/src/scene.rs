@@ -18,18 +18,40 @@ use crate::errors::{bad_argument, scene_error};
 /// A camera as Python gives it: eye, target, up and the vertical field of view in degrees.
 type CameraParts = ([f64; 3], [f64; 3], [f64; 3], f64);
 
+/// A validated scene and its visibility index, built when first needed and kept (the scene
+/// never changes); shared by the Python object and the work it starts.
+pub(crate) struct Shared {
+    pub(crate) loaded: LoadedScene,
+    visibility: OnceLock<Visibility>,
+}
+
+impl Shared {
+    pub(crate) fn data(&self) -> &SceneData {
+        &self.loaded.scene
+    }
+
+    /// The scene's visibility index (built on first use: call it without the GIL).
+    pub(crate) fn visibility(&self) -> &Visibility {
+        self.visibility
+            .get_or_init(|| Visibility::build(&self.loaded.scene))
+    }
+}
+
 /// A validated scene. Immutable: every constructor validates, so every `Scene` can be run.
 #[pyclass(module = "penumbra._native", frozen)]
 #[derive(Clone)]
 pub(crate) struct Scene {
-    pub(crate) loaded: LoadedScene,
-    /// The visibility index, built when first needed and kept (the scene never changes).
-    visibility: OnceLock<Arc<Visibility>>,
+    shared: Arc<Shared>,
 }
 
 impl Scene {
     /// A scene made in memory, validated: every problem at once in the error.
-    fn validated(py: Python<'_>, scene: SceneData, source: String) -> PyResult<Scene> {
+    fn validated(
+        py: Python<'_>,
+        scene: SceneData,
+        source: String,
+        warnings: Vec<String>,
+    ) -> PyResult<Scene> {
         let problems = penumbra_scenes::validate(&scene);
         if !problems.is_empty() {
             return Err(scene_error(
@@ -37,32 +59,37 @@ impl Scene {
                 penumbra_scenes::SceneError::Invalid {
                     source_name: source,
                     problems,
-                    warnings: Vec::new(),
+                    warnings,
                 },
             ));
         }
         Ok(Scene::new(LoadedScene {
             scene,
             source,
-            warnings: Vec::new(),
+            warnings,
         }))
     }
 
     pub(crate) fn new(loaded: LoadedScene) -> Scene {
         Scene {
-            loaded,
-            visibility: OnceLock::new(),
+            shared: Arc::new(Shared {
+                loaded,
+                visibility: OnceLock::new(),
+            }),
         }
     }
 
-    pub(crate) fn data(&self) -> &SceneData {
-        &self.loaded.scene
+    /// The scene and its index, for work on another thread.
+    pub(crate) fn shared(&self) -> Arc<Shared> {
+        Arc::clone(&self.shared)
     }
 
-    /// The scene's visibility index (built on first use; call without the GIL).
-    pub(crate) fn visibility(&self) -> &Visibility {
-        self.visibility
-            .get_or_init(|| Arc::new(Visibility::build(&self.loaded.scene)))
+    pub(crate) fn loaded(&self) -> &LoadedScene {
+        &self.shared.loaded
+    }
+
+    pub(crate) fn data(&self) -> &SceneData {
+        self.shared.data()
     }
 }
 
@@ -91,7 +118,7 @@ impl Scene {
     #[staticmethod]
     fn builtin(py: Python<'_>, name: &str) -> PyResult<Scene> {
         match penumbra_scenes::builtin::builtin(name) {
-            Some(scene) => Scene::validated(py, scene, format!("builtin:{name}")),
+            Some(scene) => Scene::validated(py, scene, format!("builtin:{name}"), Vec::new()),
             None => Err(scene_error(
                 py,
                 penumbra_scenes::SceneError::UnknownScene {
@@ -110,7 +137,7 @@ impl Scene {
     fn from_json(py: Python<'_>, text: &str) -> PyResult<Scene> {
         let scene = penumbra_scenes::parse_json(text, Path::new("<json>"))
             .map_err(|e| scene_error(py, e))?;
-        Scene::validated(py, scene, "json".to_owned())
+        Scene::validated(py, scene, "json".to_owned(), Vec::new())
     }
 
     /// Surfaces from arrays: `names` (S), `corners` (P, 3) with `counts` (S) corners each, in
@@ -170,7 +197,7 @@ impl Scene {
             camera,
             surfaces,
         };
-        Scene::validated(py, scene, "python".to_owned())
+        Scene::validated(py, scene, "python".to_owned(), Vec::new())
     }
 
     /// The scene in penumbra's JSON format.
@@ -186,13 +213,13 @@ impl Scene {
     /// Where the scene came from: a path, `builtin:NAME`, `json` or `python`.
     #[getter]
     fn source(&self) -> &str {
-        &self.loaded.source
+        &self.loaded().source
     }
 
     /// What loading repaired (OBJ files), one line each.
     #[getter]
     fn warnings(&self) -> Vec<String> {
-        self.loaded.warnings.clone()
+        self.loaded().warnings.clone()
     }
 
     #[getter]
@@ -286,7 +313,7 @@ impl Scene {
         up: Option<[f64; 3]>,
         fov_deg: Option<f64>,
     ) -> PyResult<Scene> {
-        let mut scene = self.loaded.scene.clone();
+        let mut scene = self.data().clone();
         let base = scene
             .camera
             .unwrap_or_else(|| penumbra_viz::default_camera(&scene));
@@ -296,15 +323,14 @@ impl Scene {
             up: up.map_or(base.up, DVec3::from),
             fov_deg: fov_deg.unwrap_or(base.fov_deg),
         });
-        let mut with = Scene::validated(py, scene, self.loaded.source.clone())?;
-        with.loaded.warnings.clone_from(&self.loaded.warnings);
-        Ok(with)
+        let loaded = self.loaded();
+        Scene::validated(py, scene, loaded.source.clone(), loaded.warnings.clone())
     }
 
     /// A hash of the whole scene (its JSON form), as `report.json` records it.
     #[getter]
     fn fingerprint(&self) -> String {
-        penumbra::shard::scene_fingerprint(&self.loaded)
+        penumbra::shard::scene_fingerprint(self.loaded())
     }
 
     fn __len__(&self) -> usize {

@@ -86,6 +86,22 @@ def test_other_bad_arguments_name_themselves():
         penumbra.reference(TEXTBOOK, [[0, 0, 0]], paths=10**12)
     with pytest.raises(ValueError, match="events"):
         penumbra.discontinuities(TEXTBOOK, events="all")
+    assert len(penumbra.discontinuities(TEXTBOOK, events=None)) == len(penumbra.discontinuities(TEXTBOOK))
+    floor = TEXTBOOK.surface_id("floor")
+    with pytest.raises(ValueError, match="point 0 .* does not lie on surface"):
+        penumbra.reference(TEXTBOOK, [[0.8, 0.1, -50]], surfaces=[floor])
+    with pytest.raises(ValueError, match="point 0 has no surface"):
+        penumbra.reference(TEXTBOOK, [[0.8, 0.1, 0]], surfaces=[-1])
+    with pytest.raises(ValueError, match="no surface id"):
+        penumbra.direct_light(TEXTBOOK, [[0, 0, 0]], [0, 0, 1], surfaces=np.array([2**63], np.uint64))
+    with pytest.raises(TypeError, match="svg"):
+        penumbra.run(TEXTBOOK, direct_only=True, max_elements=500).write("unused", svg=5)
+    with pytest.raises(ValueError, match="width/height"):
+        penumbra.run(TEXTBOOK, width=16384, height=16384)  # each side allowed, not the whole
+    # Normals of any length that has a direction.
+    tiny = penumbra.direct_light(TEXTBOOK, [[2, 2, 0]], [0, 0, 1e-300])
+    assert np.array_equal(tiny, penumbra.direct_light(TEXTBOOK, [[2, 2, 0]], [0, 0, 1e300]))
+    assert tiny.max() > 0
     with pytest.raises(ValueError, match="reflectance has 1 rows for 2 polygons"):
         penumbra.Scene.from_polygons([[[0, 0, 0], [1, 0, 0], [0, 1, 0]]] * 2, reflectance=[[0.5] * 3])
     with pytest.raises(ValueError, match=r"polygons\[1\] must have shape"):

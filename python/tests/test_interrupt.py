@@ -58,3 +58,75 @@ def test_ctrl_c_raises_with_the_partial_solution():
     assert time.perf_counter() - started < STOP_AFTER + PROMPT
     assert isinstance(raised.value, penumbra.RunInterrupted)
     _assert_partial(raised.value.solution)
+
+
+MAIN_THREAD = pytest.mark.skipif(
+    threading.current_thread() is not threading.main_thread(), reason="signals reach the main thread"
+)
+
+
+@MAIN_THREAD
+def test_a_second_ctrl_c_returns_at_once():
+    # Meshing 150,000 triangles takes seconds and looks at no interrupt: the first Ctrl-C waits
+    # for it, the second does not (the run ends on its own in the background).
+    for delay in (0.5, 1.0):
+        threading.Timer(delay, os.kill, (os.getpid(), signal.SIGINT)).start()
+    started = time.perf_counter()
+    with pytest.raises(KeyboardInterrupt) as raised:
+        penumbra.run(penumbra.Scene.builtin("boxworld"), max_elements=150000, direct_only=True)
+    assert time.perf_counter() - started < 1.0 + PROMPT
+    assert not isinstance(raised.value, penumbra.RunInterrupted)
+
+
+class Timeout(Exception):
+    pass
+
+
+@MAIN_THREAD
+def test_another_signal_handlers_exception_is_raised_as_it_is():
+    def alarm(signum, frame):
+        raise Timeout("too slow")
+
+    previous = signal.signal(signal.SIGALRM, alarm)
+    try:
+        signal.setitimer(signal.ITIMER_REAL, STOP_AFTER)
+        with pytest.raises(Timeout, match="too slow") as raised:
+            penumbra.run(penumbra.Scene.builtin("cornell"), **LONG)
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+    _assert_partial(raised.value.solution)
+
+
+@MAIN_THREAD
+def test_ctrl_c_stops_a_reference_between_points():
+    scene = penumbra.Scene.builtin("cornell")
+    floor = [[x, 0.0, z] for x in np.linspace(50, 500, 10) for z in np.linspace(50, 500, 10)]
+    threading.Timer(1.0, os.kill, (os.getpid(), signal.SIGINT)).start()
+    started = time.perf_counter()
+    with pytest.raises(KeyboardInterrupt):
+        penumbra.reference(scene, floor, paths=200_000)
+    assert time.perf_counter() - started < 1.0 + PROMPT
+
+
+DAEMON = """
+import sys, threading, time, penumbra
+scene = penumbra.Scene.builtin("boxworld")
+work = {
+    "run": lambda: penumbra.run(scene, max_elements=12000),
+    "progress": lambda: penumbra.run(scene, max_elements=12000, progress=lambda *a: None),
+    "direct_light": lambda: penumbra.direct_light(scene, [[0.5, 0.5, 0.0]] * 200000, [0, 0, 1]),
+}[sys.argv[1]]
+threading.Thread(target=work, daemon=True).start()
+time.sleep(0.3)
+"""
+
+
+@pytest.mark.parametrize("work", ["run", "progress", "direct_light"])
+def test_the_interpreter_exits_cleanly_with_work_under_way(work):
+    import subprocess
+    import sys
+
+    for _ in range(3):
+        done = subprocess.run([sys.executable, "-c", DAEMON, work], capture_output=True, text=True, timeout=120)
+        assert done.returncode == 0, (done.returncode, done.stderr)

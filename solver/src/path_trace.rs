@@ -21,6 +21,7 @@ use penumbra_scenes::{PlaneFrame, Rgb, Scene, SurfaceId, Visibility};
 use rayon::prelude::*;
 use serde::Serialize;
 
+use crate::Interrupt;
 use crate::direct::DirectLight;
 use crate::lambert::ReceivingPoint;
 
@@ -104,12 +105,26 @@ impl<'a> PathTracer<'a> {
         points: &[(DVec3, SurfaceId)],
         options: &PathTraceOptions,
     ) -> Vec<ReferenceValue> {
+        self.radiosity_unless(points, options, None)
+            .unwrap_or_default()
+    }
+
+    /// [`Self::radiosity`], or `None` once `interrupt` is set (points under way finish).
+    pub fn radiosity_unless(
+        &self,
+        points: &[(DVec3, SurfaceId)],
+        options: &PathTraceOptions,
+        interrupt: Option<&Interrupt>,
+    ) -> Option<Vec<ReferenceValue>> {
         points
             .par_iter()
             .enumerate()
             .map(|(k, &(x, s))| {
+                if interrupt.is_some_and(Interrupt::is_set) {
+                    return None;
+                }
                 let mut rng = SplitMix64::keyed(options.seed, &[k as u64]);
-                self.radiosity_at(x, s, options.paths.max(2), &mut rng)
+                Some(self.radiosity_at(x, s, options.paths.max(2), &mut rng))
             })
             .collect()
     }

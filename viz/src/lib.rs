@@ -70,6 +70,6 @@ mod tonemap;
 pub use camera::{DEFAULT_FOV_DEG, DEFAULT_VIEW_DIRECTION, camera_looking, default_camera};
 pub use chart::{LogLogChart, Series};
 pub use error::VizError;
-pub use render::{Render, RenderOptions, encode_png, render};
+pub use render::{MAX_PIXELS, Render, RenderOptions, encode_png, render};
 pub use surface_svg::surface_svg;
 pub use tonemap::srgb_encode;

@@ -23,7 +23,7 @@ use crate::tonemap::{auto_exposure, luminance, to_srgb8};
 /// diagonal: small enough that a camera standing close to a wall still sees it.
 pub(crate) const NEAR_PLANE_FRACTION: f64 = 1e-4;
 /// The largest image [`render`] draws, in pixels (8192 x 8192).
-pub(crate) const MAX_PIXELS: u64 = 1 << 26;
+pub const MAX_PIXELS: u64 = 1 << 26;
 /// Rows per band: the unit of parallel work.
 const BAND_ROWS: u32 = 16;
 
