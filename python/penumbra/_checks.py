@@ -39,13 +39,19 @@ def count(value: Any, name: str, *, minimum: int = 1, maximum: int = MAX_COUNT) 
     """A whole number from ``minimum`` to ``maximum``, or None."""
     if value is None:
         return None
+    return whole(value, name, minimum=minimum, maximum=maximum)
+
+
+def whole(value: Any, name: str, *, minimum: int = 1, maximum: int = MAX_COUNT) -> int:
+    """A whole number from ``minimum`` to ``maximum``."""
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
         raise TypeError(f"{name} must be a whole number, not {type(value).__name__}")
-    if value < minimum:
-        raise ValueError(f"{name} must be at least {minimum}, not {value}")
-    if value > maximum:
-        raise ValueError(f"{name} must be at most {maximum}, not {value}")
-    return int(value)
+    result = int(value)
+    if result < minimum:
+        raise ValueError(f"{name} must be at least {minimum}, not {result}")
+    if result > maximum:
+        raise ValueError(f"{name} must be at most {maximum}, not {result}")
+    return result
 
 
 def number(value: Any, name: str, *, positive: bool = False) -> Optional[float]:
@@ -54,12 +60,12 @@ def number(value: Any, name: str, *, positive: bool = False) -> Optional[float]:
         return None
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
         raise TypeError(f"{name} must be a number, not {type(value).__name__}")
-    value = float(value)
-    if not math.isfinite(value):
-        raise ValueError(f"{name} must be finite, not {value}")
-    if positive and value <= 0:
-        raise ValueError(f"{name} must be positive, not {value}")
-    return value
+    result = float(value)
+    if not math.isfinite(result):
+        raise ValueError(f"{name} must be finite, not {result}")
+    if positive and result <= 0:
+        raise ValueError(f"{name} must be positive, not {result}")
+    return result
 
 
 def flag(value: Any, name: str) -> bool:

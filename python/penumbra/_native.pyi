@@ -1,9 +1,23 @@
 """Type stubs of penumbra's native module (the Rust half). Use the public API in `penumbra`."""
 
 from pathlib import Path
-from typing import Any, Callable, Optional, Sequence, Union
+from typing import Any, Callable, Optional, Sequence, Union, final
 
 import numpy as np
+
+__all__ = [
+    "SceneError",
+    "__version__",
+    "Scene",
+    "Interrupt",
+    "RunOutput",
+    "builtin_scenes",
+    "run",
+    "direct_light",
+    "discontinuities",
+    "reference",
+    "locate",
+]
 
 __version__: str
 
@@ -15,6 +29,7 @@ class SceneError(ValueError):
     warnings: list[str]
     """What loading repaired first (OBJ files), one line each."""
 
+@final
 class Scene:
     @staticmethod
     def load(path: str, merge: bool = True) -> Scene: ...
@@ -68,6 +83,7 @@ class Scene:
     def fingerprint(self) -> str: ...
     def __len__(self) -> int: ...
 
+@final
 class Interrupt:
     """Asks the runs given it to stop, from any thread: `run` then returns the best solution
     so far, marked partial."""
@@ -78,6 +94,7 @@ class Interrupt:
     @property
     def is_set(self) -> bool: ...
 
+@final
 class RunOutput:
     def arrays(self) -> dict[str, Any]: ...
     def report_json(self, svg: Union[str, Sequence[str], None] = None) -> str: ...

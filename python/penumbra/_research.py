@@ -126,8 +126,8 @@ def reference(
         scene._native,
         at,
         ids,
-        4096 if paths is None else _checks.count(paths, "paths"),
-        1 if seed is None else _checks.count(seed, "seed", minimum=0),
+        4096 if paths is None else _checks.whole(paths, "paths"),
+        1 if seed is None else _checks.whole(seed, "seed", minimum=0),
         _checks.count(threads, "threads"),
     )
     return Reference(radiosity, error)

@@ -159,7 +159,7 @@ def run(
         # Another signal handler's exception (a SIGALRM timeout, SystemExit on SIGTERM), as it
         # was raised, with the best solution so far when it can carry one.
         try:
-            signal.solution = solution
+            setattr(signal, "solution", solution)
         except (AttributeError, TypeError):
             pass
         raise signal

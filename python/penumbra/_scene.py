@@ -47,9 +47,12 @@ class Scene:
     def _frames(self) -> list[dict[str, np.ndarray]]:
         """Every surface's frame (see :meth:`frame`), made once."""
         if self._frame_list is None:
-            self._frame_list = [
-                dict(zip(("origin", "u", "v", "normal"), rows)) for rows in self._native.frames
-            ]
+            frames = []
+            for i, rows in enumerate(self._native.frames):
+                if rows is None:  # validation refuses polygons without a plane
+                    raise ValueError(f"surface {i} has no plane")
+                frames.append(dict(zip(("origin", "u", "v", "normal"), rows)))
+            self._frame_list = frames
         return self._frame_list
 
     @staticmethod
