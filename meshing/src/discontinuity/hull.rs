@@ -1,7 +1,8 @@
 //! Convex hulls of a few points as planes: the shaft between an emitter and a receiver, and the
 //! region an EEE event's second edge must reach into.
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
+use penumbra_scenes::PlaneFrame;
 
 /// The outward planes (normal, point) of the convex hull of `points`: every plane through three
 /// of them with all the others on one side (within `tol`). Quartic in the count, for the handful
@@ -31,6 +32,100 @@ pub(super) fn hull_planes(points: &[DVec3], tol: f64) -> Vec<(DVec3, DVec3)> {
         }
     }
     planes
+}
+
+/// The outward planes of the convex hull of two planar polygons' corners, as [`hull_planes`]
+/// finds them for the corners together (each plane once or a few times rather than once per
+/// triple of corners), in time linear in the corners of each times those of the other rather
+/// than quartic in all: a light with hundreds of corners made [`hull_planes`] store one copy of
+/// its plane per triple of them. A supporting plane through two corners of one polygon, other
+/// than that polygon's own, meets its plane in a supporting line, so it holds an edge of that
+/// polygon's convex hull; the planes are each polygon's own (where supporting) and those through
+/// a hull edge of one and a corner of the other.
+pub(super) fn polygon_pair_hull_planes(
+    polygons: [(&[DVec3], &PlaneFrame); 2],
+    tol: f64,
+) -> Vec<(DVec3, DVec3)> {
+    let corners: Vec<DVec3> = polygons
+        .iter()
+        .flat_map(|(p, _)| p.iter().copied())
+        .collect();
+    let mut planes = Vec::new();
+    let mut supporting = |p: DVec3, q: DVec3, r: DVec3| {
+        if let Some(plane) = supporting_plane(&corners, p, q, r, tol) {
+            planes.push(plane);
+        }
+    };
+    for (k, &(polygon, frame)) in polygons.iter().enumerate() {
+        let other = polygons[1 - k].0;
+        let hull = convex_hull(polygon, frame);
+        if let [a, b, c, ..] = hull[..] {
+            supporting(polygon[a], polygon[b], polygon[c]);
+        }
+        for (i, &a) in hull.iter().enumerate() {
+            let b = hull[(i + 1) % hull.len()];
+            for &r in other {
+                supporting(polygon[a], polygon[b], r);
+            }
+        }
+    }
+    planes
+}
+
+/// The outward plane through `p`, `q` and `r` if every corner lies on its inner side (within
+/// `tol`).
+fn supporting_plane(
+    corners: &[DVec3],
+    p: DVec3,
+    q: DVec3,
+    r: DVec3,
+    tol: f64,
+) -> Option<(DVec3, DVec3)> {
+    let normal = (q - p).cross(r - p).try_normalize()?;
+    let (lo, hi) = corners.iter().fold((0.0f64, 0.0f64), |(lo, hi), &x| {
+        let h = normal.dot(x - p);
+        (lo.min(h), hi.max(h))
+    });
+    if hi <= tol {
+        Some((normal, p))
+    } else if lo >= -tol {
+        Some((-normal, p))
+    } else {
+        None
+    }
+}
+
+/// The corners of `polygon` on its convex hull in its plane, counter-clockwise (Andrew's
+/// monotone chain; corners on a hull edge's line between its ends are left out). Rounding may
+/// keep a corner that is not quite on the hull or drop one that is: the planes built on the
+/// hull's edges are checked against every corner, and a missing one only makes the shaft
+/// wider.
+fn convex_hull(polygon: &[DVec3], frame: &PlaneFrame) -> Vec<usize> {
+    let points: Vec<DVec2> = polygon.iter().map(|&p| frame.to_2d(p)).collect();
+    let mut order: Vec<usize> = (0..points.len()).collect();
+    order.sort_by(|&i, &j| {
+        points[i]
+            .x
+            .total_cmp(&points[j].x)
+            .then(points[i].y.total_cmp(&points[j].y))
+    });
+    let turns_left = |a: usize, b: usize, c: usize| {
+        (points[b] - points[a]).perp_dot(points[c] - points[a]) > 0.0
+    };
+    let chain = |indices: &mut dyn Iterator<Item = usize>| {
+        let mut half: Vec<usize> = Vec::new();
+        for i in indices {
+            while half.len() >= 2 && !turns_left(half[half.len() - 2], half[half.len() - 1], i) {
+                half.pop();
+            }
+            half.push(i);
+        }
+        half.pop();
+        half
+    };
+    let mut hull = chain(&mut order.iter().copied());
+    hull.extend(chain(&mut order.iter().rev().copied()));
+    hull
 }
 
 /// Whether all of `points` lie more than `tol` beyond one of the `planes`: then nothing spanned by
@@ -71,7 +166,21 @@ struct PlaneGroup {
 impl HullPlanes {
     /// The hull planes of `points` ([`hull_planes`]), grouped for points tested later that lie
     /// within `extent` of every one of `points`.
+    #[cfg(test)]
     pub(super) fn new(points: &[DVec3], tol: f64, extent: f64) -> HullPlanes {
+        HullPlanes::grouped(hull_planes(points, tol), tol, extent)
+    }
+
+    /// The planes of [`polygon_pair_hull_planes`], grouped as [`Self::new`] groups them.
+    pub(super) fn of_polygons(
+        polygons: [(&[DVec3], &PlaneFrame); 2],
+        tol: f64,
+        extent: f64,
+    ) -> HullPlanes {
+        HullPlanes::grouped(polygon_pair_hull_planes(polygons, tol), tol, extent)
+    }
+
+    fn grouped(planes: Vec<(DVec3, DVec3)>, tol: f64, extent: f64) -> HullPlanes {
         // Rounding of one height `n . (x - o)` with |n| = 1 and |x - o| <= extent is below 5 units
         // in the last place of `extent`; four times that for both evaluations and the sums here.
         let rounding = 20.0 * f64::EPSILON * extent;
@@ -81,7 +190,7 @@ impl HullPlanes {
             ((n - n0).length() * extent + n0.dot(o0 - o).abs()) * (1.0 + 1e-9) + rounding
         };
         let mut groups: Vec<PlaneGroup> = Vec::new();
-        for plane in hull_planes(points, tol) {
+        for plane in planes {
             let fits = groups.iter_mut().find_map(|g| {
                 let spread = spread_of((g.normal, g.origin), plane);
                 (spread <= GROUP_SPREAD * tol).then_some((g, spread))
@@ -147,6 +256,80 @@ mod tests {
         assert!(!beyond_a_face(&planes, &inside, 1e-12));
         assert!(!beyond_a_face(&planes, &crossing, 1e-12));
         assert!(beyond_a_face(&planes, &outside, 1e-12));
+    }
+
+    /// A regular `k`-gon of radius `r` at height `z`, turned by `turn`, facing down; with `notch`,
+    /// every other corner pulled in (not convex).
+    fn ring(k: usize, r: f64, z: f64, turn: f64, notch: bool) -> Vec<DVec3> {
+        (0..k)
+            .map(|i| {
+                let a = turn - i as f64 * std::f64::consts::TAU / k as f64;
+                let r = if notch && i % 2 == 1 { 0.6 * r } else { r };
+                DVec3::new(r * a.cos(), r * a.sin(), z)
+            })
+            .collect()
+    }
+
+    /// The planes of two polygons' hull are those of their corners' hull: each plane of one set
+    /// is a plane of the other (to rounding), and points beyond a face of one are beyond a face
+    /// of the other, for convex polygons and polygons with notches.
+    #[test]
+    fn polygon_pairs_have_the_hull_of_their_corners() {
+        let mut rng = penumbra_scenes::SplitMix64::new(11);
+        let tol = 1e-9;
+        for (k, notch) in [(3, false), (4, false), (7, true), (12, false), (10, true)] {
+            let light = ring(k, 1.0, 3.0, 0.3, notch);
+            let mut floor = ring(6, 3.0, 0.0, 0.1, false);
+            floor.reverse(); // facing up
+            let frames = [&light, &floor].map(|p| PlaneFrame::of_polygon(p).expect("a plane"));
+            let old = hull_planes(&[light.clone(), floor.clone()].concat(), tol);
+            let new = polygon_pair_hull_planes([(&light, &frames[0]), (&floor, &frames[1])], tol);
+            let same = |(n, o): (DVec3, DVec3), (m, p): (DVec3, DVec3)| {
+                (n - m).length() < 1e-9 && n.dot(p - o).abs() < 1e-9
+            };
+            for &plane in &old {
+                assert!(
+                    new.iter().any(|&q| same(plane, q)),
+                    "{k}-gon: {plane:?} missing"
+                );
+            }
+            for &plane in &new {
+                assert!(
+                    old.iter().any(|&q| same(plane, q)),
+                    "{k}-gon: {plane:?} extra"
+                );
+            }
+            for _ in 0..2_000 {
+                let mut point = || {
+                    DVec3::new(
+                        rng.next_f64() * 8.0 - 4.0,
+                        rng.next_f64() * 8.0 - 4.0,
+                        rng.next_f64() * 5.0 - 1.0,
+                    )
+                };
+                let triangle = [point(), point(), point()];
+                assert_eq!(
+                    beyond_a_face(&new, &triangle, tol),
+                    beyond_a_face(&old, &triangle, tol)
+                );
+            }
+        }
+    }
+
+    /// A light of many corners gives a hull of about as many planes, not one per triple.
+    #[test]
+    fn many_corners_give_few_planes() {
+        let light = ring(500, 0.5, 2.0, 0.0, false);
+        let mut floor = ring(4, 2.0, 0.0, 0.7, false);
+        floor.reverse();
+        let frames = [&light, &floor].map(|p| PlaneFrame::of_polygon(p).expect("a plane"));
+        let planes = polygon_pair_hull_planes([(&light, &frames[0]), (&floor, &frames[1])], 1e-9);
+        // Two own planes, 500 + 4 side faces, each found from one or two of its edges.
+        assert!(
+            (504..=2 * 504 + 2).contains(&planes.len()),
+            "{}",
+            planes.len()
+        );
     }
 
     /// Grouped planes answer as all planes do, at points near the planes' tolerance band too.

@@ -239,9 +239,11 @@ impl<'a> SearchContext<'a> {
         let (emitter, receiver) = (&self.scene.surfaces[e], &self.scene.surfaces[r]);
         let (ef, rf) = (pair.emitter_frame, pair.receiver_frame);
         let tol = self.tol;
-        let mut ends = emitter.polygon.clone();
-        ends.extend(&receiver.polygon);
-        let hull = hull::HullPlanes::new(&ends, tol, self.reach);
+        let hull = hull::HullPlanes::of_polygons(
+            [(&emitter.polygon, &ef), (&receiver.polygon, &rf)],
+            tol,
+            self.reach,
+        );
         // A blocker must have a vertex in front of both and must not lie wholly beyond one of
         // the hull's faces.
         let blockers = shaft_blockers(
