@@ -13,21 +13,9 @@ pub(super) fn hull_planes(points: &[DVec3], tol: f64) -> Vec<(DVec3, DVec3)> {
     for i in 0..n {
         for j in i + 1..n {
             for k in j + 1..n {
-                let Some(normal) = (points[j] - points[i])
-                    .cross(points[k] - points[i])
-                    .try_normalize()
-                else {
-                    continue;
-                };
-                let (lo, hi) = points.iter().fold((0.0f64, 0.0f64), |(lo, hi), &p| {
-                    let h = normal.dot(p - points[i]);
-                    (lo.min(h), hi.max(h))
-                });
-                if hi <= tol {
-                    planes.push((normal, points[i]));
-                } else if lo >= -tol {
-                    planes.push((-normal, points[i]));
-                }
+                planes.extend(supporting_plane(
+                    points, points[i], points[j], points[k], tol,
+                ));
             }
         }
     }
