@@ -35,6 +35,16 @@ def rows3(value: Any, name: str, *, allow_single: bool = False) -> np.ndarray:
 MAX_COUNT = 2**64 - 1
 
 
+def normals(value: Any, name: str, points: int) -> np.ndarray:
+    """One normal per point, (points, 3): given so, or one (3,) normal for all."""
+    rows = rows3(value, name, allow_single=True)
+    if len(rows) == 1 and points != 1:
+        rows = np.repeat(rows, points, axis=0)
+    if len(rows) != points:
+        raise ValueError(f"{name} has {len(rows)} rows for {points} points")
+    return rows
+
+
 def count(value: Any, name: str, *, minimum: int = 1, maximum: int = MAX_COUNT) -> Optional[int]:
     """A whole number from ``minimum`` to ``maximum``, or None."""
     if value is None:

@@ -1,7 +1,7 @@
 """Type stubs of penumbra's native module (the Rust half). Use the public API in `penumbra`."""
 
 from pathlib import Path
-from typing import Any, Callable, Optional, Sequence, Union, final
+from typing import Any, Callable, Optional, Union, final
 
 import numpy as np
 
@@ -97,7 +97,7 @@ class Interrupt:
 @final
 class RunOutput:
     def arrays(self) -> dict[str, Any]: ...
-    def report_json(self, svg: Union[str, Sequence[str], None] = None) -> str: ...
+    def report_json(self) -> str: ...
     def solution_json(self) -> str: ...
     def write(
         self, directory: str, svg: Union[str, list[str]], convergence: bool = False
@@ -108,8 +108,6 @@ class RunOutput:
     def render(self) -> np.ndarray: ...
     @property
     def scene(self) -> Scene: ...
-    @property
-    def triangle_count(self) -> int: ...
 
 def builtin_scenes() -> list[tuple[str, str]]: ...
 def run(

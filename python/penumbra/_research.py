@@ -51,11 +51,7 @@ def direct_light(
     """
     scene = _scene(scene)
     at = _checks.rows3(points, "points")
-    facing = _checks.rows3(normals, "normals", allow_single=True)
-    if len(facing) == 1 and len(at) != 1:
-        facing = np.repeat(facing, len(at), axis=0)
-    if len(facing) != len(at):
-        raise ValueError(f"normals has {len(facing)} rows for {len(at)} points")
+    facing = _checks.normals(normals, "normals", len(at))
     largest = np.abs(facing).max(axis=1, initial=0.0)
     if not (largest > 0).all():
         raise ValueError("normals: every normal needs a direction (a zero row has none)")

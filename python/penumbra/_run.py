@@ -26,9 +26,6 @@ ProgressCallback = Callable[[str, int, int], object]
 class _StderrProgress:
     """``progress=True``: one line on stderr per stage, its percentage updated in place."""
 
-    def __init__(self) -> None:
-        self._stage: Optional[str] = None
-
     def __call__(self, stage: str, done: int, total: int) -> None:
         percent = 100.0 * done / total if total else 100.0
         end = "\n" if done >= total else ""

@@ -140,11 +140,7 @@ class Scene:
         an (N,) int64 array. Where several surfaces meet at a point, the one whose normal is
         closest to the point's normal (if given), else the first."""
         at = _checks.rows3(points, "points", allow_single=True)
-        facing = None if normals is None else _checks.rows3(normals, "normals", allow_single=True)
-        if facing is not None and len(facing) == 1 and len(at) > 1:
-            facing = np.repeat(facing, len(at), axis=0)
-        if facing is not None and len(facing) != len(at):
-            raise ValueError(f"normals has {len(facing)} rows for {len(at)} points")
+        facing = None if normals is None else _checks.normals(normals, "normals", len(at))
         return _native.locate(self._native, at, facing)
 
     def with_camera(

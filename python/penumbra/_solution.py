@@ -40,22 +40,23 @@ class Discontinuities:
         self.order: np.ndarray = _frozen(arrays["order"])
         self.stats: Optional[dict[str, Any]] = stats
 
+    def slice(self, start: int, stop: int) -> "Discontinuities":
+        """The segments from ``start`` up to ``stop``, as views."""
+        return self._taking(slice(start, stop))
+
     def where(self, mask: np.ndarray) -> "Discontinuities":
         """The segments ``mask`` (a (K,) bool array) keeps, e.g. ``d.where(d.order == 0)``."""
         mask = np.asarray(mask, dtype=bool)
         if mask.shape != self.order.shape:
             raise ValueError(f"mask must have shape {self.order.shape}, not {mask.shape}")
-        return Discontinuities(
-            {
-                "segments": self.segments[mask],
-                "surface_id": self.surface_id[mask],
-                "emitter": self.emitter[mask],
-                "event": self.event[mask].tolist(),
-                "boundary": self.boundary[mask].tolist(),
-                "order": self.order[mask],
-            },
-            self.stats,
-        )
+        return self._taking(mask)
+
+    def _taking(self, which: Any) -> "Discontinuities":
+        taken = Discontinuities.__new__(Discontinuities)
+        for name in ("segments", "surface_id", "emitter", "event", "boundary", "order"):
+            setattr(taken, name, _frozen(getattr(self, name)[which]))
+        taken.stats = self.stats
+        return taken
 
     def __len__(self) -> int:
         return len(self.order)
@@ -169,12 +170,9 @@ class Solution:
             # Segments come surface after surface: each surface's are one slice.
             d = self.discontinuities
             bounds = np.searchsorted(d.surface_id, np.arange(count + 1))
-            mask = np.zeros(len(d), dtype=bool)
 
             def segments_of(i: int) -> Discontinuities:
-                mask[:] = False
-                mask[bounds[i] : bounds[i + 1]] = True
-                return d.where(mask)
+                return d.slice(bounds[i], bounds[i + 1])
 
             self._surfaces = [
                 SurfaceSolution(self, i, names[i], frames[i], segments_of(i)) for i in range(count)

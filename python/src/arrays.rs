@@ -2,7 +2,7 @@
 
 use glam::DVec3;
 use numpy::ndarray::Array2;
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2};
+use numpy::{Element, IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2};
 use penumbra_meshing::discontinuity::DiscontinuitySegment;
 use penumbra_scenes::Rgb;
 use pyo3::prelude::*;
@@ -37,9 +37,12 @@ pub(crate) fn points(array: &PyReadonlyArray2<'_, f64>, name: &str) -> PyResult<
     Ok(rows3(array, name)?.into_iter().map(DVec3::from).collect())
 }
 
-/// An (N, 3) float64 array from rows.
-pub(crate) fn array3<'py>(py: Python<'py>, rows: &[[f64; 3]]) -> Bound<'py, PyArray2<f64>> {
-    let flat: Vec<f64> = rows.iter().flatten().copied().collect();
+/// An (N, 3) array from rows.
+pub(crate) fn array3<'py, T: Element + Copy>(
+    py: Python<'py>,
+    rows: &[[T; 3]],
+) -> Bound<'py, PyArray2<T>> {
+    let flat: Vec<T> = rows.iter().flatten().copied().collect();
     match Array2::from_shape_vec((rows.len(), 3), flat) {
         Ok(array) => array.into_pyarray(py),
         // The shape is the data's own: this cannot happen.
@@ -51,15 +54,6 @@ pub(crate) fn array3<'py>(py: Python<'py>, rows: &[[f64; 3]]) -> Bound<'py, PyAr
 pub(crate) fn rgb_array<'py>(py: Python<'py>, colours: &[Rgb]) -> Bound<'py, PyArray2<f64>> {
     let rows: Vec<[f64; 3]> = colours.iter().map(|c| c.to_array()).collect();
     array3(py, &rows)
-}
-
-/// An (N, 3) uint32 array from rows.
-pub(crate) fn index_array<'py>(py: Python<'py>, rows: &[[u32; 3]]) -> Bound<'py, PyArray2<u32>> {
-    let flat: Vec<u32> = rows.iter().flatten().copied().collect();
-    match Array2::from_shape_vec((rows.len(), 3), flat) {
-        Ok(array) => array.into_pyarray(py),
-        Err(_) => PyArray2::zeros(py, [0, 3], false),
-    }
 }
 
 /// Discontinuity segments, per surface, as a dict of arrays: `segments` (K, 2, 3) float64,

@@ -349,7 +349,7 @@ pub(crate) fn run(
     }
     let signal = signal.map(|e| e.into_value(py).into_any());
     match outcome {
-        Ok(result) => Ok((Some(RunOutput::new(result)), signal)),
+        Ok(result) => Ok((Some(RunOutput::new(result, scene.clone())), signal)),
         Err(penumbra::RunError::Solve(SolveError::Interrupted)) => Ok((None, signal)),
         Err(e) => Err(run_error(e)),
     }

@@ -1,5 +1,6 @@
 //! `penumbra.Solution`'s native half: a finished run, its arrays, its JSON and its files.
 
+use std::borrow::Cow;
 use std::path::PathBuf;
 use std::sync::OnceLock;
 
@@ -7,31 +8,33 @@ use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2};
 use penumbra::RunResult;
 use penumbra::outputs::{SvgSelection, write_outputs};
 use penumbra_meshing::TriangleLocator;
-use penumbra_scenes::{Rgb, Visibility};
+use penumbra_scenes::{Rgb, SurfaceId};
 use pyo3::exceptions::{PyOSError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
 
-use crate::arrays::{array3, index_array, rgb_array, segment_arrays};
+use crate::arrays::{array3, rgb_array, segment_arrays};
 use crate::primitives::SurfaceLocator;
+use crate::scene::Scene;
 
 /// A finished run, held for its arrays, its report and its files.
 #[pyclass(module = "penumbra._native", frozen)]
 pub(crate) struct RunOutput {
     result: RunResult,
-    /// For `interpolate`, built on first use: each surface mesh's triangle finder, and the
-    /// scene's visibility index (which tells whether a point lies on a surface).
+    /// The scene that was run, with its visibility index shared with the caller's `Scene`.
+    scene: Scene,
+    /// For `interpolate`, built on first use: each surface mesh's triangle finder.
     locators: OnceLock<Vec<TriangleLocator>>,
-    visibility: OnceLock<Visibility>,
 }
 
 impl RunOutput {
-    pub(crate) fn new(result: RunResult) -> RunOutput {
+    /// The output of a run of `scene`.
+    pub(crate) fn new(result: RunResult, scene: Scene) -> RunOutput {
         RunOutput {
             result,
+            scene,
             locators: OnceLock::new(),
-            visibility: OnceLock::new(),
         }
     }
 }
@@ -54,7 +57,6 @@ struct Concatenated {
 
 impl Concatenated {
     fn of(result: &RunResult) -> Concatenated {
-        let scene = &result.loaded.scene;
         let solution = &result.solution;
         let mut all = Concatenated::default();
         for (s, mesh) in result.mesh.surfaces.iter().enumerate() {
@@ -69,18 +71,44 @@ impl Concatenated {
                 .extend(std::iter::repeat_n(s as u32, mesh.points3.len()));
             all.triangle_surface
                 .extend(std::iter::repeat_n(s as u32, mesh.triangles.len()));
-            let rho = scene.surfaces[mesh.surface].reflectance;
-            let (h, hd) = (&solution.irradiance[s], &solution.direct_irradiance[s]);
+            let (direct, indirect) = reflected_parts(result, s);
             all.radiosity.extend_from_slice(&solution.radiosity[s]);
-            all.irradiance.extend_from_slice(h);
-            all.direct_irradiance.extend_from_slice(hd);
-            all.direct.extend(hd.iter().map(|&d| rho.mul_rgb(d)));
-            all.indirect
-                .extend(h.iter().zip(hd).map(|(&h, &d)| rho.mul_rgb(h - d)));
+            all.irradiance.extend_from_slice(&solution.irradiance[s]);
+            all.direct_irradiance
+                .extend_from_slice(&solution.direct_irradiance[s]);
+            all.direct.extend(direct);
+            all.indirect.extend(indirect);
         }
         all.vertex_offsets.push(all.vertices.len() as u64);
         all.triangle_offsets.push(all.triangles.len() as u64);
         all
+    }
+}
+
+/// The light surface `s` reflects at its vertices, in two parts: straight from the lights,
+/// ρ·H_direct, and after more bounces, ρ·(H − H_direct).
+fn reflected_parts(result: &RunResult, s: SurfaceId) -> (Vec<Rgb>, Vec<Rgb>) {
+    let rho = result.loaded.scene.surfaces[s].reflectance;
+    let solution = &result.solution;
+    let (h, hd) = (&solution.irradiance[s], &solution.direct_irradiance[s]);
+    let direct = hd.iter().map(|&d| rho.mul_rgb(d)).collect();
+    let indirect = h
+        .iter()
+        .zip(hd)
+        .map(|(&h, &d)| rho.mul_rgb(h - d))
+        .collect();
+    (direct, indirect)
+}
+
+/// `quantity` at surface `s`'s vertices: borrowed where the solution holds it.
+fn quantity_at<'r>(result: &'r RunResult, quantity: &str, s: SurfaceId) -> Cow<'r, [Rgb]> {
+    let solution = &result.solution;
+    match quantity {
+        "irradiance" => Cow::Borrowed(&solution.irradiance[s]),
+        "direct_irradiance" => Cow::Borrowed(&solution.direct_irradiance[s]),
+        "direct" => Cow::Owned(reflected_parts(result, s).0),
+        "indirect" => Cow::Owned(reflected_parts(result, s).1),
+        _ => Cow::Borrowed(&solution.radiosity[s]),
     }
 }
 
@@ -112,7 +140,7 @@ impl RunOutput {
         let all = Concatenated::of(&self.result);
         let dict = PyDict::new(py);
         dict.set_item("vertices", array3(py, &all.vertices))?;
-        dict.set_item("triangles", index_array(py, &all.triangles))?;
+        dict.set_item("triangles", array3(py, &all.triangles))?;
         dict.set_item("surface_id", PyArray1::from_vec(py, all.vertex_surface))?;
         dict.set_item(
             "triangle_surface_id",
@@ -135,14 +163,9 @@ impl RunOutput {
         Ok(dict)
     }
 
-    /// `report.json`, as text.
-    #[pyo3(signature = (svg = None))]
-    fn report_json(&self, svg: Option<&Bound<'_, PyAny>>) -> PyResult<String> {
-        let svgs = match svg {
-            Some(svg) => svg_selection(&self.result, svg)?,
-            None => SvgSelection::Auto,
-        };
-        Ok(penumbra::outputs::report_json(&self.result, &svgs))
+    /// `report.json` as `write` with the SVGs chosen automatically writes it, as text.
+    fn report_json(&self) -> String {
+        penumbra::outputs::report_json(&self.result, &SvgSelection::Auto)
     }
 
     /// `solution.json`, as text.
@@ -190,31 +213,21 @@ impl RunOutput {
             )));
         }
         let result = &self.result;
-        let solution = &result.solution;
-        let per_surface: Vec<Vec<Rgb>> = match quantity {
-            "radiosity" => solution.radiosity.clone(),
-            "irradiance" => solution.irradiance.clone(),
-            "direct_irradiance" => solution.direct_irradiance.clone(),
-            "direct" | "indirect" => {
-                let direct = quantity == "direct";
-                (0..result.mesh.surfaces.len())
-                    .map(|s| {
-                        let rho = result.loaded.scene.surfaces[s].reflectance;
-                        let (h, hd) = (&solution.irradiance[s], &solution.direct_irradiance[s]);
-                        h.iter()
-                            .zip(hd)
-                            .map(|(&h, &d)| rho.mul_rgb(if direct { d } else { h - d }))
-                            .collect()
-                    })
-                    .collect()
-            }
-            other => {
-                return Err(PyValueError::new_err(format!(
-                    "quantity: must be \"radiosity\", \"direct\", \"indirect\", \"irradiance\" \
-                     or \"direct_irradiance\", not {other:?}"
-                )));
-            }
-        };
+        const QUANTITIES: [&str; 5] = [
+            "radiosity",
+            "direct",
+            "indirect",
+            "irradiance",
+            "direct_irradiance",
+        ];
+        if !QUANTITIES.contains(&quantity) {
+            return Err(PyValueError::new_err(format!(
+                "quantity: must be one of {QUANTITIES:?}, not {quantity:?}"
+            )));
+        }
+        let per_surface: Vec<Cow<'_, [Rgb]>> = (0..result.mesh.surfaces.len())
+            .map(|s| quantity_at(result, quantity, s))
+            .collect();
         let meshes = &result.mesh.surfaces;
         let count = meshes.len() as i64;
         if let Some(bad) = surfaces.iter().find(|&&s| s < -1 || s >= count) {
@@ -227,9 +240,8 @@ impl RunOutput {
             let locators = self
                 .locators
                 .get_or_init(|| meshes.iter().map(TriangleLocator::new).collect());
-            let scene = &result.loaded.scene;
-            let visibility = self.visibility.get_or_init(|| Visibility::build(scene));
-            let on = SurfaceLocator::new(scene, visibility);
+            let shared = self.scene.shared();
+            let on = SurfaceLocator::new(shared.data(), shared.visibility());
             at.par_iter()
                 .zip(&surfaces)
                 .map(|(&p, &s)| match usize::try_from(s) {
@@ -253,13 +265,7 @@ impl RunOutput {
 
     /// The scene that was run.
     #[getter]
-    fn scene(&self) -> crate::scene::Scene {
-        crate::scene::Scene::new(self.result.loaded.clone())
-    }
-
-    /// The mesh's triangles, for the whole scene.
-    #[getter]
-    fn triangle_count(&self) -> usize {
-        self.result.mesh.triangle_count()
+    fn scene(&self) -> Scene {
+        self.scene.clone()
     }
 }

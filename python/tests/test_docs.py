@@ -30,7 +30,7 @@ def test_interpolation_at_the_vertices_gives_their_values():
     for quantity in ("radiosity", "direct", "indirect", "irradiance", "direct_irradiance"):
         got = solution.interpolate(solution.vertices[alone], surfaces=ids, quantity=quantity)
         expected = getattr(solution, quantity)[alone]
-        assert np.allclose(got, expected, rtol=1e-9, atol=1e-9 * np.abs(expected).max()), quantity
+        assert np.allclose(got, expected, rtol=0, atol=1e-12 * np.abs(expected).max()), quantity
     # Between the vertices: the mean of a triangle's corners at its centroid.
     triangles = solution.triangles[:50]
     centroids = solution.vertices[triangles].mean(axis=1)

@@ -1,12 +1,12 @@
 //! `penumbra sweep`: error against elements and time, over methods and budgets.
 
-use penumbra_solver::path_trace::MAX_PATHS;
 use std::path::PathBuf;
 
 use crate::progress_bar::Bars;
 use anyhow::Context;
 use penumbra_scenes::ObjOptions;
 use penumbra_solver::SolverOptions;
+use penumbra_solver::path_trace::MAX_PATHS;
 
 use crate::failure::{Command, Failure, invalid_option, run_failure, usage};
 use crate::load;
