@@ -111,6 +111,10 @@ pub struct RefineReport {
     pub stop: RefineStop,
     /// The residuals of the final mesh (those of the last round), in W/m².
     pub residual: ResidualSummary,
+    /// Each triangle's residual in the last round (the final mesh's), in W/m², per surface in
+    /// the scene's order: the error indicator of the exports.
+    #[serde(skip)]
+    pub triangle_residuals: Vec<Vec<f64>>,
 }
 
 impl RefineReport {
@@ -119,6 +123,7 @@ impl RefineReport {
         rounds: Vec<RefineRound>,
         stop: RefineStop,
         residual: ResidualSummary,
+        triangle_residuals: Vec<Vec<f64>>,
     ) -> RefineReport {
         RefineReport {
             tolerance: options.tolerance,
@@ -126,6 +131,7 @@ impl RefineReport {
             rounds,
             stop,
             residual,
+            triangle_residuals,
         }
     }
 }
@@ -145,11 +151,12 @@ pub fn refine_adaptively(
     let mut rounds = Vec::new();
     let mut stop = RefineStop::Rounds;
     let mut residual = ResidualSummary::default();
+    let mut residuals = Vec::new();
     let mut limits = RoundLimits::new(max_elements, options, solver_options);
     for round in 0..=options.max_rounds {
         limits.round = round;
         solver.shoot(ROUND_EPSILON.max(solver_options.epsilon), progress);
-        let residuals = solution_residuals(scene, &solver, options.indirect);
+        residuals = solution_residuals(scene, &solver, options.indirect);
         residual = summarize(scene, &mesh.surfaces, &solver.radiosity(), &residuals);
         let (this, plan) = plan_round(scene, mesh, &residuals, residual, solver.shots(), &limits);
         rounds.push(this);
@@ -165,7 +172,7 @@ pub fn refine_adaptively(
         }
     }
     solver.shoot(solver_options.epsilon, progress);
-    let report = RefineReport::new(options, rounds, stop, residual);
+    let report = RefineReport::new(options, rounds, stop, residual, residuals);
     Ok((report, solver.solution()))
 }
 
@@ -186,6 +193,7 @@ pub fn refine_hierarchically(
     let mut rounds = Vec::new();
     let mut stop = RefineStop::Rounds;
     let mut residual = ResidualSummary::default();
+    let mut last_residuals = Vec::new();
     let mut limits = RoundLimits::new(max_elements, options, solver_options);
     let mut current = mesh.clone();
     let mut next_mesh = |r: &Round| -> Result<Option<SceneMesh>, SolveError> {
@@ -202,6 +210,7 @@ pub fn refine_hierarchically(
         limits.round = rounds.len();
         let (this, plan) = plan_round(scene, &current, &residuals, residual, 0, &limits);
         rounds.push(this);
+        last_residuals = residuals;
         Ok(match plan {
             Plan::Stop(reason) => {
                 stop = reason;
@@ -238,7 +247,7 @@ pub fn refine_hierarchically(
         s.rays_cast += early.rays_cast;
         solution
     };
-    let report = RefineReport::new(options, rounds, stop, residual);
+    let report = RefineReport::new(options, rounds, stop, residual, last_residuals);
     Ok((report, solution))
 }
 

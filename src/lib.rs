@@ -114,6 +114,7 @@
 pub mod adaptive;
 pub mod energy;
 pub mod experiments;
+pub mod export;
 #[doc(hidden)] // Support for the fuzz targets and their tests, not an API.
 pub mod fuzzing;
 pub mod memory;

@@ -38,6 +38,13 @@ pub struct SurfaceSolution {
     pub index: Option<SurfaceId>,
     /// The surface's name in the scene, unique within it.
     pub name: String,
+    /// The surface's own exitance E, `[r, g, b]` in W/m² (zero unless it is a light). Absent
+    /// from files of earlier versions, as are `reflectance` and `direct`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub emission: Option<[f64; 3]>,
+    /// The surface's diffuse reflectance ρ, `[r, g, b]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reflectance: Option<[f64; 3]>,
     /// The mesh's vertices, in 3D scene coordinates and units. The two sides of a value
     /// discontinuity (a blocker touching the surface) each have their own vertex at the same
     /// position.
@@ -48,6 +55,15 @@ pub struct SurfaceSolution {
     /// Radiosity B at each vertex, `[r, g, b]` in W/m², in the order of `vertices`: the
     /// surface's own emission included, the display-only ambient term left out.
     pub radiosity: Vec<[f64; 3]>,
+    /// The direct light's part of the radiosity at each vertex, ρ·H_direct: what the surface
+    /// reflects straight from the lights, exact. The rest of the reflected light, `radiosity`
+    /// − `emission` − `direct`, came by more bounces.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub direct: Option<Vec<[f64; 3]>>,
+    /// Adaptive runs only: each triangle's error indicator in the last round of refinement, in
+    /// W/m² (the residual the refinement split by), in the order of `triangles`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub error_indicator: Option<Vec<f64>>,
     /// The discontinuity segments of the direct light built into the mesh as edges (none for
     /// uniform meshes, for surfaces no shadow falls on, and for emitters).
     pub discontinuities: Vec<Discontinuity>,
@@ -76,15 +92,21 @@ pub struct Discontinuity {
 /// Surface `s` of a run as `solution.json` gives it.
 pub fn surface_solution(result: &RunResult, s: SurfaceId) -> SurfaceSolution {
     let m = &result.mesh.surfaces[s];
+    let surface = &result.loaded.scene.surfaces[s];
+    let rgb = |values: &[Rgb]| values.iter().map(|c| c.to_array()).collect();
     SurfaceSolution {
         index: None,
-        name: result.loaded.scene.surfaces[s].name.clone(),
+        name: surface.name.clone(),
+        emission: Some(surface.emission.to_array()),
+        reflectance: Some(surface.reflectance.to_array()),
         vertices: m.points3.iter().map(|p| p.to_array()).collect(),
         triangles: m.triangles.clone(),
-        radiosity: result.solution.radiosity[s]
-            .iter()
-            .map(|c| c.to_array())
-            .collect(),
+        radiosity: rgb(&result.solution.radiosity[s]),
+        direct: Some(rgb(&result.reflected_parts(s).0)),
+        error_indicator: result
+            .refinement
+            .as_ref()
+            .and_then(|r| r.triangle_residuals.get(s).cloned()),
         discontinuities: result.mesh.discontinuities[m.surface]
             .iter()
             .map(|g| Discontinuity {
@@ -243,6 +265,8 @@ struct RenderSummary {
     height: u32,
     exposure: f64,
     ambient: Rgb,
+    /// The camera the image was made from: the scene's, or one that frames it.
+    camera: penumbra_scenes::Camera,
 }
 
 /// What to say when the direct light at some vertices is an estimate by rays, not exact.
@@ -371,6 +395,9 @@ pub fn report_json(result: &RunResult, svgs: &SvgSelection) -> String {
             height: result.render.image.height(),
             exposure: result.render.exposure,
             ambient: result.solution.ambient,
+            camera: scene
+                .camera
+                .unwrap_or_else(|| penumbra_viz::default_camera(scene)),
         },
         svgs: SvgSummary {
             selection: svgs.name(),
@@ -482,6 +509,12 @@ pub fn worth_looking_at(scene: &Scene, segments: &[usize], count: usize) -> Vec<
 
 /// A file name for a surface's SVG: its index (names may clash once sanitized) and its name.
 pub fn svg_name(index: usize, name: &str) -> String {
+    format!("{}.svg", file_safe_name(index, name))
+}
+
+/// A name for surface `index` called `name` that is safe in file names and OBJ materials: its
+/// index, then its name with every character but ASCII letters, digits, `-` and `_` made `_`.
+pub fn file_safe_name(index: usize, name: &str) -> String {
     let clean: String = name
         .chars()
         .map(|c| {
@@ -492,7 +525,7 @@ pub fn svg_name(index: usize, name: &str) -> String {
             }
         })
         .collect();
-    format!("{index:03}-{clean}.svg")
+    format!("{index:03}-{clean}")
 }
 
 /// A temporary file name in the same directory as `path` (so that renaming it is atomic).

@@ -12,7 +12,7 @@ use penumbra_meshing::{
     ElementBudget, MeshError, SceneMesh, mesh_scene_discontinuity_on, mesh_scene_uniform,
     polygon_minimum,
 };
-use penumbra_scenes::{LoadedScene, Rgb, Visibility};
+use penumbra_scenes::{LoadedScene, Rgb, SurfaceId, Visibility};
 use penumbra_solver::{
     Progress, Solution, SolveError, SolverMethod, SolverOptions, solve_direct_on, solve_gathering,
     solve_hierarchical, solve_progressive,
@@ -112,6 +112,25 @@ pub struct RunResult {
     /// The command line that asked for the run, if one did (set by the front end; recorded in
     /// `report.json`).
     pub invocation: Option<crate::outputs::Invocation>,
+}
+
+impl RunResult {
+    /// The light surface `s` reflects at its vertices, in two parts: straight from the lights,
+    /// ρ·H_direct, and after more bounces, ρ·(H − H_direct).
+    pub fn reflected_parts(&self, s: SurfaceId) -> (Vec<Rgb>, Vec<Rgb>) {
+        let rho = self.loaded.scene.surfaces[s].reflectance;
+        let (h, hd) = (
+            &self.solution.irradiance[s],
+            &self.solution.direct_irradiance[s],
+        );
+        let direct = hd.iter().map(|&d| rho.mul_rgb(d)).collect();
+        let indirect = h
+            .iter()
+            .zip(hd)
+            .map(|(&h, &d)| rho.mul_rgb(h - d))
+            .collect();
+        (direct, indirect)
+    }
 }
 
 /// Why a run failed. [`RunError::is_usage`] tells the errors a user fixes by changing the

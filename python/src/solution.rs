@@ -71,7 +71,7 @@ impl Concatenated {
                 .extend(std::iter::repeat_n(s as u32, mesh.points3.len()));
             all.triangle_surface
                 .extend(std::iter::repeat_n(s as u32, mesh.triangles.len()));
-            let (direct, indirect) = reflected_parts(result, s);
+            let (direct, indirect) = result.reflected_parts(s);
             all.radiosity.extend_from_slice(&solution.radiosity[s]);
             all.irradiance.extend_from_slice(&solution.irradiance[s]);
             all.direct_irradiance
@@ -85,29 +85,14 @@ impl Concatenated {
     }
 }
 
-/// The light surface `s` reflects at its vertices, in two parts: straight from the lights,
-/// ρ·H_direct, and after more bounces, ρ·(H − H_direct).
-fn reflected_parts(result: &RunResult, s: SurfaceId) -> (Vec<Rgb>, Vec<Rgb>) {
-    let rho = result.loaded.scene.surfaces[s].reflectance;
-    let solution = &result.solution;
-    let (h, hd) = (&solution.irradiance[s], &solution.direct_irradiance[s]);
-    let direct = hd.iter().map(|&d| rho.mul_rgb(d)).collect();
-    let indirect = h
-        .iter()
-        .zip(hd)
-        .map(|(&h, &d)| rho.mul_rgb(h - d))
-        .collect();
-    (direct, indirect)
-}
-
 /// `quantity` at surface `s`'s vertices: borrowed where the solution holds it.
 fn quantity_at<'r>(result: &'r RunResult, quantity: &str, s: SurfaceId) -> Cow<'r, [Rgb]> {
     let solution = &result.solution;
     match quantity {
         "irradiance" => Cow::Borrowed(&solution.irradiance[s]),
         "direct_irradiance" => Cow::Borrowed(&solution.direct_irradiance[s]),
-        "direct" => Cow::Owned(reflected_parts(result, s).0),
-        "indirect" => Cow::Owned(reflected_parts(result, s).1),
+        "direct" => Cow::Owned(result.reflected_parts(s).0),
+        "indirect" => Cow::Owned(result.reflected_parts(s).1),
         _ => Cow::Borrowed(&solution.radiosity[s]),
     }
 }

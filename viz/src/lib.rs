@@ -72,4 +72,4 @@ pub use chart::{LogLogChart, Series};
 pub use error::VizError;
 pub use render::{MAX_PIXELS, Render, RenderOptions, encode_png, render};
 pub use surface_svg::surface_svg;
-pub use tonemap::srgb_encode;
+pub use tonemap::{luminance, srgb_encode, to_srgb8};

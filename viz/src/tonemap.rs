@@ -9,7 +9,7 @@ pub(crate) const AUTO_EXPOSURE_PERCENTILE: f64 = 0.95;
 pub(crate) const AUTO_EXPOSURE_TARGET: f64 = 0.8;
 
 /// Relative luminance of a linear RGB colour (Rec. 709 / sRGB primaries).
-pub(crate) fn luminance(c: Rgb) -> f64 {
+pub fn luminance(c: Rgb) -> f64 {
     0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b
 }
 
@@ -30,7 +30,7 @@ pub fn srgb_encode(linear: f64) -> f64 {
 }
 
 /// An 8-bit sRGB pixel of `linear * exposure`. NaN displays as black.
-pub(crate) fn to_srgb8(linear: Rgb, exposure: f64) -> [u8; 3] {
+pub fn to_srgb8(linear: Rgb, exposure: f64) -> [u8; 3] {
     // In [0, 255] after the clamp in `srgb_encode`, so the cast is exact.
     let encode = |v: f64| (srgb_encode(v * exposure) * 255.0).round() as u8;
     [encode(linear.r), encode(linear.g), encode(linear.b)]

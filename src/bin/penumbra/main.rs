@@ -4,6 +4,7 @@
 #![allow(clippy::print_stdout, clippy::print_stderr)]
 
 mod camera;
+mod export;
 mod failure;
 mod form_factors;
 mod merge;
@@ -22,6 +23,7 @@ use penumbra::outputs::DEFAULT_SVG_SURFACES;
 use penumbra_meshing::FIT_TRIANGLES_PER_SURFACE;
 use penumbra_scenes::{ObjOptions, SceneError, builtin, load_scene_with};
 
+use crate::export::ExportArgs;
 use crate::failure::{Failure, usage};
 use crate::form_factors::FormFactorArgs;
 use crate::merge::MergeArgs;
@@ -45,6 +47,7 @@ Examples:
   penumbra check my.json                    every problem of a scene file at once
   penumbra run my.json --out my             your scene: out/solution.json, report.json, render.png
   penumbra sweep cornell --direct-only      error against elements and time, charted
+  penumbra export out --format vtp,glb      a finished run for ParaView and Blender
 Each command's own help (penumbra run --help) lists its options and more examples.";
 
 #[derive(Parser, Debug)]
@@ -71,6 +74,9 @@ enum Command {
     /// error against cost, point by point, the hemicube's aliasing, the 1 x 2 x 3 box's face
     /// factors and dense solutions of a unit cube; write form-factors.json and print the tables.
     FormFactors(FormFactorArgs),
+    /// Write a finished run's solution for other tools: solution.vtp (ParaView), .ply
+    /// (MeshLab), .glb (glTF), .obj + .mtl, and index.html (a page to explore it in a browser).
+    Export(ExportArgs),
     /// Join the outputs of the shards of a run (`run --shard I/N`) into one: solution.json as
     /// the run not split would have written it, report.json with the shards' figures joined,
     /// render.png and the shards' SVGs.
@@ -121,6 +127,7 @@ fn dispatch(cli: Cli) -> Result<ExitCode, Failure> {
         Command::Run(args) => return run::run(&args),
         Command::Sweep(args) => sweep::sweep(&args)?,
         Command::Merge(args) => merge::merge(&args)?,
+        Command::Export(args) => export::export_run(&args)?,
         Command::FormFactors(args) => form_factors::form_factors(&args)?,
     }
     Ok(ExitCode::SUCCESS)

@@ -4,6 +4,7 @@ use std::process::ExitCode;
 
 use crate::progress_bar::Bars;
 use anyhow::Context;
+use penumbra::export::{ExportSource, export};
 use penumbra::outputs::{Invocation, SvgSelection, write_outputs};
 use penumbra_solver::Interrupt;
 
@@ -126,6 +127,7 @@ fn run_with(args: &RunArgs, fingerprint: Option<&str>) -> Result<ExitCode, Failu
         }
     }
     let svgs = svg_selection(&args.svg, &loaded.scene)?;
+    let exports = crate::export::formats("--export", &args.export)?;
     let signals = Signals::catch(&interrupt, args.out.clone()).context("cannot catch Ctrl-C")?;
     let bars = Bars::new(args.quiet);
     let mut result = match penumbra::run(loaded, &options, &bars) {
@@ -195,11 +197,13 @@ fn run_with(args: &RunArgs, fingerprint: Option<&str>) -> Result<ExitCode, Failu
         }
         return Ok(ExitCode::SUCCESS);
     }
-    let extra = if args.convergence {
+    let mut extra = if args.convergence {
         penumbra::outputs::convergence_files(&result)?
     } else {
         Vec::new()
     };
+    let source = ExportSource::of_run(&result, &svgs);
+    extra.extend(export(&source, &exports)?);
     let written = write_outputs(&result, &args.out, &svgs, extra)?;
     if !args.quiet {
         let stats = &result.solution.stats;

@@ -18,6 +18,13 @@ const SOLVER: &str = "Solver";
 const OUTPUT: &str = "Output and render";
 const LIMITS: &str = "Limits";
 
+/// What `--export` writes unless told otherwise: the viewer page.
+const DEFAULT_EXPORT: &str = "html";
+
+fn default_export() -> String {
+    DEFAULT_EXPORT.to_owned()
+}
+
 /// `penumbra run --help`'s examples.
 pub(crate) const EXAMPLES: &str = "\
 Examples:
@@ -242,6 +249,13 @@ pub(crate) struct RunArgs {
     /// surface names, comma-separated.
     #[arg(help_heading = OUTPUT, long, default_value = "auto", value_name = "auto|all|none|NAME,...")]
     pub(crate) svg: String,
+    /// Also write the solution for other tools, comma-separated: `vtp` (solution.vtp, for
+    /// ParaView), `ply` (MeshLab, Blender), `glb` (glTF: browsers, Blender), `obj` (with
+    /// solution.mtl), `html` (index.html, a page to turn the solution around in a browser);
+    /// `all`, or `none`.
+    #[arg(help_heading = OUTPUT, long, default_value = DEFAULT_EXPORT, value_name = "FORMAT,...")]
+    #[serde(default = "default_export")]
+    pub(crate) export: String,
     /// No progress bars, no summary and no warnings.
     #[arg(help_heading = OUTPUT, long)]
     pub(crate) quiet: bool,
