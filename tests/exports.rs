@@ -418,9 +418,10 @@ fn the_viewer_page_holds_the_solution() {
     let vtp = read(&out.join("solution.vtp"));
     let header = String::from_utf8_lossy(&vtp[..vtp.len().min(4000)]);
     assert!(header.contains("Name=\"error_indicator\""));
-    // Every segment end is a mesh vertex: no point was added for the lines.
+    // The mesh's vertices, then each segment's two ends.
+    let points = v + 2 * l;
     assert!(
-        header.contains(&format!("NumberOfPoints=\"{v}\"")),
+        header.contains(&format!("NumberOfPoints=\"{points}\"")),
         "{header}"
     );
 }

@@ -4,9 +4,10 @@
 //! `direct` and `indirect` (RGB, W/m²) and `luminance` (of the radiosity, Rec. 709). Cell data,
 //! lines first as VTK orders cells: `surface` (the index in `solution.json`), `event`,
 //! `boundary` and `order` (codes, -1 on triangles) and, for adaptive runs, `error_indicator`
-//! (NaN on lines). A segment's ends are the mesh vertices they were built into; an end that
-//! matches none gets a point of its own, with NaN values. Arrays are appended raw, little
-//! endian, in `f64` and `i64`.
+//! (NaN on lines). A segment's ends are points of their own, where `solution.json` puts them,
+//! after the mesh's vertices; their point data are those of the mesh vertex nearest each (the
+//! vertex the end was built into, moved by no more than the mesh's welding of close ends).
+//! Arrays are appended raw, little endian, in `f64` and `i64`.
 
 use std::fmt::Write as _;
 
@@ -14,20 +15,21 @@ use penumbra_scenes::Rgb;
 
 use super::mesh::{BOUNDARIES, EVENTS, FlatMesh};
 
-/// How far a segment's end may lie from the mesh vertex it was built into, relative to the
-/// diagonal of its surface's vertices' bounding box: rounding in the plane's frame only.
-pub const LINE_END_TOLERANCE: f64 = 1e-9;
+/// How far from a segment's end the search for its nearest mesh vertex looks first, relative
+/// to the diagonal of its surface's vertices' bounding box; beyond that it looks everywhere.
+const NEAR_END: f64 = 1e-6;
 
 /// The file's bytes.
 pub fn vtp(mesh: &FlatMesh) -> Vec<u8> {
-    let (line_points, extra) = line_points(mesh);
-    let n = mesh.positions.len() + extra.len();
+    let nearest = nearest_vertices(mesh);
+    let ends: Vec<[f64; 3]> = mesh.lines.iter().flat_map(|l| l.ends).collect();
+    let n = mesh.positions.len() + ends.len();
     let mut data = Appended::default();
     let mut xml = String::new();
     let nan3 = [f64::NAN; 3];
     let point_values = |values: &[[f64; 3]]| -> Vec<f64> {
-        let padded = values.iter().chain(std::iter::repeat_n(&nan3, extra.len()));
-        padded.flatten().copied().collect()
+        let at_ends = nearest.iter().map(|v| v.map_or(&nan3, |v| &values[v]));
+        values.iter().chain(at_ends).flatten().copied().collect()
     };
     let _ = write!(
         xml,
@@ -56,11 +58,9 @@ pub fn vtp(mesh: &FlatMesh) -> Vec<u8> {
             &f64_bytes(&point_values(values)),
         );
     }
-    let luminance: Vec<f64> = mesh
-        .radiosity
-        .iter()
-        .map(|&b| penumbra_viz::luminance(Rgb::from(b)))
-        .chain(std::iter::repeat_n(f64::NAN, extra.len()))
+    let luminance: Vec<f64> = point_values(&mesh.radiosity)
+        .chunks(3)
+        .map(|b| penumbra_viz::luminance(Rgb::new(b[0], b[1], b[2])))
         .collect();
     data.array(&mut xml, "Float64", "luminance", 1, &f64_bytes(&luminance));
     xml += "</PointData>\n<CellData Scalars=\"surface\">\n";
@@ -69,12 +69,14 @@ pub fn vtp(mesh: &FlatMesh) -> Vec<u8> {
     let points: Vec<f64> = mesh
         .positions
         .iter()
-        .chain(&extra)
+        .chain(&ends)
         .flatten()
         .copied()
         .collect();
     data.array(&mut xml, "Float64", "Points", 3, &f64_bytes(&points));
     xml += "</Points>\n<Lines>\n";
+    let first = mesh.positions.len() as i64;
+    let line_points: Vec<i64> = (first..first + ends.len() as i64).collect();
     let line_offsets: Vec<i64> = (1..=mesh.lines.len() as i64).map(|i| 2 * i).collect();
     data.array(
         &mut xml,
@@ -138,11 +140,10 @@ fn codes(names: &[&str]) -> String {
     coded.join(", ")
 }
 
-/// The point of each segment's ends (two per segment, in order), and the points added for
-/// ends that match no mesh vertex of their surface.
-fn line_points(mesh: &FlatMesh) -> (Vec<i64>, Vec<[f64; 3]>) {
-    let mut ends = Vec::with_capacity(2 * mesh.lines.len());
-    let mut extra = Vec::new();
+/// The mesh vertex nearest each segment end (two per segment, in order), on the segment's
+/// surface; `None` on a surface without vertices.
+fn nearest_vertices(mesh: &FlatMesh) -> Vec<Option<usize>> {
+    let mut nearest = Vec::with_capacity(2 * mesh.lines.len());
     let mut finder: Option<(u32, VertexFinder)> = None;
     for line in &mesh.lines {
         let s = line.surface;
@@ -150,28 +151,23 @@ fn line_points(mesh: &FlatMesh) -> (Vec<i64>, Vec<[f64; 3]>) {
             let range = mesh.vertex_offsets[s as usize]..mesh.vertex_offsets[s as usize + 1];
             finder = Some((s, VertexFinder::new(&mesh.positions, range)));
         }
-        let Some((_, find)) = &finder else { continue };
-        for end in line.ends {
-            let point = find.nearest(&mesh.positions, end).unwrap_or_else(|| {
-                extra.push(end);
-                mesh.positions.len() + extra.len() - 1
-            });
-            ends.push(point as i64);
+        if let Some((_, find)) = &finder {
+            nearest.extend(line.ends.map(|end| find.nearest(&mesh.positions, end)));
         }
     }
-    (ends, extra)
+    nearest
 }
 
-/// The vertices of one surface, sorted by x, to find the one a point lies on.
+/// The vertices of one surface, sorted by x, to find the one nearest a point.
 struct VertexFinder {
     by_x: Vec<(f64, usize)>,
-    tolerance: f64,
+    near: f64,
 }
 
 impl VertexFinder {
     fn new(positions: &[[f64; 3]], range: std::ops::Range<usize>) -> VertexFinder {
         let mut by_x: Vec<(f64, usize)> = range.map(|i| (positions[i][0], i)).collect();
-        by_x.sort_by(|a, b| a.0.total_cmp(&b.0));
+        by_x.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
         for &(_, i) in &by_x {
             for c in 0..3 {
@@ -182,27 +178,28 @@ impl VertexFinder {
         let diagonal = (0..3).map(|c| (hi[c] - lo[c]).powi(2)).sum::<f64>().sqrt();
         VertexFinder {
             by_x,
-            tolerance: LINE_END_TOLERANCE * diagonal,
+            near: NEAR_END * diagonal,
         }
     }
 
-    /// The vertex nearest `p` within the tolerance, the first in the mesh on a tie.
+    /// The vertex nearest `p`, the first in the mesh on a tie: among those within
+    /// [`NEAR_END`] in x if any is that near, else among all.
     fn nearest(&self, positions: &[[f64; 3]], p: [f64; 3]) -> Option<usize> {
-        let first = self
-            .by_x
-            .partition_point(|&(x, _)| x < p[0] - self.tolerance);
         let distance = |i: usize| {
             (0..3)
                 .map(|c| (positions[i][c] - p[c]).powi(2))
                 .sum::<f64>()
         };
-        self.by_x[first..]
-            .iter()
-            .take_while(|&&(x, _)| x <= p[0] + self.tolerance)
-            .map(|&(_, i)| (distance(i), i))
-            .filter(|&(d, _)| d <= self.tolerance * self.tolerance)
-            .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)))
-            .map(|(_, i)| i)
+        let best = |candidates: &[(f64, usize)]| {
+            let near = candidates.iter().map(|&(_, i)| (distance(i), i));
+            near.min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)))
+        };
+        let first = self.by_x.partition_point(|&(x, _)| x < p[0] - self.near);
+        let last = self.by_x.partition_point(|&(x, _)| x <= p[0] + self.near);
+        match best(&self.by_x[first..last.max(first)]) {
+            Some((d, i)) if d <= self.near * self.near => Some(i),
+            _ => best(&self.by_x).map(|(_, i)| i),
+        }
     }
 }
 

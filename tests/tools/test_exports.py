@@ -1,0 +1,223 @@
+"""The exports of `penumbra run --export`, read back by the readers their users have: VTK
+(ParaView's library) for solution.vtp, plyfile for solution.ply, pygltflib and trimesh for
+solution.glb. Counts, values to the bit against solution.json, and the discontinuity classes."""
+
+import json
+import os
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+CLI = Path(os.environ.get("PENUMBRA_CLI", ROOT / "target" / "release" / "penumbra"))
+EVENTS = ["EV", "VE", "EEE", "contact", "blocker-EV", "horizon"]
+BOUNDARIES = ["umbra", "penumbra", "inner"]
+
+
+def run(out: Path, *options: str) -> None:
+    subprocess.run(
+        [str(CLI), "run", "cornell", "--out", str(out), "--quiet", *options],
+        check=True,
+    )
+
+
+class Solution:
+    """solution.json and report.json, joined over the surfaces as the exports join them."""
+
+    def __init__(self, out: Path):
+        self.json = json.loads((out / "solution.json").read_text())
+        self.report = json.loads((out / "report.json").read_text())
+        surfaces = self.json["surfaces"]
+        self.counts = [len(s["vertices"]) for s in surfaces]
+        offsets = np.cumsum([0] + self.counts)[:-1]
+        cat = lambda field: np.concatenate(  # noqa: E731
+            [np.array(s[field], dtype=float).reshape(-1, 3) for s in surfaces]
+        )
+        self.vertices = cat("vertices")
+        self.radiosity = cat("radiosity")
+        self.direct = cat("direct")
+        emission = np.repeat([s["emission"] for s in surfaces], self.counts, axis=0)
+        self.indirect = self.radiosity - emission - self.direct
+        self.triangles = np.concatenate(
+            [np.array(s["triangles"], dtype=np.int64).reshape(-1, 3) + o for s, o in zip(surfaces, offsets)]
+        )
+        self.triangle_surface = np.repeat(np.arange(len(surfaces)), [len(s["triangles"]) for s in surfaces])
+        self.lines = [(i, d) for i, s in enumerate(surfaces) for d in s["discontinuities"]]
+        self.error = (
+            np.concatenate([s["error_indicator"] for s in surfaces])
+            if all("error_indicator" in s for s in surfaces)
+            else None
+        )
+        render = self.report["render"]
+        self.exposure = render["exposure"]
+        self.ambient = np.array(render["ambient"])
+
+    def luminance(self) -> np.ndarray:
+        r, g, b = self.radiosity.T
+        return 0.2126 * r + 0.7152 * g + 0.0722 * b
+
+    def srgb8(self) -> np.ndarray:
+        """render.png's colours: the sRGB curve of (B + ambient) * exposure, in 8 bits."""
+        v = np.clip((self.radiosity + self.ambient) * self.exposure, 0.0, 1.0)
+        encoded = np.where(v <= 0.0031308, 12.92 * v, 1.055 * v ** (1 / 2.4) - 0.055)
+        return np.round(encoded * 255.0).astype(np.uint8)
+
+
+@pytest.fixture(scope="module")
+def exported(tmp_path_factory):
+    out = tmp_path_factory.mktemp("cornell")
+    run(out, "--max-elements", "4000", "--export", "vtp,ply,glb,obj")
+    return out, Solution(out)
+
+
+@pytest.fixture(scope="module")
+def adaptive(tmp_path_factory):
+    out = tmp_path_factory.mktemp("adaptive")
+    run(out, "--max-elements", "6000", "--refine-tol", "0.05", "--solver", "progressive", "--export", "vtp")
+    return out, Solution(out)
+
+
+def read_vtp(path: Path):
+    vtk = pytest.importorskip("vtk")
+    reader = vtk.vtkXMLPolyDataReader()
+    reader.SetFileName(str(path))
+    reader.Update()
+    return reader.GetOutput()
+
+
+def array(data, name: str) -> np.ndarray:
+    from vtk.util.numpy_support import vtk_to_numpy
+
+    found = data.GetArray(name)
+    assert found is not None, f"no array {name}"
+    return vtk_to_numpy(found)
+
+
+def test_vtk_reads_the_mesh_values_and_lines(exported):
+    out, solution = exported
+    poly = read_vtp(out / "solution.vtp")
+    from vtk.util.numpy_support import vtk_to_numpy
+
+    lines = len(solution.lines)
+    n = len(solution.vertices)
+    assert poly.GetNumberOfPoints() == n + 2 * lines
+    assert poly.GetNumberOfPolys() == len(solution.triangles)
+    assert poly.GetNumberOfLines() == lines
+    # The mesh's vertices, then each segment's ends where solution.json puts them.
+    points = vtk_to_numpy(poly.GetPoints().GetData())
+    ends = np.array([[d["from"], d["to"]] for _, d in solution.lines]).reshape(-1, 3)
+    assert np.array_equal(points, np.vstack([solution.vertices, ends]))
+    line_points = vtk_to_numpy(poly.GetLines().GetConnectivityArray())
+    assert np.array_equal(line_points, n + np.arange(2 * lines))
+    # A segment end carries the values of the mesh vertex it was built into: the nearest one
+    # on its surface, within the mesh's welding of close ends.
+    surface_of = np.repeat([s for s, _ in solution.lines], 2)
+    vertex_surface = np.repeat(np.arange(len(solution.counts)), solution.counts)
+    size = np.ptp(solution.vertices, axis=0).max()
+    radiosity = array(poly.GetPointData(), "radiosity")
+    for end, s, value in zip(ends, surface_of, radiosity[n:]):
+        on = np.flatnonzero(vertex_surface == s)
+        d = np.linalg.norm(solution.vertices[on] - end, axis=1)
+        assert d.min() < 1e-6 * size
+        assert any(np.array_equal(value, solution.radiosity[v]) for v in on[d == d.min()])
+    points = poly.GetPointData()
+    assert np.array_equal(array(points, "radiosity")[:n], solution.radiosity)
+    assert np.array_equal(array(points, "direct")[:n], solution.direct)
+    assert np.array_equal(array(points, "indirect")[:n], solution.indirect)
+    assert np.array_equal(array(points, "luminance")[:n], solution.luminance())
+    # VTK orders cells lines first, then polygons.
+    polys = vtk_to_numpy(poly.GetPolys().GetConnectivityArray()).reshape(-1, 3)
+    assert np.array_equal(polys, solution.triangles)
+    cells = poly.GetCellData()
+    surface = array(cells, "surface")
+    assert np.array_equal(surface[lines:], solution.triangle_surface)
+    assert np.array_equal(surface[:lines], [s for s, _ in solution.lines])
+    for name, names in [("event", EVENTS), ("boundary", BOUNDARIES)]:
+        codes = array(cells, name)
+        assert [names[c] for c in codes[:lines]] == [d[name] for _, d in solution.lines]
+        assert (codes[lines:] == -1).all()
+    order = array(cells, "order")
+    assert list(order[:lines]) == [d["order"] for _, d in solution.lines]
+    assert set(order[:lines]) == {0, 1, 2}, "the Cornell box has lines of every class"
+
+
+def test_vtk_reads_the_error_indicator_of_an_adaptive_run(adaptive):
+    out, solution = adaptive
+    assert solution.error is not None and len(solution.error) == len(solution.triangles)
+    poly = read_vtp(out / "solution.vtp")
+    error = array(poly.GetCellData(), "error_indicator")
+    lines = len(solution.lines)
+    assert np.isnan(error[:lines]).all()
+    assert np.array_equal(error[lines:], solution.error)
+    assert (solution.error >= 0).all() and solution.error.max() > 0
+
+
+def test_plyfile_reads_positions_colours_and_quality(exported):
+    plyfile = pytest.importorskip("plyfile")
+    out, solution = exported
+    ply = plyfile.PlyData.read(str(out / "solution.ply"))
+    assert not ply.text and ply.byte_order == "<", "binary little endian"
+    v = ply["vertex"].data
+    assert len(v) == len(solution.vertices)
+    assert np.array_equal(np.c_[v["x"], v["y"], v["z"]], solution.vertices)
+    assert np.array_equal(np.c_[v["red"], v["green"], v["blue"]], solution.srgb8())
+    assert np.array_equal(v["quality"], solution.luminance())
+    faces = ply["face"].data
+    assert np.array_equal(np.vstack(faces["vertex_indices"]), solution.triangles)
+    assert np.array_equal(faces["surface"], solution.triangle_surface)
+
+
+def test_pygltflib_reads_the_mesh_and_a_lines_primitive_per_class(exported):
+    pygltflib = pytest.importorskip("pygltflib")
+    out, solution = exported
+    gltf = pygltflib.GLTF2().load(str(out / "solution.glb"))
+    blob = gltf.binary_blob()
+
+    def read(accessor_index: int, dtype, width: int) -> np.ndarray:
+        accessor = gltf.accessors[accessor_index]
+        view = gltf.bufferViews[accessor.bufferView]
+        start = (view.byteOffset or 0) + (accessor.byteOffset or 0)
+        values = np.frombuffer(blob, dtype=dtype, count=accessor.count * width, offset=start)
+        return values.reshape(accessor.count, width) if width > 1 else values
+
+    surfaces, lines = gltf.meshes
+    (triangles,) = surfaces.primitives
+    assert triangles.mode == pygltflib.TRIANGLES
+    assert "KHR_materials_unlit" in gltf.extensionsUsed
+    positions = read(triangles.attributes.POSITION, "<f4", 3)
+    assert np.array_equal(positions, solution.vertices.astype(np.float32))
+    radiosity = read(getattr(triangles.attributes, "_RADIOSITY"), "<f4", 3)
+    assert np.array_equal(radiosity, solution.radiosity.astype(np.float32))
+    colour = read(triangles.attributes.COLOR_0, "<f4", 3)
+    linear = np.clip((solution.radiosity + solution.ambient) * solution.exposure, 0, 1)
+    assert np.array_equal(colour, linear.astype(np.float32))
+    indices = read(triangles.indices, "<u4", 1).reshape(-1, 3)
+    assert np.array_equal(indices, solution.triangles)
+    classes = {p.extras["class"]: p for p in lines.primitives}
+    assert sorted(classes) == ["D0", "D1", "D2"]
+    for order in range(3):
+        primitive = classes[f"D{order}"]
+        assert primitive.mode == pygltflib.LINES
+        segments = [d for _, d in solution.lines if d["order"] == order]
+        ends = read(primitive.attributes.POSITION, "<f4", 3).reshape(-1, 2, 3)
+        given = np.array([[d["from"], d["to"]] for d in segments], dtype=np.float32)
+        assert np.array_equal(ends, given)
+
+
+def test_trimesh_loads_the_glb_as_a_scene(exported):
+    trimesh = pytest.importorskip("trimesh")
+    out, solution = exported
+    scene = trimesh.load(str(out / "solution.glb"))
+    meshes = [g for g in scene.geometry.values() if isinstance(g, trimesh.Trimesh)]
+    paths = [g for g in scene.geometry.values() if not isinstance(g, trimesh.Trimesh)]
+    assert len(meshes) == 1 and len(paths) == 3
+    (mesh,) = meshes
+    assert len(mesh.faces) == len(solution.triangles)
+    # trimesh merges nothing it was not asked to: the vertex count is the solution's.
+    assert len(mesh.vertices) == len(solution.vertices)
+    # Its area is the scene's meshed area.
+    v, t = solution.vertices, solution.triangles
+    area = 0.5 * np.linalg.norm(np.cross(v[t[:, 1]] - v[t[:, 0]], v[t[:, 2]] - v[t[:, 0]]), axis=1).sum()
+    assert mesh.area == pytest.approx(area, rel=1e-6)
