@@ -240,19 +240,27 @@ class Solution:
         *,
         svg: Union[str, Sequence[str]] = "auto",
         convergence: bool = False,
+        export: Union[str, Sequence[str]] = "html",
     ) -> list[Path]:
         """Writes the files ``penumbra run`` writes into ``directory`` (created if needed), all or
         nothing: ``solution.json``, ``report.json``, ``render.png`` and SVGs of the surfaces
         ``svg`` chooses (``"auto"``, ``"all"``, ``"none"`` or a list of names) in
-        ``surfaces/``; with ``convergence``, the solver's residual history too. Returns the
-        paths written."""
+        ``surfaces/``; with ``convergence``, the solver's residual history too; and the exports
+        ``export`` names, as ``--export`` does: any of ``"vtp"``, ``"ply"``, ``"glb"``,
+        ``"obj"``, ``"html"`` (the viewer page, ``index.html``, written by default), ``"all"``
+        or ``"none"``, as a list or comma-separated. Returns the paths written."""
         if not isinstance(directory, (str, os.PathLike)):
             raise TypeError(f"directory must be a str or a path, not {type(directory).__name__}")
         if not isinstance(svg, str):
             if not isinstance(svg, (list, tuple)) or not all(isinstance(n, str) for n in svg):
                 raise TypeError('svg must be "auto", "all", "none" or a list of surface names')
             svg = list(svg)
-        return [Path(p) for p in self._native.write(os.fspath(directory), svg, bool(convergence))]
+        if not isinstance(export, str):
+            if not isinstance(export, (list, tuple)) or not all(isinstance(n, str) for n in export):
+                raise TypeError('export must be format names ("vtp", "html", ...) as a list or a string')
+            export = ",".join(export)
+        native = self._native.write(os.fspath(directory), svg, bool(convergence), export)
+        return [Path(p) for p in native]
 
     def __repr__(self) -> str:
         method = self.report.get("method", {})

@@ -6,6 +6,7 @@ use std::sync::OnceLock;
 
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2};
 use penumbra::RunResult;
+use penumbra::export::{ExportFormat, ExportSource};
 use penumbra::outputs::{SvgSelection, write_outputs};
 use penumbra_meshing::TriangleLocator;
 use penumbra_scenes::{Rgb, SurfaceId};
@@ -159,21 +160,29 @@ impl RunOutput {
     }
 
     /// Writes the command line's files into `directory`, all or nothing; returns their paths.
-    #[pyo3(signature = (directory, svg, convergence = false))]
+    #[pyo3(signature = (directory, svg, convergence, export))]
     fn write(
         &self,
         py: Python<'_>,
         directory: PathBuf,
         svg: &Bound<'_, PyAny>,
         convergence: bool,
+        export: &str,
     ) -> PyResult<Vec<PathBuf>> {
         let svgs = svg_selection(&self.result, svg)?;
+        let formats = ExportFormat::parse_list(export).map_err(|name| {
+            PyValueError::new_err(format!(
+                "export: {name:?} is not a format; give vtp, ply, glb, obj, html, \"all\" or \"none\""
+            ))
+        })?;
         let result = &self.result;
         py.detach(|| {
-            let extra = match convergence {
+            let mut extra = match convergence {
                 true => penumbra::outputs::convergence_files(result)?,
                 false => Vec::new(),
             };
+            let source = ExportSource::of_run(result, &svgs);
+            extra.extend(penumbra::export::export(&source, &formats)?);
             write_outputs(result, &directory, &svgs, extra)
         })
         .map_err(|e| PyOSError::new_err(format!("{e:#}")))

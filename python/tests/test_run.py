@@ -58,6 +58,23 @@ def test_written_files_are_the_command_lines(cli, tmp_path):
     assert "invocation" not in report  # no command line asked for it
 
 
+def test_exports_are_the_command_lines(cli, tmp_path):
+    options = ["--direct-only", "--max-elements", "1500", "--quiet"]
+    run_cli(cli, "run", "textbook", *options, "--export", "all", "--out", "cli", cwd=tmp_path)
+    solution = penumbra.run(penumbra.Scene.builtin("textbook"), direct_only=True, max_elements=1500)
+    written = {p.name for p in solution.write(tmp_path / "py", export=["vtp", "ply", "glb", "obj", "html"])}
+    exports = ["solution.vtp", "solution.ply", "solution.glb", "solution.obj", "solution.mtl"]
+    assert written >= {*exports, "index.html"}
+    for name in exports:
+        assert (tmp_path / "py" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes(), name
+    # The page embeds report.json, which differs only by the command line the CLI records.
+    assert solution.write(tmp_path / "none", export="none")[-1].name != "index.html"
+    assert not (tmp_path / "none" / "index.html").exists()
+    with pytest.raises(ValueError, match="export: \"stl\" is not a format"):
+        solution.write(tmp_path / "bad", export="vtp,stl")
+    assert not (tmp_path / "bad").exists()
+
+
 def test_light_splits_into_emission_direct_and_indirect():
     scene = penumbra.Scene.builtin("cornell")
     solution = penumbra.run(scene, max_elements=3000)
