@@ -33,6 +33,7 @@ use penumbra_scenes::{LoadedScene, PlaneFrame, Rgb, Scene, SceneError, SurfaceId
 use serde::{Deserialize, Serialize};
 
 use crate::energy::EnergyBalance;
+use crate::export::{ExportFormat, ExportSource, export};
 use crate::options::RunOptions;
 use crate::outputs::{
     DEFAULT_SVG_SURFACES, SVG_DIR, Staging, SurfaceSolution, SvgSelection, report_json,
@@ -902,6 +903,11 @@ pub fn write_merged(merged: &Merged, dir: &Path) -> anyhow::Result<Vec<PathBuf>>
     staging.stage(dir.join("solution.json"), merged.solution_json.as_bytes())?;
     staging.stage(dir.join("report.json"), merged.report_json.as_bytes())?;
     staging.stage(dir.join("render.png"), &merged.render_png)?;
+    // The viewer page goes with the render, as in a run not split.
+    let source = ExportSource::parse(&merged.solution_json, &merged.report_json, dir)?;
+    for (name, bytes) in export(&source, &[ExportFormat::Html])? {
+        staging.stage(dir.join(name), &bytes)?;
+    }
     for (from, name) in &merged.svgs {
         let bytes =
             std::fs::read(from).with_context(|| format!("cannot read {}", from.display()))?;

@@ -446,6 +446,24 @@ fn bad_exports_are_refused_and_change_nothing() {
     );
     assert!(!out.exists(), "nothing written");
 
+    let shard = [
+        "run",
+        "textbook",
+        "--direct-only",
+        "--shard",
+        "0/2",
+        "--export",
+        "vtp",
+    ];
+    let o = penumbra(&[&shard[..], &["--out", path(&out)]].concat());
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("--shard with --export"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!out.exists(), "nothing written");
+
     let o = penumbra(&["export", path(&dir.path().join("nothing"))]);
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("solution.json"), "{}", stderr(&o));

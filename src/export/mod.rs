@@ -211,31 +211,31 @@ impl ExportSource {
                 source,
             })
         };
+        Self::parse(&read("solution.json")?, &read("report.json")?, dir)
+    }
+
+    /// `solution.json` and `report.json` from their text; `dir` is where they are, for
+    /// messages.
+    pub fn parse(solution: &str, report: &str, dir: &Path) -> Result<ExportSource, ExportError> {
         let malformed = |name: &str, what, reason: String| ExportError::Malformed {
             path: dir.join(name).display().to_string(),
             what,
             reason,
         };
-        let solution: SolutionFile = serde_json::from_str(&read("solution.json")?)
+        let solution: SolutionFile = serde_json::from_str(solution)
             .map_err(|e| malformed("solution.json", "solution", e.to_string()))?;
         if solution.format != SOLUTION_FORMAT {
-            return Err(malformed(
-                "solution.json",
-                "solution",
-                format!(
-                    "its format is {:?}, not {SOLUTION_FORMAT:?}",
-                    solution.format
-                ),
-            ));
+            let reason = format!(
+                "its format is {:?}, not {SOLUTION_FORMAT:?}",
+                solution.format
+            );
+            return Err(malformed("solution.json", "solution", reason));
         }
-        let report: serde_json::Value = serde_json::from_str(&read("report.json")?)
+        let report: serde_json::Value = serde_json::from_str(report)
             .map_err(|e| malformed("report.json", "report", e.to_string()))?;
         if report.get("format").and_then(|f| f.as_str()) != Some(crate::outputs::REPORT_FORMAT) {
-            return Err(malformed(
-                "report.json",
-                "report",
-                format!("its format is not {:?}", crate::outputs::REPORT_FORMAT),
-            ));
+            let reason = format!("its format is not {:?}", crate::outputs::REPORT_FORMAT);
+            return Err(malformed("report.json", "report", reason));
         }
         let source = ExportSource {
             scene: solution.scene,

@@ -58,6 +58,13 @@ fn shard_of(text: &str, args: &RunArgs) -> Result<penumbra::shard::Shard, Failur
     if args.time_budget.is_some() {
         return Err(refused("--time-budget", ShardError::TimeBudget));
     }
+    // The page is the default and goes with the render, which the merge makes.
+    if !matches!(args.export.trim(), crate::run_args::DEFAULT_EXPORT | "none") {
+        return Err(usage(anyhow::anyhow!(
+            "--shard with --export: a shard holds part of the solution; export the merged run \
+             (`penumbra merge ... --out DIR`, then `penumbra export DIR`)"
+        )));
+    }
     if args.convergence {
         return Err(usage(anyhow::anyhow!(
             "--shard with --convergence: a direct-only run does not iterate, so there is no \
