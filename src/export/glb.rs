@@ -17,9 +17,6 @@ use json::{Index, Root};
 use super::mesh::FlatMesh;
 use super::{Display, ExportError, boundary_colour};
 
-/// The names of the discontinuity classes, by order.
-pub const CLASSES: [&str; 3] = ["D0", "D1", "D2"];
-
 /// The file's bytes.
 pub fn glb(mesh: &FlatMesh, display: &Display) -> Result<Vec<u8>, ExportError> {
     let mut gltf = Builder::default();
@@ -27,15 +24,7 @@ pub fn glb(mesh: &FlatMesh, display: &Display) -> Result<Vec<u8>, ExportError> {
     let surfaces = gltf.mesh("surfaces", vec![surfaces]);
     let mut nodes = vec![gltf.node("surfaces", surfaces)];
     let mut classes = Vec::new();
-    for (order, class) in CLASSES.iter().enumerate() {
-        let lines: Vec<_> = mesh
-            .lines
-            .iter()
-            .filter(|l| usize::from(l.order) == order)
-            .collect();
-        if lines.is_empty() {
-            continue;
-        }
+    for (class, lines) in mesh.lines_by_class() {
         let positions: Vec<[f32; 3]> = lines
             .iter()
             .flat_map(|l| l.ends.map(|e| e.map(|c| c as f32)))

@@ -10,6 +10,9 @@ pub const EVENTS: [&str; 6] = ["EV", "VE", "EEE", "contact", "blocker-EV", "hori
 /// The boundaries a line may be, in the order their codes number them.
 pub const BOUNDARIES: [&str; 3] = ["umbra", "penumbra", "inner"];
 
+/// The names of the discontinuity classes, by order: the derivative that jumps.
+pub const CLASSES: [&str; 3] = ["D0", "D1", "D2"];
+
 /// A discontinuity segment, its names coded as indices into [`EVENTS`] and [`BOUNDARIES`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Line {
@@ -165,6 +168,18 @@ impl FlatMesh {
             _ => self.error = None,
         }
         Ok(())
+    }
+
+    /// The segments of each class present, with its name, in the order of [`CLASSES`].
+    pub fn lines_by_class(&self) -> impl Iterator<Item = (&'static str, Vec<&Line>)> {
+        CLASSES.iter().enumerate().filter_map(|(order, &class)| {
+            let lines: Vec<&Line> = self
+                .lines
+                .iter()
+                .filter(|l| usize::from(l.order) == order)
+                .collect();
+            (!lines.is_empty()).then_some((class, lines))
+        })
     }
 
     /// The number of vertices.

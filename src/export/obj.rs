@@ -10,7 +10,6 @@ use std::fmt::Write as _;
 
 use crate::outputs::SurfaceSolution;
 
-use super::glb::CLASSES;
 use super::mesh::{BOUNDARIES, FlatMesh};
 use super::{Display, boundary_colour};
 
@@ -42,15 +41,7 @@ pub fn obj(mesh: &FlatMesh, surfaces: &[SurfaceSolution], display: &Display) -> 
         );
     }
     let mut next = mesh.positions.len() as u64 + 1;
-    for (order, class) in CLASSES.iter().enumerate() {
-        let lines: Vec<_> = mesh
-            .lines
-            .iter()
-            .filter(|l| usize::from(l.order) == order)
-            .collect();
-        if lines.is_empty() {
-            continue;
-        }
+    for (class, lines) in mesh.lines_by_class() {
         let _ = writeln!(obj, "o discontinuities_{class}");
         for line in &lines {
             let colour = boundary_colour(BOUNDARIES[usize::from(line.boundary)]);
