@@ -8,16 +8,22 @@ const DEFAULT_VIEW_DIRECTION = [0.3, -1.0, 0.6];
 
 // eye, target, up (Vector3) and the vertical field of view in degrees.
 export function initialView(data, box) {
+  const center = box.getCenter(new Vector3());
   if (data.camera) {
     const c = data.camera;
+    const eye = new Vector3(...c.eye);
+    const target = new Vector3(...c.target);
+    // The same view, but the controls orbit about the point of the line of sight nearest the
+    // scene's centre rather than wherever the target was put (the Cornell box's open front).
+    const forward = target.clone().sub(eye).normalize();
+    const depth = center.clone().sub(eye).dot(forward);
     return {
-      eye: new Vector3(...c.eye),
-      target: new Vector3(...c.target),
+      eye,
+      target: depth > 0 ? eye.clone().addScaledVector(forward, depth) : target,
       up: new Vector3(...c.up).normalize(),
       fov: c.fov_deg,
     };
   }
-  const center = box.getCenter(new Vector3());
   const radius = Math.max(0.5 * box.getSize(new Vector3()).length(), 1e-9);
   const [x, y, z] = DEFAULT_VIEW_DIRECTION;
   const yUp = lightsFaceMinusY(data);

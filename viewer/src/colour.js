@@ -42,8 +42,9 @@ export function viridis(t) {
 
 // A log scale once the positive values span this many times their smallest.
 const LOG_SPAN = 100;
-// A log scale shows at most this many decades below the largest value.
-const MAX_DECADES = 6;
+// A log scale shows at most this many decades below the largest value: errors far below the
+// largest do not matter, and a wider range would flatten the ones that do.
+const MAX_DECADES = 4;
 
 // The error colour map's range: linear from 0, or logarithmic when the values span decades.
 // `position(v)` gives t in [0, 1].

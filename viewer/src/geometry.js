@@ -10,20 +10,18 @@ import {
   Mesh,
   ShaderMaterial,
   Vector3,
+  Vector4,
 } from 'three';
-import { LineMaterial } from 'three/examples/jsm/lines/LineMaterial.js';
 import { LineSegments2 } from 'three/examples/jsm/lines/LineSegments2.js';
 import { LineSegmentsGeometry } from 'three/examples/jsm/lines/LineSegmentsGeometry.js';
 import { boundaryColour, errorScale, viridis } from './colour.js';
-import { surfaceMaterial } from './material.js';
+import { drawingViewport, edgeShaders, paintedLineMaterial } from './lines.js';
+import { fillLinesMaterial, surfaceMaterial, surfaceUniforms } from './material.js';
 
 // Width of discontinuity lines in CSS pixels.
 const LINE_WIDTH = 2.5;
-// Lines on a surface are drawn only where its front can be seen: from behind, where no light
-// leaves, they would show through it. A surface is planar, so that depends only on which side of
-// its plane the eye is; the vertex shaders move the lines of the far side out of view.
-const CULL_BEHIND = /* glsl */ `
-  if (dot(plane.xyz, cameraPosition) < plane.w) gl_Position = vec4(2.0, 2.0, 2.0, 1.0);`;
+// Above this many edge-plane tests, outlines are not matched with the surfaces they meet.
+const MAX_SEAM_TESTS = 5e7;
 
 // Each surface's plane: unit normal (the side light leaves) and offset, [nx, ny, nz, n·p].
 export function surfacePlanes(data) {
@@ -50,9 +48,10 @@ export function surfacePlanes(data) {
 }
 
 // The surfaces as one mesh of separate triangles (three vertices each), so that the error
-// indicator can be flat per triangle while the light is interpolated per vertex.
-export function buildSurfaces(data) {
-  const { index, position, radiosity, direct, indirect, error } = data.arrays;
+// indicator can be flat per triangle while the light is interpolated per vertex; and the
+// surfaces' outlines as lines in the same colours, which fill the cracks between surfaces.
+export function buildSurfaces(data, planes, diagonal) {
+  const { index, position, radiosity, direct, indirect, error, triangle_surface: owner } = data.arrays;
   const corners = index.length;
   const gather = (source) => {
     const out = new Float32Array(corners * 3);
@@ -84,8 +83,12 @@ export function buildSurfaces(data) {
   geometry.setAttribute('errorColour', new BufferAttribute(colours, 3));
   geometry.computeBoundingBox();
   geometry.computeBoundingSphere();
-  const mesh = new Mesh(geometry, surfaceMaterial(data.display));
-  return { mesh, errorScale: scale };
+  const uniforms = surfaceUniforms(data.display);
+  const front = new Mesh(geometry, surfaceMaterial(uniforms, false));
+  const back = new Mesh(geometry, surfaceMaterial(uniforms, true));
+
+  const fill = buildSeams(data, geometry, planes, diagonal, uniforms);
+  return { meshes: [front, back], fill, uniforms, errorScale: scale };
 }
 
 // Every edge of the triangulation once, as thin dark lines.
@@ -116,11 +119,8 @@ export function buildEdges(data, planes) {
   geometry.setAttribute('position', new BufferAttribute(points, 3));
   geometry.setAttribute('plane', new BufferAttribute(plane, 4));
   const material = new ShaderMaterial({
-    vertexShader: `attribute vec4 plane;
-void main() {
-  gl_Position = projectionMatrix * modelViewMatrix * vec4(position, 1.0);${CULL_BEHIND}
-}`,
-    fragmentShader: 'void main() { gl_FragColor = vec4(0.0, 0.0, 0.0, 0.35); }',
+    ...edgeShaders,
+    uniforms: { colour: { value: new Vector4(0, 0, 0, 0.35) }, drawingViewport },
     transparent: true,
   });
   const lines = new LineSegments(geometry, material);
@@ -156,32 +156,91 @@ export function buildDiscontinuities(data, planes, diagonal) {
     geometry.setPositions(xyz);
     geometry.setColors(rgb);
     geometry.setAttribute('plane', new InstancedBufferAttribute(plane, 4));
-    const material = new LineMaterial({
+    const material = paintedLineMaterial({
       linewidth: LINE_WIDTH,
       vertexColors: true,
       dashed: order === 0,
       dashSize: diagonal * 0.01,
       gapSize: diagonal * 0.006,
     });
-    cullBehind(material);
     const object = new LineSegments2(geometry, material);
     if (order === 0) object.computeLineDistances();
-    // Drawn after the surfaces so that their depth is known.
-    object.renderOrder = 1;
     classes.push({ order, count: chosen.length, byBoundary, object });
   }
   return classes;
 }
 
-// Adds CULL_BEHIND to three's fat-line shader (pinned with three, so the anchors are known).
-function cullBehind(material) {
-  const anchors = ['attribute vec3 instanceEnd;', 'gl_Position = clip;'];
-  if (!anchors.every((a) => material.vertexShader.includes(a))) {
-    throw new Error('three.js\'s line shader has changed: discontinuity lines cannot be hidden from behind');
+// Each surface's boundary edges (those of one triangle only: a surface's own triangulation
+// has no T-junctions, so cracks open only where surfaces meet) as lines with the surface's
+// values. With each, the plane of a surface it lies on that has the line's surface in front
+// (the floor under a block's side), or zeros. In scenes too large to match every edge with
+// every plane, zeros: an outline may then show through a surface it meets, seen from behind.
+function buildSeams(data, geometry, planes, diagonal, uniforms) {
+  const { index, triangle_surface: owner } = data.arrays;
+  const uses = new Map();
+  const n = data.vertex_count;
+  const key = (t, k) => {
+    const a = index[t * 3 + k];
+    const b = index[t * 3 + ((k + 1) % 3)];
+    return Math.min(a, b) * n + Math.max(a, b);
+  };
+  for (let t = 0; t < owner.length; t++) {
+    for (let k = 0; k < 3; k++) uses.set(key(t, k), (uses.get(key(t, k)) ?? 0) + 1);
   }
-  material.vertexShader = material.vertexShader
-    .replace(anchors[0], `${anchors[0]}\nattribute vec4 plane;`)
-    .replace(anchors[1], `${anchors[1]}${CULL_BEHIND}`);
+  // Each boundary edge as its two corners and the triangle's third, in the separate triangles.
+  const corners = [];
+  for (let t = 0; t < owner.length; t++) {
+    for (let k = 0; k < 3; k++) {
+      if (uses.get(key(t, k)) === 1) corners.push(t * 3 + k, t * 3 + ((k + 1) % 3), t * 3 + ((k + 2) % 3));
+    }
+  }
+  const count = corners.length / 3;
+  const seams = new BufferGeometry();
+  for (const name of ['position', 'radiosity', 'direct', 'indirect', 'errorColour']) {
+    const from = geometry.getAttribute(name).array;
+    const to = new Float32Array(count * 6);
+    for (let e = 0; e < count; e++) {
+      to.set(from.subarray(corners[e * 3] * 3, corners[e * 3] * 3 + 3), e * 6);
+      to.set(from.subarray(corners[e * 3 + 1] * 3, corners[e * 3 + 1] * 3 + 3), e * 6 + 3);
+    }
+    seams.setAttribute(name, new BufferAttribute(to, 3));
+  }
+  const p = geometry.getAttribute('position').array;
+  const tolerance = 1e-5 * diagonal;
+  const plane = new Float32Array(count * 8);
+  const beyond = new Float32Array(count * 8);
+  const a = new Vector3();
+  const b = new Vector3();
+  const edge = new Vector3();
+  const inward = new Vector3();
+  const on = (q, v) => Math.abs(q[0] * v.x + q[1] * v.y + q[2] * v.z - q[3]) <= tolerance;
+  const match = count * planes.length <= MAX_SEAM_TESTS;
+  for (let e = 0; e < count; e++) {
+    const own = owner[Math.floor(corners[e * 3] / 3)];
+    plane.set(planes[own], e * 8);
+    plane.set(planes[own], e * 8 + 4);
+    if (!match) continue;
+    a.fromArray(p, corners[e * 3] * 3);
+    b.fromArray(p, corners[e * 3 + 1] * 3);
+    // Into the triangle, square to the edge.
+    edge.subVectors(b, a).normalize();
+    inward.fromArray(p, corners[e * 3 + 2] * 3).sub(a);
+    inward.addScaledVector(edge, -inward.dot(edge));
+    for (let s = 0; s < planes.length; s++) {
+      const q = planes[s];
+      if (s === own || !on(q, a) || !on(q, b)) continue;
+      if (q[0] * inward.x + q[1] * inward.y + q[2] * inward.z > 0) {
+        beyond.set(q, e * 8);
+        beyond.set(q, e * 8 + 4);
+        break;
+      }
+    }
+  }
+  seams.setAttribute('plane', new BufferAttribute(plane, 4));
+  seams.setAttribute('beyond', new BufferAttribute(beyond, 4));
+  seams.boundingBox = geometry.boundingBox;
+  seams.boundingSphere = geometry.boundingSphere;
+  return new LineSegments(seams, fillLinesMaterial(uniforms));
 }
 
 export function bounds(data) {

@@ -27,6 +27,7 @@ export function buildSidePanel(root, data, state, on) {
   const select = h('select', { id: 'colour-mode', 'aria-label': 'Colour by', onchange: () => on.mode(select.value) },
     modes.map((m) => h('option', { value: m }, MODE_LABELS[m])));
   const bar = h('canvas', { width: BAR_STEPS, height: 1, 'aria-hidden': 'true' });
+  const threshold = h('div', { class: 'threshold', title: 'The refinement\'s threshold in its last round' });
   const ticks = h('div', { class: 'ticks' });
   const scaleNote = h('p', { class: 'note' });
   const stopsInput = h('input', {
@@ -49,7 +50,7 @@ export function buildSidePanel(root, data, state, on) {
       report?.partial === true ? h('span', { class: 'badge', title: 'The run was cut short: the values are the best so far.' }, 'partial') : null),
     h('h2', {}, 'Colour by'),
     select,
-    h('div', { class: 'scale', style: { marginTop: '8px' } }, bar, ticks),
+    h('div', { class: 'scale', style: { marginTop: '8px' } }, bar, threshold, ticks),
     scaleNote,
     exposureRow,
     h('p', { class: 'note' }, h('span', { class: 'swatch box', style: { background: '#3a3d42' } }),
@@ -78,8 +79,17 @@ export function buildSidePanel(root, data, state, on) {
       const values = scale.log ? decadeTicks(scale.lo, scale.hi, 6) : niceTicks(0, scale.hi, 4);
       for (const v of values) marks.push([scale.position(v), v]);
       note = scale.log
-        ? `W/m², log scale, ${format.value(scale.lo)} to ${format.value(scale.hi)}${scale.clipped ? '; smaller values show as the lowest colour' : ''}. One colour per triangle: the refinement's estimate of its interpolation error.`
-        : `W/m², linear scale, 0 to ${format.value(scale.hi)}. One colour per triangle: the refinement's estimate of its interpolation error.`;
+        ? `W/m², log scale, ${format.value(scale.lo)} to ${format.value(scale.hi)}${scale.clipped ? '; smaller values show as the lowest colour' : ''}.`
+        : `W/m², linear scale, 0 to ${format.value(scale.hi)}.`;
+      note += ' One colour per triangle: the refinement\'s estimate of its interpolation error.';
+      const last = report?.refinement?.rounds?.at?.(-1);
+      const t = last?.threshold > 0 ? scale.position(last.threshold) : NaN;
+      threshold.hidden = !(t >= 0 && t <= 1);
+      if (!threshold.hidden) {
+        threshold.style.left = `${(t * 100).toFixed(2)}%`;
+        note += ` White mark: the last round's threshold, ${format.value(last.threshold)} W/m²`;
+        note += Number.isInteger(last.over_tolerance) ? ` (${format.count(last.over_tolerance)} triangles above).` : '.';
+      }
       exposureRow.style.display = 'none';
     } else {
       const exposure = state.exposure * 2 ** state.stops;
@@ -95,6 +105,7 @@ export function buildSidePanel(root, data, state, on) {
       note = `W/m² per channel, shown as ${formula}; white at ${format.value(white)} W/m² and above.`;
       if (mode === 'radiosity' && ambient !== 0) note += ` Ambient ${format.point(data.display.ambient)} W/m², for display only.`;
       exposureRow.style.display = '';
+      threshold.hidden = true;
       exposureText.textContent = `${format.value(exposure)} m²/W`;
     }
     context.putImageData(image, 0, 0);
@@ -147,15 +158,16 @@ function runSection(data, report) {
   const method = report.method ?? {};
   add('mesh', method.mesh);
   const solver = report.solver ?? {};
-  add('solver', [method.solver, solver.stop].filter(Boolean).join(', '));
-  add('iterations', Number.isInteger(solver.iterations) ? format.count(solver.iterations) : undefined);
+  add('solver', method.solver);
+  add('iterations', [Number.isInteger(solver.iterations) ? format.count(solver.iterations) : null, solver.stop].filter((x) => x !== null && x !== undefined).join(', '));
   const counts = report.counts ?? {};
   add('triangles', counts.triangles !== undefined ? format.count(counts.triangles) : undefined);
   add('vertices', counts.vertices !== undefined ? format.count(counts.vertices) : undefined);
   add('discontinuity segments', counts.discontinuity_segments !== undefined ? format.count(counts.discontinuity_segments) : undefined);
   const refinement = report.refinement;
   if (refinement) {
-    add('refinement', `tol ${format.value(refinement.tolerance)}, ${refinement.rounds?.length ?? '?'} rounds${refinement.stop ? `, ${refinement.stop}` : ''}`);
+    add('refinement tol.', format.value(refinement.tolerance), 'As a fraction of the mean reflected radiosity');
+    add('rounds', [Array.isArray(refinement.rounds) ? format.count(refinement.rounds.length) : null, refinement.stop].filter(Boolean).join(', '));
   }
   add('total time', report.times_seconds?.total !== undefined ? format.seconds(report.times_seconds.total) : undefined);
   if (typeof method.threads === 'number') add('threads', String(method.threads));
@@ -166,7 +178,7 @@ function runSection(data, report) {
     add('energy balance', `${energy.balanced ? 'closes' : 'does not close'} (${format.value(energy.closure_error, 2)})`,
       'emitted = absorbed + escaped + unshot, to this relative error');
   }
-  if (report.partial === true) add('partial', 'yes: the run was cut short');
+  if (report.partial === true) add('partial', 'yes, cut short', 'The run was cut short: the values are the best so far');
   if (Array.isArray(report.warnings) && report.warnings.length) add('warnings', String(report.warnings.length));
   const warnings = Array.isArray(report.warnings)
     ? report.warnings.map((w) => h('p', { class: 'note' }, typeof w === 'string' ? w : w?.message ?? JSON.stringify(w)))

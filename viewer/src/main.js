@@ -2,13 +2,14 @@
 // Flags for scripts and tests: window.penumbraReady (first frame drawn), window.penumbraError
 // (the message shown), window.penumbraFrame (frames drawn so far).
 
-import { Color, Scene, Vector3, WebGLRenderer } from 'three';
+import { Color, Scene, Vector2, Vector3, WebGLRenderer } from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import { applyView, fitAspect, fitClipping, initialView, makeCamera } from './camera.js';
 import { DataError, readData } from './data.js';
 import { h } from './dom.js';
 import { bounds, buildDiscontinuities, buildEdges, buildSurfaces, surfacePlanes } from './geometry.js';
 import { buildSidePanel } from './legend.js';
+import { drawingViewport } from './lines.js';
 import { setExposure, setMode } from './material.js';
 import { hidePick, showPick } from './pickpanel.js';
 import { Picker } from './picking.js';
@@ -50,12 +51,12 @@ function start() {
   const diagonal = box.getSize(new Vector3()).length();
   const scene = new Scene();
   scene.background = new Color(BACKGROUND);
-  const { mesh, errorScale } = buildSurfaces(data);
   const planes = surfacePlanes(data);
+  const { meshes, fill, uniforms, errorScale } = buildSurfaces(data, planes, diagonal);
   const edges = buildEdges(data, planes);
   const classes = buildDiscontinuities(data, planes, diagonal);
-  const picker = new Picker(data, mesh);
-  scene.add(mesh, edges.lines, picker.marker);
+  const picker = new Picker(data, meshes);
+  scene.add(...meshes, fill, edges.lines, picker.marker);
   for (const c of classes) if (c.object) scene.add(c.object);
 
   const home = initialView(data, box);
@@ -70,13 +71,13 @@ function start() {
   const panel = buildSidePanel(side, data, state, {
     mode(mode) {
       state.mode = mode;
-      setMode(mesh.material, mode);
+      setMode(uniforms, mode);
       panel.updateScale();
       requestFrame();
     },
     stops(stops) {
       state.stops = stops;
-      setExposure(mesh.material, state.exposure * 2 ** stops);
+      setExposure(uniforms, state.exposure * 2 ** stops);
       panel.updateScale();
       requestFrame();
     },
@@ -95,8 +96,11 @@ function start() {
   });
 
   let frames = 0;
+  const drawingSize = new Vector2();
   function draw() {
     fitClipping(camera, box);
+    renderer.getDrawingBufferSize(drawingSize);
+    drawingViewport.value.set(0, 0, drawingSize.x, drawingSize.y);
     picker.update(camera);
     renderer.render(scene, camera);
     window.penumbraFrame = ++frames;

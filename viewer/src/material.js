@@ -2,7 +2,8 @@
 // sRGB curve per fragment, as render.png does per pixel (encoding per vertex would brighten the
 // insides of triangles).
 
-import { DoubleSide, ShaderMaterial, Vector2, Vector3 } from 'three';
+import { BackSide, FrontSide, ShaderMaterial, Vector2, Vector3 } from 'three';
+import { CULL_BEHIND, PLANE_DEPTH, drawingViewport } from './lines.js';
 
 export const MODES = ['radiosity', 'direct', 'indirect', 'error'];
 
@@ -10,6 +11,11 @@ export const MODES = ['radiosity', 'direct', 'indirect', 'error'];
 // grey, shaded by their slant, so that the geometry reads from outside the box.
 const BACK_GREY = [0.16, 0.27];
 
+// With FILL_LINES the same shader draws the surfaces' outlines as lines (see lines.js), to fill
+// the pixel-wide cracks the rasterizer leaves where one surface's vertex lies on another's edge
+// (T-junctions, where two surfaces meet). Not where the plane of the surface met there lies
+// between the eye and the line's surface (a block's foot seen from under the floor): painted on
+// its own plane, the line would show through that surface's back along the seam.
 const vertexShader = /* glsl */ `
 attribute vec3 radiosity;
 attribute vec3 direct;
@@ -19,12 +25,20 @@ uniform int mode;
 varying vec3 vLight;
 varying vec3 vErrorColour;
 varying vec3 vViewPosition;
+#ifdef FILL_LINES
+attribute vec4 plane;
+attribute vec4 beyond;
+varying vec4 vPlane;
+#endif
 void main() {
   vLight = mode == 0 ? radiosity : (mode == 1 ? direct : indirect);
   vErrorColour = errorColour;
   vec4 viewPosition = modelViewMatrix * vec4(position, 1.0);
   vViewPosition = viewPosition.xyz;
   gl_Position = projectionMatrix * viewPosition;
+#ifdef FILL_LINES${CULL_BEHIND}
+  if (dot(beyond.xyz, beyond.xyz) > 0.0 && dot(beyond.xyz, cameraPosition) < beyond.w) gl_Position = vec4(2.0, 2.0, 2.0, 1.0);
+#endif
 }
 `;
 
@@ -36,6 +50,9 @@ uniform vec2 backGrey;
 varying vec3 vLight;
 varying vec3 vErrorColour;
 varying vec3 vViewPosition;
+#ifdef FILL_LINES
+${PLANE_DEPTH}
+#endif
 float srgbEncode(float x) {
   x = clamp(x, 0.0, 1.0);
   return x <= 0.0031308 ? 12.92 * x : 1.055 * pow(x, 1.0 / 2.4) - 0.055;
@@ -44,8 +61,17 @@ vec3 srgbEncode(vec3 c) {
   return vec3(srgbEncode(c.r), srgbEncode(c.g), srgbEncode(c.b));
 }
 void main() {
+#ifdef FILL_LINES
+  gl_FragDepth = planeDepth(vPlane);
+#endif
+  // Each material draws one side (gl_FrontFacing is flipped for three's BackSide materials).
+#ifdef BACK_FACES
+  bool front = false;
+#else
+  bool front = true;
+#endif
   vec3 colour;
-  if (!gl_FrontFacing) {
+  if (!front) {
     vec3 normal = normalize(cross(dFdx(vViewPosition), dFdy(vViewPosition)));
     float slant = abs(dot(normal, normalize(vViewPosition)));
     vec3 lit = mode == 0 ? srgbEncode(ambient * exposure) : vec3(0.0);
@@ -60,28 +86,44 @@ void main() {
 }
 `;
 
-export function surfaceMaterial(display) {
+// The uniforms the two materials share: a mode or exposure set once applies to both.
+export function surfaceUniforms(display) {
+  return {
+    mode: { value: 0 },
+    exposure: { value: display.exposure },
+    ambient: { value: new Vector3(...display.ambient) },
+    backGrey: { value: new Vector2(...BACK_GREY) },
+  };
+}
+
+// One material per side. Backs are pushed back in depth a little, so that where a front and a
+// back meet along a silhouette, the front shows rather than a jagged grey seam.
+export function surfaceMaterial(uniforms, back) {
   return new ShaderMaterial({
     vertexShader,
     fragmentShader,
-    side: DoubleSide,
-    uniforms: {
-      mode: { value: 0 },
-      exposure: { value: display.exposure },
-      ambient: { value: new Vector3(...display.ambient) },
-      backGrey: { value: new Vector2(...BACK_GREY) },
-    },
-    // Pushed back in depth so that mesh edges and discontinuity lines on a surface win.
-    polygonOffset: true,
-    polygonOffsetFactor: 1,
-    polygonOffsetUnits: 1,
+    uniforms,
+    side: back ? BackSide : FrontSide,
+    defines: back ? { BACK_FACES: '' } : {},
+    polygonOffset: back,
+    polygonOffsetFactor: 0,
+    polygonOffsetUnits: 4,
   });
 }
 
-export function setMode(material, mode) {
-  material.uniforms.mode.value = MODES.indexOf(mode);
+export function fillLinesMaterial(uniforms) {
+  return new ShaderMaterial({
+    vertexShader,
+    fragmentShader,
+    uniforms: { ...uniforms, drawingViewport },
+    defines: { FILL_LINES: '' },
+  });
 }
 
-export function setExposure(material, exposure) {
-  material.uniforms.exposure.value = exposure;
+export function setMode(uniforms, mode) {
+  uniforms.mode.value = MODES.indexOf(mode);
+}
+
+export function setExposure(uniforms, exposure) {
+  uniforms.exposure.value = exposure;
 }

@@ -7,9 +7,10 @@ import { Mesh, MeshBasicMaterial, Raycaster, SphereGeometry, Triangle, Vector2, 
 const MARKER_SCALE = 0.006;
 
 export class Picker {
-  constructor(data, mesh) {
+  // `meshes`: the surfaces' fronts and backs (one geometry, so one triangle numbering).
+  constructor(data, meshes) {
     this.data = data;
-    this.mesh = mesh;
+    this.meshes = meshes;
     this.raycaster = new Raycaster();
     this.marker = new Mesh(
       new SphereGeometry(1, 16, 12),
@@ -22,7 +23,7 @@ export class Picker {
   // The pick at a point in normalized device coordinates, or null when nothing is there.
   pick(ndc, camera) {
     this.raycaster.setFromCamera(new Vector2(ndc.x, ndc.y), camera);
-    const hit = this.raycaster.intersectObject(this.mesh, false)[0];
+    const hit = this.raycaster.intersectObjects(this.meshes, false)[0];
     if (!hit) return null;
     const t = hit.faceIndex;
     const { index, position, radiosity, direct, indirect, error, triangle_surface: owner } = this.data.arrays;
