@@ -31,6 +31,8 @@ function showError(message) {
 }
 
 function start() {
+  // The page's own message, for when this script does not run at all.
+  document.getElementById('message').hidden = true;
   const data = readData(document);
   const view = document.getElementById('view');
   const side = document.getElementById('side');
