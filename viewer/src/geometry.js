@@ -176,22 +176,27 @@ export function buildDiscontinuities(data, planes, diagonal) {
 // (the floor under a block's side), or zeros. In scenes too large to match every edge with
 // every plane, zeros: an outline may then show through a surface it meets, seen from behind.
 function buildSeams(data, geometry, planes, diagonal, uniforms) {
-  const { index, triangle_surface: owner } = data.arrays;
-  const uses = new Map();
-  const n = data.vertex_count;
-  const key = (t, k) => {
-    const a = index[t * 3 + k];
-    const b = index[t * 3 + ((k + 1) % 3)];
-    return Math.min(a, b) * n + Math.max(a, b);
+  const { triangle_surface: owner } = data.arrays;
+  const p = geometry.getAttribute('position').array;
+  // Edges by their ends' positions: the two sides of a value jump (D0) carry separate vertices
+  // at the same places, and meet without a crack.
+  const at = (c) => `${p[c * 3]},${p[c * 3 + 1]},${p[c * 3 + 2]}`;
+  const key = (c, d) => {
+    const [u, v] = [at(c), at(d)];
+    return u < v ? `${u} ${v}` : `${v} ${u}`;
   };
-  for (let t = 0; t < owner.length; t++) {
-    for (let k = 0; k < 3; k++) uses.set(key(t, k), (uses.get(key(t, k)) ?? 0) + 1);
+  const uses = new Map();
+  for (let c = 0; c < p.length / 3; c += 3) {
+    for (let k = 0; k < 3; k++) {
+      const edge = key(c + k, c + ((k + 1) % 3));
+      uses.set(edge, (uses.get(edge) ?? 0) + 1);
+    }
   }
   // Each boundary edge as its two corners and the triangle's third, in the separate triangles.
   const corners = [];
-  for (let t = 0; t < owner.length; t++) {
+  for (let c = 0; c < p.length / 3; c += 3) {
     for (let k = 0; k < 3; k++) {
-      if (uses.get(key(t, k)) === 1) corners.push(t * 3 + k, t * 3 + ((k + 1) % 3), t * 3 + ((k + 2) % 3));
+      if (uses.get(key(c + k, c + ((k + 1) % 3))) === 1) corners.push(c + k, c + ((k + 1) % 3), c + ((k + 2) % 3));
     }
   }
   const count = corners.length / 3;
@@ -205,7 +210,6 @@ function buildSeams(data, geometry, planes, diagonal, uniforms) {
     }
     seams.setAttribute(name, new BufferAttribute(to, 3));
   }
-  const p = geometry.getAttribute('position').array;
   const tolerance = 1e-5 * diagonal;
   const plane = new Float32Array(count * 8);
   const beyond = new Float32Array(count * 8);

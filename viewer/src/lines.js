@@ -15,9 +15,10 @@ export const CULL_BEHIND = /* glsl */ `
   if (dot(plane.xyz, cameraPosition) < plane.w) gl_Position = vec4(2.0, 2.0, 2.0, 1.0);`;
 
 // Fragment shader: planeDepth(vPlane) is the window depth of the plane where this pixel's view
-// ray meets it, brought nearer by half the plane's depth change across a pixel (antialiasing
-// samples the surface up to half a pixel from the pixel's centre, where the line's depth is
-// taken) and a hair more.
+// ray meets it, brought nearer by the plane's depth change over 3/8 of a pixel (4x antialiasing
+// samples the surface that far from the pixel's centre, where the line's depth is taken) and a
+// hair more. A surface nearer than that in front of the line's own (a lamp just under a
+// ceiling, seen at a slant) does not hide it.
 export const PLANE_DEPTH = /* glsl */ `
 uniform mat4 projectionMatrix;
 uniform vec4 drawingViewport;
@@ -34,7 +35,7 @@ float planeDepth(vec4 plane) {
   float viewZ = -(plane.w - dot(plane.xyz, cameraPosition)) / along;
   float ndcZ = (projectionMatrix[2][2] * viewZ + projectionMatrix[3][2]) / -viewZ;
   float depth = 0.5 * ndcZ + 0.5;
-  return clamp(depth - 0.5 * fwidth(depth) - LINE_LIFT, 0.0, 1.0);
+  return clamp(depth - 0.375 * fwidth(depth) - LINE_LIFT, 0.0, 1.0);
 }
 `;
 
