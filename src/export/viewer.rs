@@ -30,13 +30,15 @@ pub const VIEWER_FORMAT: &str = "penumbra-viewer/1";
 
 /// The page's text.
 pub fn page(source: &ExportSource, mesh: &FlatMesh, display: &Display) -> String {
-    // `</` would end the script element early; `<\/` is the same JSON string.
+    // Markup in a name (`</script>`, `<!--`) would end or change the script element: `<` is
+    // written `\u003c`, the same JSON string (outside strings, JSON has no `<`).
     let data = data(source, mesh, display)
         .to_string()
-        .replace("</", "<\\/");
+        .replace('<', "\\u003c");
+    // The script first: the data may hold any text, the bundle holds no slot (`viewer/build`).
     TEMPLATE
-        .replacen(DATA_SLOT, &data, 1)
         .replacen(SCRIPT_SLOT, SCRIPT, 1)
+        .replacen(DATA_SLOT, &data, 1)
 }
 
 /// The `penumbra-viewer/1` object.
