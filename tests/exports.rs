@@ -329,7 +329,7 @@ fn the_glb_export_is_a_valid_gltf_document() {
         let found = p
             .attributes
             .iter()
-            .find(|(s, _)| serde_json::to_value(s).expect("a name") == Value::from(name));
+            .find(|(s, _)| serde_json::to_value(s).expect("a name") == name);
         root.accessors[found.expect(name).1.value()].count.0 as usize
     };
     for name in ["POSITION", "NORMAL", "COLOR_0", "_RADIOSITY"] {

@@ -232,7 +232,6 @@ impl Builder {
         };
         material.extensions = Some(json::extensions::material::Material {
             unlit: Some(json::extensions::material::Unlit {}),
-            ..Default::default()
         });
         self.root.push(material)
     }

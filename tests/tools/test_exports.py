@@ -3,24 +3,23 @@
 solution.glb. Counts, values to the bit against solution.json, and the discontinuity classes."""
 
 import json
-import os
 import subprocess
 from pathlib import Path
 
 import numpy as np
+import plyfile
+import pygltflib
 import pytest
+import trimesh
+import vtk
+from vtk.util.numpy_support import vtk_to_numpy
 
-ROOT = Path(__file__).resolve().parents[2]
-CLI = Path(os.environ.get("PENUMBRA_CLI", ROOT / "target" / "release" / "penumbra"))
 EVENTS = ["EV", "VE", "EEE", "contact", "blocker-EV", "horizon"]
 BOUNDARIES = ["umbra", "penumbra", "inner"]
 
 
-def run(out: Path, *options: str) -> None:
-    subprocess.run(
-        [str(CLI), "run", "cornell", "--out", str(out), "--quiet", *options],
-        check=True,
-    )
+def run(cli: Path, out: Path, *options: str) -> None:
+    subprocess.run([str(cli), "run", "cornell", "--out", str(out), "--quiet", *options], check=True)
 
 
 class Solution:
@@ -66,21 +65,20 @@ class Solution:
 
 
 @pytest.fixture(scope="module")
-def exported(tmp_path_factory):
+def exported(penumbra_cli, tmp_path_factory):
     out = tmp_path_factory.mktemp("cornell")
-    run(out, "--max-elements", "4000", "--export", "vtp,ply,glb,obj")
+    run(penumbra_cli, out, "--max-elements", "4000", "--export", "vtp,ply,glb,obj")
     return out, Solution(out)
 
 
 @pytest.fixture(scope="module")
-def adaptive(tmp_path_factory):
+def adaptive(penumbra_cli, tmp_path_factory):
     out = tmp_path_factory.mktemp("adaptive")
-    run(out, "--max-elements", "6000", "--refine-tol", "0.05", "--solver", "progressive", "--export", "vtp")
+    run(penumbra_cli, out, "--max-elements", "6000", "--refine-tol", "0.05", "--solver", "progressive", "--export", "vtp")
     return out, Solution(out)
 
 
 def read_vtp(path: Path):
-    vtk = pytest.importorskip("vtk")
     reader = vtk.vtkXMLPolyDataReader()
     reader.SetFileName(str(path))
     reader.Update()
@@ -88,8 +86,6 @@ def read_vtp(path: Path):
 
 
 def array(data, name: str) -> np.ndarray:
-    from vtk.util.numpy_support import vtk_to_numpy
-
     found = data.GetArray(name)
     assert found is not None, f"no array {name}"
     return vtk_to_numpy(found)
@@ -98,8 +94,6 @@ def array(data, name: str) -> np.ndarray:
 def test_vtk_reads_the_mesh_values_and_lines(exported):
     out, solution = exported
     poly = read_vtp(out / "solution.vtp")
-    from vtk.util.numpy_support import vtk_to_numpy
-
     lines = len(solution.lines)
     n = len(solution.vertices)
     assert poly.GetNumberOfPoints() == n + 2 * lines
@@ -155,7 +149,6 @@ def test_vtk_reads_the_error_indicator_of_an_adaptive_run(adaptive):
 
 
 def test_plyfile_reads_positions_colours_and_quality(exported):
-    plyfile = pytest.importorskip("plyfile")
     out, solution = exported
     ply = plyfile.PlyData.read(str(out / "solution.ply"))
     assert not ply.text and ply.byte_order == "<", "binary little endian"
@@ -170,7 +163,6 @@ def test_plyfile_reads_positions_colours_and_quality(exported):
 
 
 def test_pygltflib_reads_the_mesh_and_a_lines_primitive_per_class(exported):
-    pygltflib = pytest.importorskip("pygltflib")
     out, solution = exported
     gltf = pygltflib.GLTF2().load(str(out / "solution.glb"))
     blob = gltf.binary_blob()
@@ -207,7 +199,6 @@ def test_pygltflib_reads_the_mesh_and_a_lines_primitive_per_class(exported):
 
 
 def test_trimesh_loads_the_glb_as_a_scene(exported):
-    trimesh = pytest.importorskip("trimesh")
     out, solution = exported
     scene = trimesh.load(str(out / "solution.glb"))
     meshes = [g for g in scene.geometry.values() if isinstance(g, trimesh.Trimesh)]
