@@ -3,6 +3,7 @@
 solution.glb. Counts, values to the bit against solution.json, and the discontinuity classes."""
 
 import json
+import shutil
 import subprocess
 from pathlib import Path
 
@@ -14,6 +15,7 @@ import trimesh
 import vtk
 from vtk.util.numpy_support import vtk_to_numpy
 
+ROOT = Path(__file__).resolve().parents[2]
 EVENTS = ["EV", "VE", "EEE", "contact", "blocker-EV", "horizon"]
 BOUNDARIES = ["umbra", "penumbra", "inner"]
 
@@ -212,3 +214,15 @@ def test_trimesh_loads_the_glb_as_a_scene(exported):
     v, t = solution.vertices, solution.triangles
     area = 0.5 * np.linalg.norm(np.cross(v[t[:, 1]] - v[t[:, 0]], v[t[:, 2]] - v[t[:, 0]]), axis=1).sum()
     assert mesh.area == pytest.approx(area, rel=1e-6)
+
+
+def test_the_khronos_validator_finds_no_issue(exported):
+    out, _ = exported
+    node = shutil.which("node")
+    assert node, "the glTF validator runs on Node.js"
+    assert (ROOT / "viewer" / "node_modules" / "gltf-validator").is_dir(), "run viewer/build (npm ci) first"
+    script = Path(__file__).with_name("validate_gltf.js")
+    done = subprocess.run([node, str(script), str(out / "solution.glb")], capture_output=True, text=True, check=True)
+    issues = json.loads(done.stdout)
+    assert issues["numErrors"] == 0 and issues["numWarnings"] == 0, issues["messages"]
+    assert issues["numInfos"] == 0 and issues["numHints"] == 0, issues["messages"]
