@@ -20,7 +20,7 @@ use super::{Display, ExportError, boundary_colour};
 /// The file's bytes.
 pub fn glb(mesh: &FlatMesh, display: &Display) -> Result<Vec<u8>, ExportError> {
     let mut gltf = Builder::default();
-    let surfaces = surface_primitive(&mut gltf, mesh, display)?;
+    let surfaces = surface_primitive(&mut gltf, mesh, display);
     let surfaces = gltf.mesh("surfaces", vec![surfaces]);
     let mut nodes = vec![gltf.node("surfaces", surfaces)];
     let mut classes = Vec::new();
@@ -65,7 +65,7 @@ fn surface_primitive(
     gltf: &mut Builder,
     mesh: &FlatMesh,
     display: &Display,
-) -> Result<json::mesh::Primitive, ExportError> {
+) -> json::mesh::Primitive {
     let f32s = |v: &[f64; 3]| v.map(|c| c as f32);
     let positions: Vec<[f32; 3]> = mesh.positions.iter().map(f32s).collect();
     let normals = vertex_normals(mesh);
@@ -93,9 +93,9 @@ fn surface_primitive(
             gltf.vec3(&radiosity, "_RADIOSITY", false),
         ),
     ]);
-    let indices = gltf.indices(&mesh.triangles)?;
+    let indices = gltf.indices(&mesh.triangles);
     let material = gltf.unlit("surfaces");
-    Ok(json::mesh::Primitive {
+    json::mesh::Primitive {
         attributes,
         extensions: None,
         extras: None,
@@ -103,7 +103,7 @@ fn surface_primitive(
         material: Some(material),
         mode: Valid(json::mesh::Mode::Triangles),
         targets: None,
-    })
+    }
 }
 
 /// Each vertex's surface's normal (a surface is planar: the normal of its largest triangle),
@@ -198,14 +198,14 @@ impl Builder {
     }
 
     /// The triangles' corners as `u32` indices.
-    fn indices(&mut self, triangles: &[[u32; 3]]) -> Result<Index<json::Accessor>, ExportError> {
+    fn indices(&mut self, triangles: &[[u32; 3]]) -> Index<json::Accessor> {
         let bytes: Vec<u8> = triangles
             .iter()
             .flatten()
             .flat_map(|v| v.to_le_bytes())
             .collect();
         let view = self.view(&bytes, json::buffer::Target::ElementArrayBuffer);
-        Ok(self.root.push(json::Accessor {
+        self.root.push(json::Accessor {
             buffer_view: Some(view),
             byte_offset: Some(USize64(0)),
             count: USize64::from(triangles.len() * 3),
@@ -220,7 +220,7 @@ impl Builder {
             name: Some("indices".into()),
             normalized: false,
             sparse: None,
-        }))
+        })
     }
 
     /// An unlit, double-sided, white material: vertex colours show as they are.
