@@ -2,28 +2,13 @@
 Chromium driven by Playwright, and a directory for the pictures the tests leave behind."""
 
 import os
-import shutil
 from pathlib import Path
 
 import pytest
 
+from browser import CHROMIUM_ARGS, chromium_path
+
 ROOT = Path(__file__).resolve().parents[2]
-
-# Chromium from the system (Debian's `chromium`); Playwright's own browser download is not used.
-# WebGL in headless Chromium needs a software renderer: SwiftShader through ANGLE. Recent
-# Chromium no longer falls back to it on its own, hence --enable-unsafe-swiftshader; without
-# --use-angle=swiftshader it logs a "GPU stall due to ReadPixels" warning per frame read. Root
-# cannot use the sandbox. The rest keeps the browser off the network.
-CHROMIUM_ARGS = [
-    "--no-sandbox",
-    "--use-angle=swiftshader",
-    "--enable-unsafe-swiftshader",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--no-first-run",
-    "--disable-sync",
-]
-
 
 def _missing(reason: str):
     """Skips the test, or fails it when PENUMBRA_REQUIRE_BROWSER is set (as in CI)."""
@@ -48,7 +33,7 @@ def browser():
         from playwright.sync_api import sync_playwright
     except ImportError:
         _missing("the browser tests need Playwright: pip install playwright")
-    executable = os.environ.get("PENUMBRA_CHROMIUM") or shutil.which("chromium") or "/usr/bin/chromium"
+    executable = chromium_path()
     if not Path(executable).is_file():
         _missing(f"the browser tests need Chromium (apt-get install chromium); none at {executable}")
     with sync_playwright() as playwright:
