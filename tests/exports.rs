@@ -164,11 +164,9 @@ fn direct_light_in_solution_json_is_the_direct_only_runs() {
 fn the_obj_export_reads_back_with_tobj() {
     let dir = tempfile::tempdir().expect("temp dir");
     let out = dir.path().join("out");
-    run_quietly(
-        "cornell",
-        &out,
-        &["--max-elements", "2000", "--export", "obj"],
-    );
+    // Direct light only: the render adds an ambient term, each surface ρ times it.
+    let options = ["--max-elements", "2000", "--direct-only", "--export", "obj"];
+    run_quietly("cornell", &out, &options);
     let solution = json(&out.join("solution.json"));
     let report = json(&out.join("report.json"));
     let options = tobj::LoadOptions {
@@ -183,6 +181,7 @@ fn the_obj_export_reads_back_with_tobj() {
     assert_eq!(models.len(), surfaces.len() + classes);
     let exposure = report["render"]["exposure"].as_f64().expect("exposure");
     let ambient: [f64; 3] = serde_json::from_value(report["render"]["ambient"].clone()).expect("");
+    assert!(ambient.iter().all(|a| *a > 0.0), "an ambient term to show");
     for (model, surface) in models.iter().zip(surfaces) {
         let m = &model.mesh;
         let expected: Vec<[f64; 3]> =
@@ -205,7 +204,7 @@ fn the_obj_export_reads_back_with_tobj() {
         let rgb = |f: &str| -> [f64; 3] { serde_json::from_value(surface[f].clone()).expect(f) };
         assert_eq!(material.diffuse, Some(rgb("reflectance")));
         assert_eq!(material.emissive.unwrap_or_default(), rgb("emission"));
-        // Colours are render.png's: sRGB of (B + ambient) × exposure, in 8 bits.
+        // Colours are render.png's: sRGB of (B + ρ·ambient) × exposure, in 8 bits.
         let radiosity: Vec<[f64; 3]> =
             serde_json::from_value(surface["radiosity"].clone()).expect("radiosity");
         let mut checked = 0;
@@ -216,7 +215,8 @@ fn the_obj_export_reads_back_with_tobj() {
                 continue;
             };
             for ch in 0..3 {
-                let shown = penumbra_viz::srgb_encode((radiosity[v][ch] + ambient[ch]) * exposure);
+                let lifted = radiosity[v][ch] + rgb("reflectance")[ch] * ambient[ch];
+                let shown = penumbra_viz::srgb_encode(lifted * exposure);
                 assert!((c[ch] - (shown * 255.0).round() / 255.0).abs() < 1e-6);
             }
             checked += 1;

@@ -1,7 +1,7 @@
 //! `solution.glb`: glTF 2.0 binary, which browsers (three.js, Babylon.js) and Blender read.
 //!
 //! One unlit mesh of every surface (`KHR_materials_unlit`): positions, normals and `COLOR_0`,
-//! the linear display value of `render.png` ((radiosity + ambient) × exposure, clamped to
+//! the linear display value of `render.png` ((radiosity + ρ·ambient) × exposure, clamped to
 //! [0, 1]: a glTF viewer's sRGB output then shows the render's colours), and `_RADIOSITY`, the
 //! radiosity in W/m². Then one mesh of discontinuity lines, a `LINES` primitive per class (D0,
 //! D1, D2: the derivative that jumps), coloured by boundary as the SVGs are. Everything is in
@@ -69,10 +69,9 @@ fn surface_primitive(
     let f32s = |v: &[f64; 3]| v.map(|c| c as f32);
     let positions: Vec<[f32; 3]> = mesh.positions.iter().map(f32s).collect();
     let normals = vertex_normals(mesh);
-    let colours: Vec<[f32; 3]> = mesh
-        .radiosity
-        .iter()
-        .map(|&b| display.linear(b).map(|c| c as f32))
+    let colours: Vec<[f32; 3]> = (0..mesh.positions.len())
+        .map(|v| display.linear(mesh.radiosity[v], mesh.reflectance_at(v)))
+        .map(|c| c.map(|c| c as f32))
         .collect();
     let radiosity: Vec<[f32; 3]> = mesh.radiosity.iter().map(f32s).collect();
     let attributes = BTreeMap::from([

@@ -41,6 +41,8 @@ pub struct FlatMesh {
     pub indirect: Vec<[f64; 3]>,
     /// The surface of each vertex.
     pub vertex_surface: Vec<u32>,
+    /// Each surface's reflectance ρ.
+    pub reflectance: Vec<[f64; 3]>,
     /// Triangles, counter-clockwise seen from the front.
     pub triangles: Vec<[u32; 3]>,
     /// The surface of each triangle.
@@ -88,6 +90,7 @@ impl FlatMesh {
         let n = surface.vertices.len();
         let direct = surface.direct.as_ref().ok_or_else(|| missing("direct"))?;
         let emission = surface.emission.ok_or_else(|| missing("emission"))?;
+        let reflectance = surface.reflectance.ok_or_else(|| missing("reflectance"))?;
         for (what, len) in [
             ("radiosity", surface.radiosity.len()),
             ("direct", direct.len()),
@@ -122,6 +125,7 @@ impl FlatMesh {
                 .map(|(b, d)| [0, 1, 2].map(|c| b[c] - emission[c] - d[c])),
         );
         self.vertex_surface.extend(std::iter::repeat_n(id, n));
+        self.reflectance.push(reflectance);
         self.triangles
             .extend(surface.triangles.iter().map(|t| t.map(shifted)));
         self.triangle_surface
@@ -180,6 +184,11 @@ impl FlatMesh {
                 .collect();
             (!lines.is_empty()).then_some((class, lines))
         })
+    }
+
+    /// The reflectance of vertex `v`'s surface.
+    pub fn reflectance_at(&self, v: usize) -> [f64; 3] {
+        self.reflectance[self.vertex_surface[v] as usize]
     }
 
     /// The number of vertices.

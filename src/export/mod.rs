@@ -5,8 +5,9 @@
 //!
 //! Every export is made from what `solution.json` and `report.json` hold ([`ExportSource`]),
 //! so `penumbra export DIR` on a finished run writes the same bytes as `penumbra run
-//! --export`. Colours are tone-mapped as in `render.png`: the radiosity plus the display-only
-//! ambient term, times the render's exposure, through the sRGB curve.
+//! --export`. Colours are tone-mapped as in `render.png`: the radiosity plus the surface's share
+//! of the display-only ambient term (ρ·ambient), times the render's exposure, through the sRGB
+//! curve.
 
 pub mod glb;
 mod mesh;
@@ -144,25 +145,34 @@ pub enum ExportError {
     },
 }
 
-/// How values are shown as colours, as `render.png` shows them (`report.json`'s `render`).
+/// How values are shown as colours, as `render.png` shows them (`report.json`'s `render`): each
+/// surface adds its share of the display-only ambient term, ρ·ambient.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Display {
-    /// The render's exposure: displayed value = (radiosity + ambient) × exposure.
+    /// The render's exposure: displayed value = (radiosity + ρ·ambient) × exposure.
     pub exposure: f64,
     /// The display-only ambient term, W/m² per channel.
     pub ambient: Rgb,
 }
 
 impl Display {
-    /// The 8-bit sRGB colour of radiosity `b` (ambient added).
-    pub fn srgb8(&self, b: [f64; 3]) -> [u8; 3] {
-        penumbra_viz::to_srgb8(Rgb::from(b) + self.ambient, self.exposure)
+    /// What `render.png` shows for radiosity `b` on a surface of reflectance `rho`, before the
+    /// exposure: `b` plus the surface's share of the ambient term, ρ·ambient.
+    fn shown(&self, b: [f64; 3], rho: [f64; 3]) -> Rgb {
+        Rgb::from(b) + Rgb::from(rho).mul_rgb(self.ambient)
     }
 
-    /// The linear display value of radiosity `b` (ambient added, times the exposure), each
-    /// channel clamped to `[0, 1]`: what glTF's linear `COLOR_0` takes.
-    pub fn linear(&self, b: [f64; 3]) -> [f64; 3] {
-        let c = Rgb::from(b) + self.ambient;
+    /// The 8-bit sRGB colour `render.png` gives radiosity `b` on a surface of reflectance
+    /// `rho`.
+    pub fn srgb8(&self, b: [f64; 3], rho: [f64; 3]) -> [u8; 3] {
+        penumbra_viz::to_srgb8(self.shown(b, rho), self.exposure)
+    }
+
+    /// The linear display value of radiosity `b` on a surface of reflectance `rho` (its share
+    /// of the ambient term added, times the exposure), each channel clamped to `[0, 1]`: what
+    /// glTF's linear `COLOR_0` takes.
+    pub fn linear(&self, b: [f64; 3], rho: [f64; 3]) -> [f64; 3] {
+        let c = self.shown(b, rho);
         [c.r, c.g, c.b].map(|v| {
             let v = v * self.exposure;
             if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) }

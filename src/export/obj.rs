@@ -23,7 +23,8 @@ pub fn obj(mesh: &FlatMesh, surfaces: &[SurfaceSolution], display: &Display) -> 
         let _ = writeln!(obj, "o {material}\nusemtl {material}");
         for v in mesh.vertex_offsets[s]..mesh.vertex_offsets[s + 1] {
             let [x, y, z] = mesh.positions[v];
-            vertex(&mut obj, [x, y, z], display.srgb8(mesh.radiosity[v]));
+            let colour = display.srgb8(mesh.radiosity[v], mesh.reflectance_at(v));
+            vertex(&mut obj, [x, y, z], colour);
         }
         for t in &mesh.triangles[mesh.triangle_offsets[s]..mesh.triangle_offsets[s + 1]] {
             let [a, b, c] = t.map(|i| u64::from(i) + 1);

@@ -91,7 +91,7 @@ pub fn ply(mesh: &FlatMesh, display: &Display) -> Result<Vec<u8>, ExportError> {
     let vertices: Vec<Vertex> = (0..mesh.positions.len())
         .map(|v| Vertex {
             position: mesh.positions[v],
-            colour: display.srgb8(mesh.radiosity[v]),
+            colour: display.srgb8(mesh.radiosity[v], mesh.reflectance_at(v)),
             quality: penumbra_viz::luminance(Rgb::from(mesh.radiosity[v])),
         })
         .collect();

@@ -40,6 +40,7 @@ class Solution:
         self.radiosity = cat("radiosity")
         self.direct = cat("direct")
         emission = np.repeat([s["emission"] for s in surfaces], self.counts, axis=0)
+        self.reflectance = np.repeat([s["reflectance"] for s in surfaces], self.counts, axis=0)
         self.indirect = self.radiosity - emission - self.direct
         self.triangles = np.concatenate(
             [np.array(s["triangles"], dtype=np.int64).reshape(-1, 3) + o for s, o in zip(surfaces, offsets)]
@@ -59,9 +60,14 @@ class Solution:
         r, g, b = self.radiosity.T
         return 0.2126 * r + 0.7152 * g + 0.0722 * b
 
+    def shown(self) -> np.ndarray:
+        """What render.png shows, before the exposure: B plus each surface's share of the
+        ambient term, rho * ambient."""
+        return self.radiosity + self.reflectance * self.ambient
+
     def srgb8(self) -> np.ndarray:
-        """render.png's colours: the sRGB curve of (B + ambient) * exposure, in 8 bits."""
-        v = np.clip((self.radiosity + self.ambient) * self.exposure, 0.0, 1.0)
+        """render.png's colours: the sRGB curve of (B + rho * ambient) * exposure, in 8 bits."""
+        v = np.clip(self.shown() * self.exposure, 0.0, 1.0)
         encoded = np.where(v <= 0.0031308, 12.92 * v, 1.055 * v ** (1 / 2.4) - 0.055)
         return np.round(encoded * 255.0).astype(np.uint8)
 
@@ -71,6 +77,16 @@ def exported(penumbra_cli, tmp_path_factory):
     out = tmp_path_factory.mktemp("cornell")
     run(penumbra_cli, out, "--max-elements", "4000", "--export", "vtp,ply,glb,obj")
     return out, Solution(out)
+
+
+@pytest.fixture(scope="module")
+def direct(penumbra_cli, tmp_path_factory):
+    """Direct light only: the render shows an ambient term, the colours must too."""
+    out = tmp_path_factory.mktemp("direct")
+    run(penumbra_cli, out, "--max-elements", "4000", "--direct-only", "--export", "ply,glb")
+    solution = Solution(out)
+    assert (solution.ambient > 0).all()
+    return out, solution
 
 
 @pytest.fixture(scope="module")
@@ -150,8 +166,9 @@ def test_vtk_reads_the_error_indicator_of_an_adaptive_run(adaptive):
     assert (solution.error >= 0).all() and solution.error.max() > 0
 
 
-def test_plyfile_reads_positions_colours_and_quality(exported):
-    out, solution = exported
+@pytest.mark.parametrize("run", ["exported", "direct"])
+def test_plyfile_reads_positions_colours_and_quality(request, run):
+    out, solution = request.getfixturevalue(run)
     ply = plyfile.PlyData.read(str(out / "solution.ply"))
     assert not ply.text and ply.byte_order == "<", "binary little endian"
     v = ply["vertex"].data
@@ -164,8 +181,9 @@ def test_plyfile_reads_positions_colours_and_quality(exported):
     assert np.array_equal(faces["surface"], solution.triangle_surface)
 
 
-def test_pygltflib_reads_the_mesh_and_a_lines_primitive_per_class(exported):
-    out, solution = exported
+@pytest.mark.parametrize("run", ["exported", "direct"])
+def test_pygltflib_reads_the_mesh_and_a_lines_primitive_per_class(request, run):
+    out, solution = request.getfixturevalue(run)
     gltf = pygltflib.GLTF2().load(str(out / "solution.glb"))
     blob = gltf.binary_blob()
 
@@ -185,7 +203,7 @@ def test_pygltflib_reads_the_mesh_and_a_lines_primitive_per_class(exported):
     radiosity = read(getattr(triangles.attributes, "_RADIOSITY"), "<f4", 3)
     assert np.array_equal(radiosity, solution.radiosity.astype(np.float32))
     colour = read(triangles.attributes.COLOR_0, "<f4", 3)
-    linear = np.clip((solution.radiosity + solution.ambient) * solution.exposure, 0, 1)
+    linear = np.clip(solution.shown() * solution.exposure, 0, 1)
     assert np.array_equal(colour, linear.astype(np.float32))
     indices = read(triangles.indices, "<u4", 1).reshape(-1, 3)
     assert np.array_equal(indices, solution.triangles)

@@ -36,6 +36,13 @@ def run_dir(penumbra_cli, tmp_path_factory) -> Path:
 
 
 @pytest.fixture(scope="module")
+def direct_dir(penumbra_cli, tmp_path_factory) -> Path:
+    """A direct-only run: its render adds the ambient term (the light not shot), each surface its
+    reflectance's share."""
+    return export(penumbra_cli, tmp_path_factory.mktemp("viewer-direct"), *RUN_OPTIONS, "--direct-only")
+
+
+@pytest.fixture(scope="module")
 def adaptive_dir(penumbra_cli, tmp_path_factory) -> Path:
     return export(penumbra_cli, tmp_path_factory.mktemp("viewer-adaptive"), *ADAPTIVE_OPTIONS)
 
@@ -213,9 +220,13 @@ def pinhole_pixel(camera: dict, width: int, height: int, point) -> tuple[int, in
     return int(0.5 * width + focal * (d @ right) / z), int(0.5 * height - focal * (d @ true_up) / z)
 
 
-def test_radiosity_colours_are_those_of_render_png(open_page, run_dir):
+@pytest.mark.parametrize("run", ["run_dir", "direct_dir"])
+def test_radiosity_colours_are_those_of_render_png(open_page, request, run):
+    run_dir = request.getfixturevalue(run)
     report = json.loads((run_dir / "report.json").read_text())
     render = report["render"]
+    if run == "direct_dir":
+        assert min(render["ambient"]) > 0, "a direct-only run shows an ambient term"
     page = open_page(run_dir / "index.html")
     for order in range(3):
         toggle = page.page.locator(f"#toggle-d{order}")

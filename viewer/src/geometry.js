@@ -68,6 +68,7 @@ export function buildSurfaces(data, planes, diagonal) {
   geometry.setAttribute('radiosity', new BufferAttribute(gather(radiosity), 3));
   geometry.setAttribute('direct', new BufferAttribute(gather(direct), 3));
   geometry.setAttribute('indirect', new BufferAttribute(gather(indirect), 3));
+  geometry.setAttribute('ambientShare', new BufferAttribute(ambientShares(data), 3));
 
   const colours = new Float32Array(corners * 3);
   let scale = null;
@@ -89,6 +90,21 @@ export function buildSurfaces(data, planes, diagonal) {
 
   const fill = buildSeams(data, geometry, planes, diagonal, uniforms);
   return { meshes: [front, back], fill, uniforms, errorScale: scale };
+}
+
+// The display-only ambient term each corner's surface reflects, ρ·ambient (as render.png adds
+// it), the same at the three corners of a triangle.
+function ambientShares(data) {
+  const { triangle_surface: owner } = data.arrays;
+  const ambient = data.display.ambient;
+  const shares = new Float32Array(owner.length * 9);
+  for (let t = 0; t < owner.length; t++) {
+    const rho = data.surfaces[owner[t]].reflectance;
+    for (let k = 0; k < 3; k++) {
+      for (let c = 0; c < 3; c++) shares[t * 9 + k * 3 + c] = rho[c] * ambient[c];
+    }
+  }
+  return shares;
 }
 
 // Every edge of the triangulation once, as thin dark lines.
@@ -201,7 +217,7 @@ function buildSeams(data, geometry, planes, diagonal, uniforms) {
   }
   const count = corners.length / 3;
   const seams = new BufferGeometry();
-  for (const name of ['position', 'radiosity', 'direct', 'indirect', 'errorColour']) {
+  for (const name of ['position', 'radiosity', 'direct', 'indirect', 'ambientShare', 'errorColour']) {
     const from = geometry.getAttribute(name).array;
     const to = new Float32Array(count * 6);
     for (let e = 0; e < count; e++) {

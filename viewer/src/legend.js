@@ -93,17 +93,20 @@ export function buildSidePanel(root, data, state, on) {
       exposureRow.style.display = 'none';
     } else {
       const exposure = state.exposure * 2 ** state.stops;
-      const ambient = mode === 'radiosity' ? luminance(data.display.ambient) : 0;
+      const ambient = mode === 'radiosity' && luminance(data.display.ambient) !== 0;
       for (let i = 0; i < BAR_STEPS; i++) {
         const g = i / (BAR_STEPS - 1);
         paint(image, i, [g, g, g]);
       }
       // White from this value on; the bar is even in display value, so ticks crowd at the top.
-      const white = 1 / exposure - ambient;
-      for (const v of niceTicks(0, Math.max(white, 0), 5)) marks.push([srgbEncode((v + ambient) * exposure), v]);
-      const formula = mode === 'radiosity' && ambient !== 0 ? 'sRGB((B + ambient) × exposure)' : 'sRGB(value × exposure)';
+      const white = 1 / exposure;
+      for (const v of niceTicks(0, white, 5)) marks.push([srgbEncode(v * exposure), v]);
+      const formula = ambient ? 'sRGB((B + ρ·ambient) × exposure)' : 'sRGB(value × exposure)';
       note = `W/m² per channel, shown as ${formula}; white at ${format.value(white)} W/m² and above.`;
-      if (mode === 'radiosity' && ambient !== 0) note += ` Ambient ${format.point(data.display.ambient)} W/m², for display only.`;
+      if (ambient) {
+        note += ` Ambient ${format.point(data.display.ambient)} W/m², the light not shot yet, for display only;`;
+        note += ' each surface adds it times its reflectance ρ, as render.png does.';
+      }
       exposureRow.style.display = '';
       threshold.hidden = true;
       exposureText.textContent = `${format.value(exposure)} m²/W`;

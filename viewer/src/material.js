@@ -2,13 +2,13 @@
 // sRGB curve per fragment, as render.png does per pixel (encoding per vertex would brighten the
 // insides of triangles).
 
-import { BackSide, FrontSide, ShaderMaterial, Vector2, Vector3 } from 'three';
+import { BackSide, FrontSide, ShaderMaterial, Vector2 } from 'three';
 import { CULL_BEHIND, PLANE_DEPTH, drawingViewport } from './lines.js';
 
 export const MODES = ['radiosity', 'direct', 'indirect', 'error'];
 
-// Back faces send no light; the renderer shows them black (plus ambient). Here they are a dark
-// grey, shaded by their slant, so that the geometry reads from outside the box.
+// Back faces send no light; the renderer shows them black. Here they are a dark grey, shaded by
+// their slant, so that the geometry reads from outside the box.
 const BACK_GREY = [0.16, 0.27];
 
 // With FILL_LINES the same shader draws the surfaces' outlines as lines (see lines.js), to fill
@@ -20,6 +20,7 @@ const vertexShader = /* glsl */ `
 attribute vec3 radiosity;
 attribute vec3 direct;
 attribute vec3 indirect;
+attribute vec3 ambientShare;
 attribute vec3 errorColour;
 uniform int mode;
 varying vec3 vLight;
@@ -31,7 +32,8 @@ attribute vec4 beyond;
 varying vec4 vPlane;
 #endif
 void main() {
-  vLight = mode == 0 ? radiosity : (mode == 1 ? direct : indirect);
+  // Radiosity is shown as render.png shows it, with the surface's share of the ambient term.
+  vLight = mode == 0 ? radiosity + ambientShare : (mode == 1 ? direct : indirect);
   vErrorColour = errorColour;
   vec4 viewPosition = modelViewMatrix * vec4(position, 1.0);
   vViewPosition = viewPosition.xyz;
@@ -45,7 +47,6 @@ void main() {
 const fragmentShader = /* glsl */ `
 uniform int mode;
 uniform float exposure;
-uniform vec3 ambient;
 uniform vec2 backGrey;
 varying vec3 vLight;
 varying vec3 vErrorColour;
@@ -74,13 +75,11 @@ void main() {
   if (!front) {
     vec3 normal = normalize(cross(dFdx(vViewPosition), dFdy(vViewPosition)));
     float slant = abs(dot(normal, normalize(vViewPosition)));
-    vec3 lit = mode == 0 ? srgbEncode(ambient * exposure) : vec3(0.0);
-    colour = max(vec3(mix(backGrey.x, backGrey.y, slant)), lit);
+    colour = vec3(mix(backGrey.x, backGrey.y, slant));
   } else if (mode == 3) {
     colour = vErrorColour;
   } else {
-    vec3 light = mode == 0 ? vLight + ambient : vLight;
-    colour = srgbEncode(light * exposure);
+    colour = srgbEncode(vLight * exposure);
   }
   gl_FragColor = vec4(colour, 1.0);
 }
@@ -91,7 +90,6 @@ export function surfaceUniforms(display) {
   return {
     mode: { value: 0 },
     exposure: { value: display.exposure },
-    ambient: { value: new Vector3(...display.ambient) },
     backGrey: { value: new Vector2(...BACK_GREY) },
   };
 }
