@@ -484,16 +484,79 @@ fn bad_exports_are_refused_and_change_nothing() {
     let o = penumbra(&["export", path(&out), "--format", "vtp"]);
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("has no direct"), "{}", stderr(&o));
-    // A triangle that points past its surface's vertices.
-    let mut solution = original;
-    solution["surfaces"][2]["triangles"][0][1] = Value::from(1_000_000);
-    std::fs::write(&solution_path, solution.to_string()).expect("writes");
-    let o = penumbra(&["export", path(&out), "--format", "glb"]);
-    assert_eq!(o.status.code(), Some(2));
+    // A triangle that points past its surface's vertices; a position no f32 holds; no
+    // triangles at all; a report of another run.
+    let mut past = original.clone();
+    past["surfaces"][2]["triangles"][0][1] = Value::from(1_000_000);
+    let mut huge = original.clone();
+    huge["surfaces"][2]["vertices"][0][0] = Value::from(1e308);
+    let mut empty = original.clone();
+    for s in empty["surfaces"].as_array_mut().expect("surfaces") {
+        s["triangles"] = Value::Array(Vec::new());
+    }
+    let mut other = original.clone();
+    other["scene"] = Value::from("cornell");
+    let cases = [
+        (past, "vertex 1000000 is not one of its"),
+        (huge, "its vertices hold a number beyond"),
+        (empty, "no triangles to export"),
+        (other, "not the report of solution.json's run"),
+    ];
+    for (solution, message) in cases {
+        std::fs::write(&solution_path, solution.to_string()).expect("writes");
+        let o = penumbra(&["export", path(&out), "--format", "all"]);
+        assert_eq!(o.status.code(), Some(2), "{message}");
+        assert!(stderr(&o).contains(message), "{}", stderr(&o));
+    }
+    let left: Vec<String> = std::fs::read_dir(&out)
+        .expect("the output directory")
+        .map(|e| {
+            e.expect("an entry")
+                .file_name()
+                .to_string_lossy()
+                .into_owned()
+        })
+        .collect();
     assert!(
-        stderr(&o).contains("vertex 1000000 is not one of its"),
-        "{}",
-        stderr(&o)
+        left.iter()
+            .all(|n| !n.starts_with("solution.") || n == "solution.json"),
+        "no export written: {left:?}"
     );
-    assert!(!out.join("solution.vtp").exists() && !out.join("solution.glb").exists());
+    assert!(
+        left.iter().all(|n| !n.contains(".tmp-")),
+        "no temporary left: {left:?}"
+    );
+}
+
+/// A camera the page cannot use (no field of view, or looking nowhere) is left out: the page
+/// frames the scene instead.
+#[test]
+fn an_unusable_camera_is_left_out_of_the_page() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("out");
+    run_quietly(
+        "textbook",
+        &out,
+        &["--max-elements", "600", "--export", "none"],
+    );
+    let report_path = out.join("report.json");
+    let original = json(&report_path);
+    let page_camera = || {
+        succeeds(&["export", path(&out), "--format", "html", "--quiet"]);
+        let page = String::from_utf8(read(&out.join("index.html"))).expect("utf-8");
+        let start = page.find("id=\"penumbra-data\"").expect("the data element");
+        let body = &page[start..];
+        let body = &body[body.find('>').expect("tag end") + 1..];
+        let data: Value = serde_json::from_str(&body[..body.find("</script>").expect("end")])
+            .expect("the data is JSON");
+        data["camera"].clone()
+    };
+    assert_eq!(page_camera(), original["render"]["camera"]);
+    let eye = original["render"]["camera"]["eye"].clone();
+    for (key, value) in [("fov_deg", Value::from(0.0)), ("target", eye)] {
+        let mut report = original.clone();
+        report["render"]["camera"][key] = value;
+        std::fs::write(&report_path, report.to_string()).expect("writes");
+        assert_eq!(page_camera(), Value::Null, "{key}");
+    }
 }

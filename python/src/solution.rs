@@ -6,7 +6,7 @@ use std::sync::OnceLock;
 
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2};
 use penumbra::RunResult;
-use penumbra::export::{ExportFormat, ExportSource};
+use penumbra::export::{ExportFormat, export_run};
 use penumbra::outputs::{SvgSelection, write_outputs};
 use penumbra_meshing::TriangleLocator;
 use penumbra_scenes::{Rgb, SurfaceId};
@@ -176,16 +176,26 @@ impl RunOutput {
             ))
         })?;
         let result = &self.result;
-        py.detach(|| {
-            let mut extra = match convergence {
-                true => penumbra::outputs::convergence_files(result)?,
-                false => Vec::new(),
-            };
-            let source = ExportSource::of_run(result, &svgs);
-            extra.extend(penumbra::export::export(&source, &formats)?);
-            write_outputs(result, &directory, &svgs, extra)
-        })
-        .map_err(|e| PyOSError::new_err(format!("{e:#}")))
+        let (written, exported) = py.detach(|| {
+            // The run's own files are written even when its exports cannot be.
+            let exported = export_run(result, &svgs, &formats);
+            let written = (|| {
+                let mut extra = match convergence {
+                    true => penumbra::outputs::convergence_files(result)?,
+                    false => Vec::new(),
+                };
+                if let Ok(files) = &exported {
+                    extra.extend(files.iter().cloned());
+                }
+                write_outputs(result, &directory, &svgs, extra)
+            })();
+            (written, exported)
+        });
+        let written = written.map_err(|e| PyOSError::new_err(format!("{e:#}")))?;
+        exported.map_err(|e| {
+            PyValueError::new_err(format!("wrote the run's files, but not its exports: {e}"))
+        })?;
+        Ok(written)
     }
 
     /// `quantity` at `points` on the surfaces `surfaces` names, linear over the mesh's

@@ -15,7 +15,7 @@ use json::validation::USize64;
 use json::{Index, Root};
 
 use super::mesh::FlatMesh;
-use super::{Display, ExportError, boundary_colour};
+use super::{Display, ExportError, line_colour};
 
 /// The file's bytes.
 pub fn glb(mesh: &FlatMesh, display: &Display) -> Result<Vec<u8>, ExportError> {
@@ -32,7 +32,7 @@ pub fn glb(mesh: &FlatMesh, display: &Display) -> Result<Vec<u8>, ExportError> {
         let colours: Vec<[f32; 3]> = lines
             .iter()
             .flat_map(|l| {
-                let c = boundary_colour(super::mesh::BOUNDARIES[usize::from(l.boundary)]);
+                let c = line_colour(l);
                 let linear = c.map(|v| srgb_decode(f64::from(v) / 255.0) as f32);
                 [linear, linear]
             })

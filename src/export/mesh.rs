@@ -5,24 +5,36 @@ use crate::outputs::SurfaceSolution;
 
 use super::ExportError;
 
-/// The events and boundaries, in the order their codes number them in the exports.
-pub const EVENTS: [&str; 6] = ["EV", "VE", "EEE", "contact", "blocker-EV", "horizon"];
-/// The boundaries a line may be, in the order their codes number them.
-pub const BOUNDARIES: [&str; 3] = ["umbra", "penumbra", "inner"];
+use penumbra_meshing::discontinuity::{Boundary, Event};
+
+/// The events' names, in the order their codes number them in the exports.
+pub fn event_names() -> [&'static str; 6] {
+    Event::ALL.map(Event::name)
+}
+
+/// The boundaries' names, in the order their codes number them.
+pub fn boundary_names() -> [&'static str; 3] {
+    Boundary::ALL.map(Boundary::name)
+}
+
+/// The largest magnitude an exported number may have: the formats that hold `f32` (glTF, the
+/// viewer page) hold nothing larger.
+const LARGEST: f64 = f32::MAX as f64;
 
 /// The names of the discontinuity classes, by order: the derivative that jumps.
 pub const CLASSES: [&str; 3] = ["D0", "D1", "D2"];
 
-/// A discontinuity segment, its names coded as indices into [`EVENTS`] and [`BOUNDARIES`].
+/// A discontinuity segment, its names coded as indices into [`event_names`] and
+/// [`boundary_names`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Line {
     /// The segment's ends.
     pub ends: [[f64; 3]; 2],
     /// The surface it lies on.
     pub surface: u32,
-    /// Its event, an index into [`EVENTS`].
+    /// Its event, an index into [`event_names`].
     pub event: u8,
-    /// Its boundary, an index into [`BOUNDARIES`].
+    /// Its boundary, an index into [`boundary_names`].
     pub boundary: u8,
     /// The derivative that jumps across it: 0, 1 or 2.
     pub order: u8,
@@ -69,6 +81,9 @@ impl FlatMesh {
         for (s, surface) in surfaces.iter().enumerate() {
             flat.push(s, surface)?;
         }
+        if flat.triangles.is_empty() {
+            return Err(ExportError::Empty);
+        }
         if flat.positions.len() > u32::MAX as usize {
             return Err(ExportError::TooLarge {
                 format: "an export",
@@ -79,38 +94,18 @@ impl FlatMesh {
     }
 
     fn push(&mut self, s: usize, surface: &SurfaceSolution) -> Result<(), ExportError> {
-        let inconsistent = |reason: String| ExportError::Inconsistent {
-            surface: surface.name.clone(),
-            reason,
-        };
         let missing = |field| ExportError::Missing {
             surface: surface.name.clone(),
             field,
         };
-        let n = surface.vertices.len();
         let direct = surface.direct.as_ref().ok_or_else(|| missing("direct"))?;
         let emission = surface.emission.ok_or_else(|| missing("emission"))?;
         let reflectance = surface.reflectance.ok_or_else(|| missing("reflectance"))?;
-        for (what, len) in [
-            ("radiosity", surface.radiosity.len()),
-            ("direct", direct.len()),
-        ] {
-            if len != n {
-                return Err(inconsistent(format!(
-                    "{len} {what} values for {n} vertices"
-                )));
-            }
-        }
-        if let Some(bad) = surface
-            .triangles
-            .iter()
-            .flatten()
-            .find(|&&i| i as usize >= n)
-        {
-            return Err(inconsistent(format!(
-                "a triangle's vertex {bad} is not one of its {n} vertices"
-            )));
-        }
+        check(surface, direct).map_err(|reason| ExportError::Inconsistent {
+            surface: surface.name.clone(),
+            reason,
+        })?;
+        let n = surface.vertices.len();
         let offset = self.positions.len() as u64;
         let shifted = |i: u32| u32::try_from(u64::from(i) + offset).unwrap_or(u32::MAX);
         let id = u32::try_from(s).unwrap_or(u32::MAX);
@@ -134,19 +129,17 @@ impl FlatMesh {
         self.vertex_offsets.push(self.positions.len());
         self.triangle_offsets.push(self.triangles.len());
         for d in &surface.discontinuities {
-            let code = |names: &[&str], name: &str, what: &str| {
-                let i = names.iter().position(|n| *n == name);
-                i.map(|i| i as u8)
-                    .ok_or_else(|| inconsistent(format!("a segment's {what} is {name:?}")))
-            };
-            if d.order > 2 {
-                return Err(inconsistent(format!("a segment's order is {}", d.order)));
-            }
+            let code = |names: &[&str], name: &str| names.iter().position(|n| *n == name);
+            // `check` found every name among them.
+            let (event, boundary) = (
+                code(&event_names(), &d.event),
+                code(&boundary_names(), &d.boundary),
+            );
             self.lines.push(Line {
                 ends: [d.from, d.to],
                 surface: id,
-                event: code(&EVENTS, &d.event, "event")?,
-                boundary: code(&BOUNDARIES, &d.boundary, "boundary")?,
+                event: event.unwrap_or_default() as u8,
+                boundary: boundary.unwrap_or_default() as u8,
                 order: d.order,
             });
         }
@@ -190,9 +183,73 @@ impl FlatMesh {
     pub fn reflectance_at(&self, v: usize) -> [f64; 3] {
         self.reflectance[self.vertex_surface[v] as usize]
     }
+}
 
-    /// The number of vertices.
-    pub fn vertex_count(&self) -> usize {
-        self.positions.len()
+/// What does not fit together in one surface of a `solution.json`, if anything.
+fn check(surface: &SurfaceSolution, direct: &[[f64; 3]]) -> Result<(), String> {
+    let n = surface.vertices.len();
+    for (what, len) in [
+        ("radiosity", surface.radiosity.len()),
+        ("direct", direct.len()),
+    ] {
+        if len != n {
+            return Err(format!("{len} {what} values for {n} vertices"));
+        }
     }
+    if let Some(bad) = surface
+        .triangles
+        .iter()
+        .flatten()
+        .find(|&&i| i as usize >= n)
+    {
+        return Err(format!(
+            "a triangle's vertex {bad} is not one of its {n} vertices"
+        ));
+    }
+    for d in &surface.discontinuities {
+        if !event_names().contains(&d.event.as_str()) {
+            return Err(format!("a segment's event is {:?}", d.event));
+        }
+        if !boundary_names().contains(&d.boundary.as_str()) {
+            return Err(format!("a segment's boundary is {:?}", d.boundary));
+        }
+        if d.order > 2 {
+            return Err(format!("a segment's order is {}", d.order));
+        }
+    }
+    check_magnitudes(surface, direct)
+}
+
+/// Every number of the surface within [`LARGEST`].
+fn check_magnitudes(surface: &SurfaceSolution, direct: &[[f64; 3]]) -> Result<(), String> {
+    let triples = [
+        ("vertices", &surface.vertices[..]),
+        ("radiosity", &surface.radiosity[..]),
+        ("direct", direct),
+    ];
+    let ends: Vec<[f64; 3]> = surface
+        .discontinuities
+        .iter()
+        .flat_map(|d| [d.from, d.to])
+        .collect();
+    let singles = [surface.emission, surface.reflectance]
+        .into_iter()
+        .flatten();
+    let too_large = |v: &f64| !(v.abs() <= LARGEST);
+    for (what, values) in triples.into_iter().chain([("discontinuities", &ends[..])]) {
+        if values.iter().flatten().any(too_large) {
+            return Err(format!("its {what} hold a number beyond ±{LARGEST:e}"));
+        }
+    }
+    let errors = surface.error_indicator.iter().flatten();
+    if singles
+        .flatten()
+        .chain(errors.copied())
+        .any(|v| too_large(&v))
+    {
+        return Err(format!(
+            "its emission, reflectance or error indicator is beyond ±{LARGEST:e}"
+        ));
+    }
+    Ok(())
 }

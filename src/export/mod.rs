@@ -9,15 +9,16 @@
 //! of the display-only ambient term (ρ·ambient), times the render's exposure, through the sRGB
 //! curve.
 
-pub mod glb;
+mod glb;
 mod mesh;
-pub mod obj;
-pub mod ply;
-pub mod viewer;
-pub mod vtp;
+mod obj;
+mod ply;
+mod viewer;
+mod vtp;
 
 use std::path::Path;
 
+use penumbra_meshing::discontinuity::Boundary;
 use penumbra_scenes::{Camera, Rgb};
 use serde::Deserialize;
 
@@ -26,7 +27,8 @@ use crate::outputs::{
 };
 use crate::pipeline::RunResult;
 
-pub use mesh::{FlatMesh, Line};
+use mesh::{FlatMesh, Line};
+pub use viewer::VIEWER_FORMAT;
 
 /// An export format (`--export`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -127,6 +129,9 @@ pub enum ExportError {
         /// What does not fit.
         reason: String,
     },
+    /// The solution has no triangles: nothing to show.
+    #[error("solution.json has no triangles to export")]
+    Empty,
     /// A format's encoder refused the data.
     #[error("cannot encode {format}: {reason}")]
     Encode {
@@ -247,6 +252,20 @@ impl ExportSource {
             let reason = format!("its format is not {:?}", crate::outputs::REPORT_FORMAT);
             return Err(malformed("report.json", "report", reason));
         }
+        let (name, count) = (
+            report.pointer("/scene/name"),
+            report.pointer("/scene/surfaces"),
+        );
+        if name.and_then(|n| n.as_str()) != Some(solution.scene.as_str())
+            || count.and_then(serde_json::Value::as_u64) != Some(solution.surfaces.len() as u64)
+        {
+            let reason = format!(
+                "it is not the report of solution.json's run (scene {:?} of {} surfaces)",
+                solution.scene,
+                solution.surfaces.len()
+            );
+            return Err(malformed("report.json", "report", reason));
+        }
         let source = ExportSource {
             scene: solution.scene,
             surfaces: solution.surfaces,
@@ -275,11 +294,29 @@ impl ExportSource {
         Ok(Display { exposure, ambient })
     }
 
-    /// The camera `render.png` was made from (`report.json`'s `render.camera`), if recorded.
+    /// The camera `render.png` was made from (`report.json`'s `render.camera`), if recorded
+    /// and usable: finite, looking somewhere, with a field of view in (0, 180) degrees.
     pub fn camera(&self) -> Option<Camera> {
-        let camera = self.report.pointer("/render/camera")?;
-        Camera::deserialize(camera).ok()
+        let camera = Camera::deserialize(self.report.pointer("/render/camera")?).ok()?;
+        let view = camera.target - camera.eye;
+        let finite = camera.eye.is_finite() && view.is_finite() && camera.up.is_finite();
+        let upright = view.cross(camera.up).length_squared() > 0.0;
+        let fov = camera.fov_deg > 0.0 && camera.fov_deg < 180.0;
+        (finite && upright && fov).then_some(camera)
     }
+}
+
+/// The files of `formats` for `result` (whose SVGs `svgs` chooses): nothing, and no work, for
+/// no formats.
+pub fn export_run(
+    result: &RunResult,
+    svgs: &SvgSelection,
+    formats: &[ExportFormat],
+) -> Result<Vec<(String, Vec<u8>)>, ExportError> {
+    if formats.is_empty() {
+        return Ok(Vec::new());
+    }
+    export(&ExportSource::of_run(result, svgs), formats)
 }
 
 /// The files of `formats` for `source`: (file name, bytes), in the order of
@@ -320,12 +357,12 @@ pub fn export(
     Ok(files)
 }
 
-/// The colour of a discontinuity line of each boundary, `umbra`, `penumbra` and `inner`, as
-/// 8-bit sRGB: the surfaces' SVGs use the same.
-pub fn boundary_colour(boundary: &str) -> [u8; 3] {
-    match boundary {
-        "umbra" => [0x6a, 0x1b, 0x9a],
-        "penumbra" => [0xe6, 0x51, 0x00],
+/// The colour of a discontinuity line, by its boundary, as 8-bit sRGB: umbra purple, penumbra
+/// orange, inner green, as in the surfaces' SVGs.
+pub(crate) fn line_colour(line: &Line) -> [u8; 3] {
+    match Boundary::ALL.get(usize::from(line.boundary)) {
+        Some(Boundary::Umbra) => [0x6a, 0x1b, 0x9a],
+        Some(Boundary::Penumbra) => [0xe6, 0x51, 0x00],
         _ => [0x2e, 0x7d, 0x32],
     }
 }

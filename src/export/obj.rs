@@ -10,8 +10,11 @@ use std::fmt::Write as _;
 
 use crate::outputs::SurfaceSolution;
 
-use super::mesh::{BOUNDARIES, FlatMesh};
-use super::{Display, boundary_colour};
+use super::mesh::FlatMesh;
+use super::{Display, line_colour};
+
+/// The material of the discontinuity lines.
+const LINE_MATERIAL: &str = "discontinuity_lines";
 
 /// `solution.obj` and `solution.mtl`.
 pub fn obj(mesh: &FlatMesh, surfaces: &[SurfaceSolution], display: &Display) -> (String, String) {
@@ -41,11 +44,16 @@ pub fn obj(mesh: &FlatMesh, surfaces: &[SurfaceSolution], display: &Display) -> 
             rgb(surface.emission)
         );
     }
+    if !mesh.lines.is_empty() {
+        // The lines' colours are their vertices'; a material of their own keeps them from
+        // taking the last surface's.
+        mtl += &format!("\nnewmtl {LINE_MATERIAL}\nKd 1 1 1\nKa 0 0 0\nKs 0 0 0\nillum 0\n");
+    }
     let mut next = mesh.positions.len() as u64 + 1;
     for (class, lines) in mesh.lines_by_class() {
-        let _ = writeln!(obj, "o discontinuities_{class}");
+        let _ = writeln!(obj, "o discontinuities_{class}\nusemtl {LINE_MATERIAL}");
         for line in &lines {
-            let colour = boundary_colour(BOUNDARIES[usize::from(line.boundary)]);
+            let colour = line_colour(line);
             for end in line.ends {
                 vertex(&mut obj, end, colour);
             }

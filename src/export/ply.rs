@@ -106,39 +106,7 @@ pub fn ply(mesh: &FlatMesh, display: &Display) -> Result<Vec<u8>, ExportError> {
             })
         })
         .collect::<Result<Vec<Face>, ExportError>>()?;
-    let double = PropertyType::Scalar(ScalarType::Double);
-    let uchar = PropertyType::Scalar(ScalarType::UChar);
-    let mut header = Header::new();
-    header.encoding = Encoding::BinaryLittleEndian;
-    header.comments.push(
-        "penumbra solution: colour as render.png shows it, quality = luminance of the \
-         radiosity in W/m^2"
-            .into(),
-    );
-    header.elements.add(element(
-        "vertex",
-        vertices.len(),
-        &[
-            ("x", double.clone()),
-            ("y", double.clone()),
-            ("z", double.clone()),
-            ("red", uchar.clone()),
-            ("green", uchar.clone()),
-            ("blue", uchar),
-            ("quality", double),
-        ],
-    ));
-    header.elements.add(element(
-        "face",
-        faces.len(),
-        &[
-            (
-                "vertex_indices",
-                PropertyType::List(ScalarType::UChar, ScalarType::Int),
-            ),
-            ("surface", PropertyType::Scalar(ScalarType::Int)),
-        ],
-    ));
+    let header = header(vertices.len(), faces.len());
     let mut out = Vec::new();
     // Writing to memory fails only on a header that does not match its payload: a bug here.
     let failed = |e: std::io::Error| ExportError::Encode {
@@ -156,4 +124,42 @@ pub fn ply(mesh: &FlatMesh, display: &Display) -> Result<Vec<u8>, ExportError> {
         .write_payload_of_element(&mut out, &faces, &header.elements["face"], &header)
         .map_err(failed)?;
     Ok(out)
+}
+
+/// The header: binary little endian, the vertex and face elements and what they hold.
+fn header(vertices: usize, faces: usize) -> Header {
+    let double = PropertyType::Scalar(ScalarType::Double);
+    let uchar = PropertyType::Scalar(ScalarType::UChar);
+    let mut header = Header::new();
+    header.encoding = Encoding::BinaryLittleEndian;
+    header.comments.push(
+        "penumbra solution: colour as render.png shows it, quality = luminance of the \
+         radiosity in W/m^2"
+            .into(),
+    );
+    header.elements.add(element(
+        "vertex",
+        vertices,
+        &[
+            ("x", double.clone()),
+            ("y", double.clone()),
+            ("z", double.clone()),
+            ("red", uchar.clone()),
+            ("green", uchar.clone()),
+            ("blue", uchar),
+            ("quality", double),
+        ],
+    ));
+    header.elements.add(element(
+        "face",
+        faces,
+        &[
+            (
+                "vertex_indices",
+                PropertyType::List(ScalarType::UChar, ScalarType::Int),
+            ),
+            ("surface", PropertyType::Scalar(ScalarType::Int)),
+        ],
+    ));
+    header
 }

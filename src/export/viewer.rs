@@ -14,7 +14,7 @@ use base64::Engine as _;
 use base64::engine::general_purpose::STANDARD;
 use serde_json::{Value, json};
 
-use super::mesh::{BOUNDARIES, EVENTS, FlatMesh};
+use super::mesh::{FlatMesh, boundary_names, event_names};
 use super::{Display, ExportSource};
 
 /// The page around the data and the script.
@@ -85,8 +85,8 @@ fn data(source: &ExportSource, mesh: &FlatMesh, display: &Display) -> Value {
         "vertex_count": mesh.positions.len(),
         "triangle_count": mesh.triangles.len(),
         "line_count": lines.len(),
-        "events": EVENTS,
-        "boundaries": BOUNDARIES,
+        "events": event_names(),
+        "boundaries": boundary_names(),
         "arrays": arrays,
     })
 }

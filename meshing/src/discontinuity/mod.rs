@@ -49,6 +49,9 @@ pub enum Boundary {
 }
 
 impl Boundary {
+    /// Every boundary, in the order the exports number them.
+    pub const ALL: [Boundary; 3] = [Boundary::Umbra, Boundary::Penumbra, Boundary::Inner];
+
     /// The boundary's name in outputs: `umbra`, `penumbra` or `inner`.
     pub fn name(self) -> &'static str {
         match self {

@@ -25,6 +25,16 @@ pub enum Event {
 }
 
 impl Event {
+    /// Every event, in the order the exports number them.
+    pub const ALL: [Event; 6] = [
+        Event::Ev,
+        Event::Ve,
+        Event::Eee,
+        Event::Contact,
+        Event::BlockerEv,
+        Event::Horizon,
+    ];
+
     /// The event's name in outputs: `EV`, `VE`, `EEE`, `contact`, `blocker-EV` or `horizon`.
     pub fn name(self) -> &'static str {
         match self {

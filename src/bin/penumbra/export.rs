@@ -46,7 +46,12 @@ pub(crate) fn export_run(args: &ExportArgs) -> Result<(), Failure> {
         .collect();
     penumbra::outputs::write_all_atomic(&files)?;
     if !args.quiet {
-        println!("wrote {} files to {}", files.len(), args.dir.display());
+        let names: Vec<String> = files
+            .iter()
+            .filter_map(|(path, _)| path.file_name())
+            .map(|n| n.to_string_lossy().into_owned())
+            .collect();
+        println!("wrote {} to {}", names.join(", "), args.dir.display());
     }
     Ok(())
 }

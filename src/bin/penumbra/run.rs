@@ -4,7 +4,7 @@ use std::process::ExitCode;
 
 use crate::progress_bar::Bars;
 use anyhow::Context;
-use penumbra::export::{ExportSource, export};
+use penumbra::export::{ExportFormat, export_run};
 use penumbra::outputs::{Invocation, SvgSelection, write_outputs};
 use penumbra_solver::Interrupt;
 
@@ -58,8 +58,9 @@ fn shard_of(text: &str, args: &RunArgs) -> Result<penumbra::shard::Shard, Failur
     if args.time_budget.is_some() {
         return Err(refused("--time-budget", ShardError::TimeBudget));
     }
-    // The page is the default and goes with the render, which the merge makes.
-    if !matches!(args.export.trim(), crate::run_args::DEFAULT_EXPORT | "none") {
+    // The page goes with the render, which the merge makes; a bad name is refused later.
+    let exports = ExportFormat::parse_list(&args.export).unwrap_or_default();
+    if exports.iter().any(|&f| f != ExportFormat::Html) {
         return Err(usage(anyhow::anyhow!(
             "--shard with --export: a shard holds part of the solution; export the merged run \
              (`penumbra merge ... --out DIR`, then `penumbra export DIR`)"
@@ -209,8 +210,11 @@ fn run_with(args: &RunArgs, fingerprint: Option<&str>) -> Result<ExitCode, Failu
     } else {
         Vec::new()
     };
-    let source = ExportSource::of_run(&result, &svgs);
-    extra.extend(export(&source, &exports)?);
+    // The run's own files are written even when its exports cannot be.
+    let exported = export_run(&result, &svgs, &exports);
+    if let Ok(files) = &exported {
+        extra.extend(files.iter().cloned());
+    }
     let written = write_outputs(&result, &args.out, &svgs, extra)?;
     if !args.quiet {
         let stats = &result.solution.stats;
@@ -233,6 +237,13 @@ fn run_with(args: &RunArgs, fingerprint: Option<&str>) -> Result<ExitCode, Failu
             result.times.total
         );
         println!("wrote {} files to {}", written.len(), args.out.display());
+    }
+    if let Err(e) = exported {
+        return Err(anyhow::anyhow!(
+            "wrote the run's files to {}, but not its exports: {e}",
+            args.out.display()
+        )
+        .into());
     }
     if interrupt.is_set() {
         eprintln!(

@@ -19,7 +19,7 @@ const OUTPUT: &str = "Output and render";
 const LIMITS: &str = "Limits";
 
 /// What `--export` writes unless told otherwise: the viewer page.
-pub(crate) const DEFAULT_EXPORT: &str = "html";
+const DEFAULT_EXPORT: &str = "html";
 
 fn default_export() -> String {
     DEFAULT_EXPORT.to_owned()
