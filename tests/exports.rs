@@ -92,6 +92,16 @@ fn a_run_and_its_directory_export_the_same_bytes() {
     assert!(!c.join("solution.vtp").exists());
 }
 
+/// The data a viewer page embeds, with both of the template's slots filled.
+fn page_data(page: &Path) -> Value {
+    let page = String::from_utf8(read(page)).expect("utf-8");
+    assert!(!page.contains("/*PENUMBRA_DATA*/") && !page.contains("/*PENUMBRA_VIEWER_JS*/"));
+    let start = page.find("id=\"penumbra-data\"").expect("the data element");
+    let body = &page[start..];
+    let body = &body[body.find('>').expect("tag end") + 1..];
+    serde_json::from_str(&body[..body.find("</script>").expect("end")]).expect("the data is JSON")
+}
+
 fn read(p: &Path) -> Vec<u8> {
     std::fs::read(p).unwrap_or_else(|e| panic!("cannot read {}: {e}", p.display()))
 }
@@ -372,13 +382,7 @@ fn the_viewer_page_holds_the_solution() {
         ],
     );
     let solution = json(&out.join("solution.json"));
-    let page = String::from_utf8(read(&out.join("index.html"))).expect("utf-8");
-    assert!(!page.contains("/*PENUMBRA_DATA*/") && !page.contains("/*PENUMBRA_VIEWER_JS*/"));
-    let start = page.find("id=\"penumbra-data\"").expect("the data element");
-    let body = &page[start..];
-    let body = &body[body.find('>').expect("tag end") + 1..];
-    let data: Value = serde_json::from_str(&body[..body.find("</script>").expect("end")])
-        .expect("the data is JSON");
+    let data = page_data(&out.join("index.html"));
     assert_eq!(data["format"], "penumbra-viewer/1");
     assert_eq!(data["report"], json(&out.join("report.json")));
     let (v, t) = (count(&solution, "vertices"), count(&solution, "triangles"));
@@ -543,13 +547,7 @@ fn an_unusable_camera_is_left_out_of_the_page() {
     let original = json(&report_path);
     let page_camera = || {
         succeeds(&["export", path(&out), "--format", "html", "--quiet"]);
-        let page = String::from_utf8(read(&out.join("index.html"))).expect("utf-8");
-        let start = page.find("id=\"penumbra-data\"").expect("the data element");
-        let body = &page[start..];
-        let body = &body[body.find('>').expect("tag end") + 1..];
-        let data: Value = serde_json::from_str(&body[..body.find("</script>").expect("end")])
-            .expect("the data is JSON");
-        data["camera"].clone()
+        page_data(&out.join("index.html"))["camera"].clone()
     };
     assert_eq!(page_camera(), original["render"]["camera"]);
     let eye = original["render"]["camera"]["eye"].clone();
