@@ -102,6 +102,7 @@ mod lambert;
 mod measure;
 mod occluder_tree;
 pub mod path_trace;
+pub mod photon_map;
 mod progress;
 mod progressive;
 mod shadow_union;

@@ -1,0 +1,287 @@
+//! Photon mapping (Jensen 1996) for the light reflected more than once: photons leave the
+//! emitters, stratified over their area and directions and carrying equal shares of their power,
+//! bounce through the scene with Russian roulette, and are stored where they land after at
+//! least one reflection. The direct light stays exact ([`crate::DirectLight`]); the map holds
+//! only the indirect light, whose irradiance at a point is estimated from its nearest photons
+//! on the same surface ([`PhotonMap::indirect_irradiance`]).
+//!
+//! Each photon has its own random stream, keyed by the seed, its emitter and its index, and
+//! photons are stored in the order they were emitted, so the map does not depend on the thread
+//! count.
+
+mod disc;
+mod emit;
+
+use std::num::NonZero;
+
+use glam::DVec3;
+use kiddo::{ImmutableKdTree, SquaredEuclidean};
+use penumbra_scenes::{PlaneFrame, Rgb, Scene, SplitMix64, SurfaceId, Visibility};
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::{Interrupt, SolveError};
+use emit::Emission;
+
+/// Paths whose power, relative to what they left their emitter with, falls below this play
+/// Russian roulette with it as their survival chance.
+const ROULETTE_BELOW: f64 = 0.5;
+/// Bounces at most: a photon this old carries ρ^64 of its power.
+const MAX_BOUNCES: usize = 64;
+/// Photons traced between two looks at the interrupt.
+const CHUNK: usize = 4096;
+
+/// How the map is made and read.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PhotonMapOptions {
+    /// Photons emitted, shared among the emitters in proportion to their power.
+    pub photons: usize,
+    /// Photons each irradiance estimate gathers.
+    pub gather_photons: usize,
+    /// Seeds every photon's own random stream.
+    pub seed: u64,
+}
+
+impl Default for PhotonMapOptions {
+    fn default() -> Self {
+        PhotonMapOptions {
+            photons: 1_000_000,
+            gather_photons: 200,
+            seed: 1,
+        }
+    }
+}
+
+/// What making the map did (`solver.photon_map` in `report.json`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct PhotonStats {
+    /// Photons emitted.
+    pub emitted: usize,
+    /// Photons stored: landings after at least one reflection.
+    pub stored: usize,
+    /// Bytes the map holds: positions, powers and the trees.
+    pub bytes: usize,
+}
+
+/// A photon where it landed: its position and the power it brought, W per channel.
+#[derive(Clone, Copy, Debug)]
+struct Landing {
+    surface: SurfaceId,
+    point: DVec3,
+    power: Rgb,
+}
+
+/// The photons of one surface, and a k-d tree over their positions.
+struct SurfacePhotons {
+    tree: ImmutableKdTree<f64, 3>,
+    power: Vec<Rgb>,
+}
+
+/// The indirect photons of a scene, surface by surface.
+pub struct PhotonMap<'a> {
+    scene: &'a Scene,
+    frames: Vec<Option<PlaneFrame>>,
+    surfaces: Vec<Option<SurfacePhotons>>,
+    gather: usize,
+    /// What making it did.
+    pub stats: PhotonStats,
+}
+
+impl std::fmt::Debug for PhotonMap<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("PhotonMap")
+            .field("scene", &self.scene.name)
+            .field("stats", &self.stats)
+            .finish()
+    }
+}
+
+impl<'a> PhotonMap<'a> {
+    /// Traces `options.photons` photons through `scene` (with `visibility` its index) and
+    /// stores where they land after a reflection; [`SolveError::Interrupted`] once `interrupt`
+    /// is set.
+    pub fn trace(
+        scene: &'a Scene,
+        visibility: &Visibility,
+        options: &PhotonMapOptions,
+        interrupt: Option<&Interrupt>,
+    ) -> Result<PhotonMap<'a>, SolveError> {
+        let frames: Vec<Option<PlaneFrame>> = scene
+            .surfaces
+            .iter()
+            .map(|s| PlaneFrame::of_polygon(&s.polygon))
+            .collect();
+        let emission = Emission::new(scene, &frames, options.photons, options.seed);
+        let tracer = Tracer {
+            scene,
+            visibility,
+            frames: &frames,
+            offset: visibility.contact_distance(),
+        };
+        let mut landings = Vec::new();
+        let mut start = 0;
+        while start < emission.count() {
+            if interrupt.is_some_and(Interrupt::is_set) {
+                return Err(SolveError::Interrupted);
+            }
+            let end = (start + CHUNK).min(emission.count());
+            let chunk: Vec<Vec<Landing>> = (start..end)
+                .into_par_iter()
+                .map(|i| {
+                    let mut rng = SplitMix64::keyed(options.seed, &[i as u64]);
+                    let photon = emission.photon(i);
+                    tracer.landings(photon, &mut rng)
+                })
+                .collect();
+            landings.extend(chunk.into_iter().flatten());
+            start = end;
+        }
+        Ok(Self::store(
+            scene,
+            frames,
+            landings,
+            emission.count(),
+            options,
+        ))
+    }
+
+    /// The map of `landings`, sorted by surface in the order they came.
+    fn store(
+        scene: &'a Scene,
+        frames: Vec<Option<PlaneFrame>>,
+        landings: Vec<Landing>,
+        emitted: usize,
+        options: &PhotonMapOptions,
+    ) -> PhotonMap<'a> {
+        let stored = landings.len();
+        let mut by_surface: Vec<Vec<Landing>> = vec![Vec::new(); scene.surfaces.len()];
+        for l in landings {
+            by_surface[l.surface].push(l);
+        }
+        let mut bytes = 0;
+        let surfaces = by_surface
+            .into_iter()
+            .map(|photons| {
+                let points: Vec<[f64; 3]> = photons.iter().map(|l| l.point.to_array()).collect();
+                let tree = ImmutableKdTree::new_from_slice(&points).ok()?;
+                bytes += points.len() * (3 * 8 + size_of::<Rgb>() + 3 * 8);
+                Some(SurfacePhotons {
+                    tree,
+                    power: photons.iter().map(|l| l.power).collect(),
+                })
+            })
+            .collect();
+        PhotonMap {
+            scene,
+            frames,
+            surfaces,
+            gather: options.gather_photons.max(1),
+            stats: PhotonStats {
+                emitted,
+                stored,
+                bytes,
+            },
+        }
+    }
+
+    /// The irradiance at `x` on surface `s` from light reflected at least once, W/m² per
+    /// channel: the power of the nearest photons on `s` over the part of `s` the disc through
+    /// the farthest of them covers (so a disc that reaches over the surface's edge is not
+    /// diluted by area where no photon could land).
+    pub fn indirect_irradiance(&self, x: DVec3, s: SurfaceId) -> Rgb {
+        let (Some(Some(photons)), Some(Some(frame))) = (self.surfaces.get(s), self.frames.get(s))
+        else {
+            return Rgb::ZERO;
+        };
+        let k = NonZero::new(self.gather).unwrap_or(NonZero::<usize>::MIN);
+        let nearest = photons
+            .tree
+            .query(&x.to_array())
+            .nearest_n::<SquaredEuclidean<f64>>(k)
+            .execute();
+        let Some(radius_squared) = nearest.iter().map(|n| n.distance).reduce(f64::max) else {
+            return Rgb::ZERO;
+        };
+        let polygon: Vec<_> = self.scene.surfaces[s]
+            .polygon
+            .iter()
+            .map(|&p| frame.to_2d(p))
+            .collect();
+        let area = disc::area_in_polygon(frame.to_2d(x), radius_squared.sqrt(), &polygon);
+        if !(area > 0.0) {
+            return Rgb::ZERO;
+        }
+        let power: Rgb = nearest.iter().map(|n| photons.power[n.item as usize]).sum();
+        power * (1.0 / area)
+    }
+}
+
+/// A photon leaving its emitter.
+#[derive(Clone, Copy, Debug)]
+struct Photon {
+    surface: SurfaceId,
+    origin: DVec3,
+    direction: DVec3,
+    power: Rgb,
+}
+
+/// What traces photons.
+struct Tracer<'s> {
+    scene: &'s Scene,
+    visibility: &'s Visibility,
+    frames: &'s [Option<PlaneFrame>],
+    /// Rays start this far off their surface, and hits this close to the start are ignored.
+    offset: f64,
+}
+
+impl Tracer<'_> {
+    /// Where `photon` lands after its first reflection, bounce after bounce, until it leaves the
+    /// scene, reaches a surface's back or loses at Russian roulette.
+    fn landings(&self, photon: Photon, rng: &mut SplitMix64) -> Vec<Landing> {
+        let mut landings = Vec::new();
+        let (mut s, mut x, mut d) = (photon.surface, photon.origin, photon.direction);
+        let mut power = photon.power;
+        let start_strength = power.max_channel();
+        for bounce in 0..MAX_BOUNCES {
+            let Some(frame) = self.frames[s] else { break };
+            let start = x + frame.normal * self.offset;
+            let Some(hit) =
+                self.visibility
+                    .closest_hit(start, d, self.offset, f64::INFINITY, Some(s))
+            else {
+                break;
+            };
+            let Some(hit_frame) = self.frames[hit.surface] else {
+                break;
+            };
+            // Surfaces receive on their front only.
+            if d.dot(hit_frame.normal) >= 0.0 {
+                break;
+            }
+            if bounce > 0 {
+                landings.push(Landing {
+                    surface: hit.surface,
+                    point: hit.point,
+                    power,
+                });
+            }
+            power = power.mul_rgb(self.scene.surfaces[hit.surface].reflectance);
+            let strength = power.max_channel() / start_strength;
+            if !(strength > 0.0) {
+                break;
+            }
+            if strength < ROULETTE_BELOW {
+                if rng.next_f64() >= strength {
+                    break;
+                }
+                power *= 1.0 / strength;
+            }
+            (s, x) = (hit.surface, hit.point);
+            d = emit::cosine_direction(&hit_frame, (rng.next_f64(), rng.next_f64()));
+        }
+        landings
+    }
+}
+
+#[cfg(test)]
+mod tests;
