@@ -11,6 +11,7 @@
 
 mod disc;
 mod emit;
+mod solve;
 
 use std::num::NonZero;
 
@@ -22,6 +23,7 @@ use serde::Serialize;
 
 use crate::{Interrupt, SolveError};
 use emit::Emission;
+pub use solve::solve_photon_map;
 
 /// Paths whose power, relative to what they left their emitter with, falls below this play
 /// Russian roulette with it as their survival chance.
@@ -38,6 +40,8 @@ pub struct PhotonMapOptions {
     pub photons: usize,
     /// Photons each irradiance estimate gathers.
     pub gather_photons: usize,
+    /// Rays per vertex of the final gather; 0 reads the map at the vertices themselves.
+    pub final_gather: usize,
     /// Seeds every photon's own random stream.
     pub seed: u64,
 }
@@ -47,6 +51,7 @@ impl Default for PhotonMapOptions {
         PhotonMapOptions {
             photons: 1_000_000,
             gather_photons: 200,
+            final_gather: 0,
             seed: 1,
         }
     }

@@ -43,6 +43,7 @@ fn the_furnace_has_the_closed_form_indirect_light() {
             photons,
             gather_photons: 1000,
             seed: 3,
+            final_gather: 0,
         };
         let map = PhotonMap::trace(&scene, &visibility, &options, None).expect("traced");
         assert_eq!(map.stats.emitted, photons);
@@ -71,6 +72,47 @@ fn the_furnace_has_the_closed_form_indirect_light() {
             rms < 1.3 * spread,
             "ρ {rho}: RMS error {rms} against noise {spread}"
         );
+    }
+}
+
+/// The furnace's radiosity, B = 1/(1 − ρ), at every vertex of a mesh, within 2 % RMS with and
+/// without a final gather.
+#[test]
+fn the_furnace_solution_is_the_closed_form() {
+    for rho in [0.5, 0.9] {
+        let scene = builtin::furnace(1.0, rho);
+        let visibility = Visibility::build(&scene);
+        let mesh = penumbra_meshing::mesh_scene_uniform(&scene, 600).expect("a mesh");
+        let exact = 1.0 / (1.0 - rho);
+        for final_gather in [0, 16] {
+            let photons = PhotonMapOptions {
+                photons: 200_000,
+                gather_photons: 4000,
+                seed: 4,
+                final_gather,
+            };
+            let options = crate::SolverOptions::default();
+            let (solution, _) = solve_photon_map(
+                &scene,
+                &mesh,
+                &visibility,
+                &options,
+                &photons,
+                &crate::NoProgress,
+            )
+            .expect("solved");
+            let errors: Vec<f64> = solution
+                .radiosity
+                .iter()
+                .flatten()
+                .map(|b| b.mean() / exact - 1.0)
+                .collect();
+            let rms = (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt();
+            assert!(
+                rms < 0.02,
+                "ρ {rho}, final gather {final_gather}: RMS {rms}"
+            );
+        }
     }
 }
 
@@ -112,6 +154,7 @@ fn the_map_does_not_depend_on_the_thread_count() {
         photons: 30_000,
         gather_photons: 50,
         seed: 5,
+        final_gather: 0,
     };
     let points = points_on(&scene, 3);
     let estimates = |threads: usize| {
@@ -166,5 +209,110 @@ fn photons_carry_the_emitted_power() {
         assert!((p.origin - frame.origin).dot(frame.normal).abs() < 1e-9 * scene.diagonal());
         assert!(p.direction.dot(frame.normal) > 0.0);
         assert!((p.direction.length() - 1.0).abs() < 1e-12);
+    }
+}
+
+/// Vertices of the floor and the back wall away from their edges, with the path-traced
+/// radiosity there (4,096 paths: standard errors under 1 %); points under the blocks, which see
+/// no light, left out.
+fn cornell_references(
+    scene: &Scene,
+    visibility: &Visibility,
+    mesh: &penumbra_meshing::SceneMesh,
+) -> Vec<(SurfaceId, usize, Rgb)> {
+    use crate::path_trace::{PathTraceOptions, PathTracer};
+    let mut points = Vec::new();
+    for name in ["floor", "back_wall"] {
+        let id = scene.surface_id(name).expect("a surface");
+        let m = &mesh.surfaces[id];
+        let bounds = penumbra_scenes::Bounds::from_points(&m.points3);
+        let (lo, hi) = (bounds.min, bounds.max);
+        let margin = 0.15 * (hi - lo);
+        for (v, p) in m.points3.iter().enumerate().step_by(13) {
+            let flat_or_inside = |c: usize| {
+                hi[c] - lo[c] < 1e-9 * scene.diagonal()
+                    || (p[c] > lo[c] + margin[c] && p[c] < hi[c] - margin[c])
+            };
+            if (0..3).all(flat_or_inside) {
+                points.push((*p, id, v));
+            }
+        }
+    }
+    let tracer = PathTracer::new(scene, visibility);
+    let at: Vec<_> = points.iter().map(|&(p, s, _)| (p, s)).collect();
+    let reference = tracer.radiosity(
+        &at,
+        &PathTraceOptions {
+            paths: 4096,
+            seed: 9,
+        },
+    );
+    points
+        .iter()
+        .zip(reference)
+        .filter(|(_, r)| r.radiosity.mean() > 0.0)
+        .map(|(&(_, s, v), r)| (s, v, r.radiosity))
+        .collect()
+}
+
+/// The Cornell box by photon mapping against the path-traced reference. Without a final gather
+/// the raw density estimate is noisy (400 photons: 5 %) and low beside the blocks' feet, where
+/// the disc covers floor no photon can reach: measured RMS 5.2 %, worst 15 %. A final gather of
+/// 64 rays reads the map a bounce away: measured RMS 2.4 %, worst 6.9 % (on this coarse
+/// uniform mesh, whose interpolated direct light the gather reads). Absorbed: 2.2 % and 1.2 %
+/// more than the hierarchical solution. What the surfaces absorb is what hierarchical radiosity
+/// finds on the same mesh (the box is open at the front), to the photons' noise.
+#[test]
+fn the_cornell_box_against_path_tracing() {
+    let scene = builtin::cornell();
+    let visibility = Visibility::build(&scene);
+    let mesh = penumbra_meshing::mesh_scene_uniform(&scene, 3000).expect("a mesh");
+    let references = cornell_references(&scene, &visibility, &mesh);
+    assert!(references.len() > 10, "{} points lit", references.len());
+    let options = crate::SolverOptions::default();
+    let hierarchical =
+        crate::solve_hierarchical(&scene, &mesh, &visibility, &options, &crate::NoProgress)
+            .expect("solved");
+    for (final_gather, bound) in [(0, 0.07), (64, 0.035)] {
+        let photons = PhotonMapOptions {
+            photons: 400_000,
+            gather_photons: 400,
+            seed: 2,
+            final_gather,
+        };
+        let (solution, stats) = solve_photon_map(
+            &scene,
+            &mesh,
+            &visibility,
+            &options,
+            &photons,
+            &crate::NoProgress,
+        )
+        .expect("solved");
+        assert!(stats.stored > photons.photons / 2, "{stats:?}");
+        for b in solution.radiosity.iter().flatten() {
+            assert!(
+                [b.r, b.g, b.b].iter().all(|c| c.is_finite() && *c >= 0.0),
+                "{b:?}"
+            );
+        }
+        let (a, h) = (
+            solution.stats.absorbed.mean(),
+            hierarchical.stats.absorbed.mean(),
+        );
+        assert!((a / h - 1.0).abs() < 0.03, "absorbed {a} against {h}");
+        let errors: Vec<f64> = references
+            .iter()
+            .map(|&(s, v, r)| solution.radiosity[s][v].mean() / r.mean() - 1.0)
+            .collect();
+        let rms = (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt();
+        let worst = errors.iter().fold(0.0_f64, |m, e| m.max(e.abs()));
+        eprintln!(
+            "final gather {final_gather}: {} points, RMS error {rms:.4}, worst {worst:.4}, \
+             absorbed {:.4} of hierarchical's",
+            errors.len(),
+            a / h
+        );
+        assert!(rms < bound, "final gather {final_gather}: RMS {rms}");
     }
 }
