@@ -33,6 +33,15 @@ const MAX_BOUNCES: usize = 64;
 /// Photons traced between two looks at the interrupt.
 const CHUNK: usize = 4096;
 
+/// Photons a solve emits unless told otherwise.
+pub const DEFAULT_PHOTONS: usize = 1_000_000;
+/// Photons an irradiance estimate gathers unless told otherwise.
+pub const DEFAULT_GATHER_PHOTONS: usize = 200;
+/// Final-gather rays per vertex unless told otherwise.
+pub const DEFAULT_FINAL_GATHER: usize = 64;
+/// Most photons a solve may emit: a billion stored photons would take about 60 GB.
+pub const MAX_PHOTONS: usize = 200_000_000;
+
 /// How the map is made and read.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PhotonMapOptions {
@@ -42,17 +51,14 @@ pub struct PhotonMapOptions {
     pub gather_photons: usize,
     /// Rays per vertex of the final gather; 0 reads the map at the vertices themselves.
     pub final_gather: usize,
-    /// Seeds every photon's own random stream.
-    pub seed: u64,
 }
 
 impl Default for PhotonMapOptions {
     fn default() -> Self {
         PhotonMapOptions {
-            photons: 1_000_000,
-            gather_photons: 200,
-            final_gather: 0,
-            seed: 1,
+            photons: DEFAULT_PHOTONS,
+            gather_photons: DEFAULT_GATHER_PHOTONS,
+            final_gather: DEFAULT_FINAL_GATHER,
         }
     }
 }
@@ -102,13 +108,14 @@ impl std::fmt::Debug for PhotonMap<'_> {
 }
 
 impl<'a> PhotonMap<'a> {
-    /// Traces `options.photons` photons through `scene` (with `visibility` its index) and
-    /// stores where they land after a reflection; [`SolveError::Interrupted`] once `interrupt`
-    /// is set.
+    /// Traces `options.photons` photons through `scene` (with `visibility` its index), their
+    /// random streams keyed by `seed`, and stores where they land after a reflection;
+    /// [`SolveError::Interrupted`] once `interrupt` is set.
     pub fn trace(
         scene: &'a Scene,
         visibility: &Visibility,
         options: &PhotonMapOptions,
+        seed: u64,
         interrupt: Option<&Interrupt>,
     ) -> Result<PhotonMap<'a>, SolveError> {
         let frames: Vec<Option<PlaneFrame>> = scene
@@ -116,7 +123,7 @@ impl<'a> PhotonMap<'a> {
             .iter()
             .map(|s| PlaneFrame::of_polygon(&s.polygon))
             .collect();
-        let emission = Emission::new(scene, &frames, options.photons, options.seed);
+        let emission = Emission::new(scene, &frames, options.photons, seed);
         let tracer = Tracer {
             scene,
             visibility,
@@ -133,7 +140,7 @@ impl<'a> PhotonMap<'a> {
             let chunk: Vec<Vec<Landing>> = (start..end)
                 .into_par_iter()
                 .map(|i| {
-                    let mut rng = SplitMix64::keyed(options.seed, &[i as u64]);
+                    let mut rng = SplitMix64::keyed(seed, &[i as u64]);
                     let photon = emission.photon(i);
                     tracer.landings(photon, &mut rng)
                 })

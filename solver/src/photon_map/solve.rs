@@ -34,13 +34,19 @@ pub fn solve_photon_map(
     let direct_seconds = started.elapsed().as_secs_f64();
 
     let started = Instant::now();
-    let map = PhotonMap::trace(scene, visibility, photons, options.interrupt.as_ref())?;
+    let map = PhotonMap::trace(
+        scene,
+        visibility,
+        photons,
+        options.seed,
+        options.interrupt.as_ref(),
+    )?;
     let indirect: Vec<Rgb> = if photons.final_gather > 0 {
         let gather = FinalGather::new(scene, mesh, visibility, &map, disc.per_surface(&direct));
         (0..disc.receiver_count())
             .into_par_iter()
             .map(|i| {
-                let mut rng = SplitMix64::keyed(photons.seed, &[GATHER_KEY, i as u64]);
+                let mut rng = SplitMix64::keyed(options.seed, &[GATHER_KEY, i as u64]);
                 let r = &disc.receivers[i];
                 gather.indirect(r, disc.receiver_surface[i], photons.final_gather, &mut rng)
             })

@@ -42,10 +42,9 @@ fn the_furnace_has_the_closed_form_indirect_light() {
         let options = PhotonMapOptions {
             photons,
             gather_photons: 1000,
-            seed: 3,
             final_gather: 0,
         };
-        let map = PhotonMap::trace(&scene, &visibility, &options, None).expect("traced");
+        let map = PhotonMap::trace(&scene, &visibility, &options, 1, None).expect("traced");
         assert_eq!(map.stats.emitted, photons);
         let exact = rho / (1.0 - rho);
         let spread = 1.0 / (options.gather_photons as f64).sqrt();
@@ -88,7 +87,6 @@ fn the_furnace_solution_is_the_closed_form() {
             let photons = PhotonMapOptions {
                 photons: 200_000,
                 gather_photons: 4000,
-                seed: 4,
                 final_gather,
             };
             let options = crate::SolverOptions::default();
@@ -127,7 +125,7 @@ fn nothing_reflected_comes_back_in_the_textbook() {
         photons: 20_000,
         ..PhotonMapOptions::default()
     };
-    let map = PhotonMap::trace(&scene, &visibility, &options, None).expect("traced");
+    let map = PhotonMap::trace(&scene, &visibility, &options, 1, None).expect("traced");
     let light = scene.surface_id("light").expect("a light");
     assert!(scene.surfaces[light].reflectance.is_zero());
     assert!(
@@ -153,7 +151,6 @@ fn the_map_does_not_depend_on_the_thread_count() {
     let options = PhotonMapOptions {
         photons: 30_000,
         gather_photons: 50,
-        seed: 5,
         final_gather: 0,
     };
     let points = points_on(&scene, 3);
@@ -163,7 +160,7 @@ fn the_map_does_not_depend_on_the_thread_count() {
             .build()
             .expect("a pool");
         pool.install(|| {
-            let map = PhotonMap::trace(&scene, &visibility, &options, None).expect("traced");
+            let map = PhotonMap::trace(&scene, &visibility, &options, 1, None).expect("traced");
             let values: Vec<Rgb> = points
                 .iter()
                 .map(|&(x, s)| map.indirect_irradiance(x, s))
@@ -257,11 +254,11 @@ fn cornell_references(
 
 /// The Cornell box by photon mapping against the path-traced reference. Without a final gather
 /// the raw density estimate is noisy (400 photons: 5 %) and low beside the blocks' feet, where
-/// the disc covers floor no photon can reach: measured RMS 5.2 %, worst 15 %. A final gather of
-/// 64 rays reads the map a bounce away: measured RMS 2.4 %, worst 6.9 % (on this coarse
-/// uniform mesh, whose interpolated direct light the gather reads). Absorbed: 2.2 % and 1.2 %
-/// more than the hierarchical solution. What the surfaces absorb is what hierarchical radiosity
-/// finds on the same mesh (the box is open at the front), to the photons' noise.
+/// the disc covers floor no photon can reach; a final gather of 64 rays reads the map a bounce
+/// away. Measured over five seeds (400,000 photons, a 3,000-triangle uniform mesh whose
+/// interpolated direct light the gather reads): RMS 5.2 to 6.8 % raw, 1.8 to 4.0 % gathered.
+/// What the surfaces absorb is what hierarchical radiosity finds on the same mesh (the box is
+/// open at the front) to 3 % (measured 1.2 to 2.2 % more).
 #[test]
 fn the_cornell_box_against_path_tracing() {
     let scene = builtin::cornell();
@@ -273,11 +270,10 @@ fn the_cornell_box_against_path_tracing() {
     let hierarchical =
         crate::solve_hierarchical(&scene, &mesh, &visibility, &options, &crate::NoProgress)
             .expect("solved");
-    for (final_gather, bound) in [(0, 0.07), (64, 0.035)] {
+    for (final_gather, bound) in [(0, 0.08), (64, 0.05)] {
         let photons = PhotonMapOptions {
             photons: 400_000,
             gather_photons: 400,
-            seed: 2,
             final_gather,
         };
         let (solution, stats) = solve_photon_map(
