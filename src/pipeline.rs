@@ -13,6 +13,7 @@ use penumbra_meshing::{
     polygon_minimum,
 };
 use penumbra_scenes::{LoadedScene, Rgb, SurfaceId, Visibility};
+use penumbra_solver::photon_map::solve_photon_map;
 use penumbra_solver::{
     Progress, Solution, SolveError, SolverMethod, SolverOptions, solve_direct_on, solve_gathering,
     solve_hierarchical, solve_progressive,
@@ -454,6 +455,13 @@ pub fn run(
             None,
             solve_hierarchical(scene, &mesh, &visibility, &solver, progress)?,
         ),
+        None if options.method == SolverMethod::PhotonMap => {
+            let photons = &solver.photon_map;
+            let (mut solution, stats) =
+                solve_photon_map(scene, &mesh, &visibility, &solver, photons, progress)?;
+            solution.stats.photon_map = Some(stats);
+            (None, solution)
+        }
         None => (
             None,
             solve_gathering(scene, &mesh, &visibility, &solver, options.method, progress)?.0,

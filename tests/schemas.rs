@@ -308,6 +308,25 @@ fn hierarchical_solutions_match_the_schemas() {
     assert!(report.get("refinement").is_none());
 }
 
+#[test]
+fn photon_map_solutions_match_the_schemas() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("photon-map");
+    let options = [
+        "--solver",
+        "photon-map",
+        "--max-elements",
+        "800",
+        "--photons",
+        "20000",
+    ];
+    run("cornell", &out, &options);
+    let report = check_outputs(&out);
+    assert_eq!(report["method"]["solver"], "photon-map");
+    assert!(report["solver"]["photon_map"].is_object());
+    assert_eq!(report["invocation"]["options"]["photons"], 20000);
+}
+
 /// Full solutions by Jacobi gathering with `--convergence`, and by the dense direct solve.
 #[test]
 fn gathering_and_dense_solutions_match_the_schemas() {

@@ -12,11 +12,11 @@ from ._solution import Solution
 Interrupt = _native.Interrupt
 
 MeshMethod = Literal["auto", "uniform", "discontinuity"]
-SolverMethod = Literal["hierarchical", "progressive", "jacobi", "gauss-seidel", "direct"]
+SolverMethod = Literal["hierarchical", "progressive", "jacobi", "gauss-seidel", "direct", "photon-map"]
 FormFactors = Literal["analytic", "monte-carlo", "hemicube"]
 
 _MESHES = ("auto", "uniform", "discontinuity")
-_SOLVERS = ("hierarchical", "progressive", "jacobi", "gauss-seidel", "direct")
+_SOLVERS = ("hierarchical", "progressive", "jacobi", "gauss-seidel", "direct", "photon-map")
 _FORM_FACTORS = ("analytic", "monte-carlo", "hemicube")
 
 
@@ -63,6 +63,9 @@ def run(
     refine_rounds: Optional[int] = None,
     solver: SolverMethod = "hierarchical",
     link_tol: Optional[float] = None,
+    photons: Optional[int] = None,
+    gather_photons: Optional[int] = None,
+    final_gather: Optional[int] = None,
     form_factors: FormFactors = "analytic",
     ff_samples: Optional[int] = None,
     hemicube_resolution: Optional[int] = None,
@@ -88,7 +91,8 @@ def run(
     uniform), ``"uniform"`` or ``"discontinuity"``; ``max_elements`` caps the triangles for the
     whole scene (default 25,000 with the hierarchical solver, 10,000 with the others and
     ``direct_only``, or what the scene needs if more); ``solver`` ``"hierarchical"``,
-    ``"progressive"``, ``"jacobi"``, ``"gauss-seidel"`` or ``"direct"``; ``direct_only``
+    ``"progressive"``, ``"jacobi"``, ``"gauss-seidel"``, ``"direct"`` or ``"photon-map"`` (with
+    ``photons``, ``gather_photons`` and ``final_gather``); ``direct_only``
     solves one exact bounce; ``refine_tol`` turns on adaptive refinement from
     ``initial_elements`` up to ``max_elements``; ``time_budget`` (seconds) stops early with the
     best solution so far; ``threads`` workers (default one per core; results do not depend on
@@ -126,6 +130,9 @@ def run(
         "refine_rounds": _checks.count(refine_rounds, "refine_rounds"),
         "solver": _checks.choice(solver, "solver", _SOLVERS),
         "link_tol": _checks.number(link_tol, "link_tol"),
+        "photons": _checks.count(photons, "photons"),
+        "gather_photons": _checks.count(gather_photons, "gather_photons"),
+        "final_gather": _checks.count(final_gather, "final_gather", minimum=0),
         "form_factors": _checks.choice(form_factors, "form_factors", _FORM_FACTORS),
         "ff_samples": _checks.count(ff_samples, "ff_samples"),
         "hemicube_resolution": _checks.count(hemicube_resolution, "hemicube_resolution"),

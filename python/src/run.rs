@@ -68,6 +68,9 @@ pub(crate) struct RunArguments {
     refine_rounds: Option<usize>,
     solver: Option<String>,
     link_tol: Option<f64>,
+    photons: Option<usize>,
+    gather_photons: Option<usize>,
+    final_gather: Option<usize>,
     form_factors: Option<String>,
     ff_samples: Option<usize>,
     hemicube_resolution: Option<usize>,
@@ -118,6 +121,7 @@ impl RunArguments {
                 ("jacobi", SolverMethod::Jacobi),
                 ("gauss-seidel", SolverMethod::GaussSeidel),
                 ("direct", SolverMethod::Direct),
+                ("photon-map", SolverMethod::PhotonMap),
             ],
         )?;
         let mesh = choice(
@@ -212,6 +216,15 @@ impl RunArguments {
             max_shots: self.max_shots.unwrap_or(defaults.max_shots),
             visibility_rays: self.rays.unwrap_or(defaults.visibility_rays),
             link_tol: self.link_tol.unwrap_or(DEFAULT_LINK_TOL),
+            photon_map: penumbra_solver::photon_map::PhotonMapOptions {
+                photons: self.photons.unwrap_or(defaults.photon_map.photons),
+                gather_photons: self
+                    .gather_photons
+                    .unwrap_or(defaults.photon_map.gather_photons),
+                final_gather: self
+                    .final_gather
+                    .unwrap_or(defaults.photon_map.final_gather),
+            },
             form_factors: match form_factors {
                 "monte-carlo" => FormFactorMethod::MonteCarlo {
                     samples: self.ff_samples.unwrap_or(penumbra::DEFAULT_FF_SAMPLES),

@@ -43,6 +43,8 @@ pub enum SolverMethod {
     Direct,
     /// Hierarchical radiosity with clustering, and a final gather at the vertices.
     Hierarchical,
+    /// Photon mapping for the indirect light, the direct light exact.
+    PhotonMap,
 }
 
 impl SolverMethod {
@@ -54,6 +56,7 @@ impl SolverMethod {
             SolverMethod::GaussSeidel => "gauss-seidel",
             SolverMethod::Direct => "direct",
             SolverMethod::Hierarchical => "hierarchical",
+            SolverMethod::PhotonMap => "photon-map",
         }
     }
 }
@@ -376,6 +379,7 @@ pub fn solve_gathering(
         gathered: 0,
         gather_seconds: 0.0,
         hierarchy: None,
+        photon_map: None,
     };
     Ok((
         Solution {

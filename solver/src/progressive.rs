@@ -62,6 +62,8 @@ pub struct SolverOptions {
     /// The hierarchical solver's link tolerance: the light a link may carry wrongly, as a
     /// fraction of the light the surfaces reflect of the direct light.
     pub link_tol: f64,
+    /// The photon-map solver's photons, estimates and final gather.
+    pub photon_map: crate::photon_map::PhotonMapOptions,
 }
 
 /// The default of [`SolverOptions::epsilon`].
@@ -89,6 +91,7 @@ impl Default for SolverOptions {
             interrupt: None,
             form_factors: FormFactorMethod::Analytic,
             link_tol: crate::hierarchical::DEFAULT_LINK_TOL,
+            photon_map: crate::photon_map::PhotonMapOptions::default(),
         }
     }
 }
@@ -115,6 +118,16 @@ impl SolverOptions {
         }
         if !(self.link_tol > 0.0 && self.link_tol < 1.0) {
             return bad("link tolerance", "must be in (0, 1)");
+        }
+        let photons = &self.photon_map;
+        if !(1..=crate::photon_map::MAX_PHOTONS).contains(&photons.photons) {
+            return bad("photons", "must be from 1 to 200,000,000");
+        }
+        if !(1..=crate::photon_map::MAX_GATHER_PHOTONS).contains(&photons.gather_photons) {
+            return bad("gather photons", "must be from 1 to 100,000");
+        }
+        if photons.final_gather > MAX_FORM_FACTOR_SAMPLES {
+            return bad("final gather", "must be from 0 to 65,536 rays");
         }
         if !(1..=MAX_VISIBILITY_RAYS).contains(&self.visibility_rays) {
             return bad("visibility rays", "must be from 1 to 4096");
@@ -201,6 +214,9 @@ pub struct SolveStats {
     /// The hierarchical solver's own figures.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub hierarchy: Option<crate::hierarchical::HierarchyStats>,
+    /// The photon-map solver's figures: photons emitted and stored, the map's memory.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub photon_map: Option<crate::photon_map::PhotonStats>,
 }
 
 /// One step of a solver: its residual relative to the light put in (for progressive refinement
@@ -982,6 +998,7 @@ impl<'a> ProgressiveSolver<'a> {
             gathered: self.gathered,
             gather_seconds: self.gather_seconds,
             hierarchy: None,
+            photon_map: None,
         };
         Solution {
             radiosity: self.radiosity(),

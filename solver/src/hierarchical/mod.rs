@@ -566,6 +566,7 @@ fn energy_stats(
         gathered: 0,
         gather_seconds: 0.0,
         hierarchy: None,
+        photon_map: None,
     }
 }
 

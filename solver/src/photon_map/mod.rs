@@ -21,7 +21,7 @@ use penumbra_scenes::{PlaneFrame, Rgb, Scene, SplitMix64, SurfaceId, Visibility}
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::{Interrupt, SolveError};
+use crate::{Interrupt, Progress, SolveError};
 use emit::Emission;
 pub use solve::solve_photon_map;
 
@@ -39,8 +39,10 @@ pub const DEFAULT_PHOTONS: usize = 1_000_000;
 pub const DEFAULT_GATHER_PHOTONS: usize = 200;
 /// Final-gather rays per vertex unless told otherwise.
 pub const DEFAULT_FINAL_GATHER: usize = 64;
-/// Most photons a solve may emit: a billion stored photons would take about 60 GB.
+/// Most photons a solve may emit: each stores about two landings of 72 bytes.
 pub const MAX_PHOTONS: usize = 200_000_000;
+/// Most photons an estimate may gather.
+pub const MAX_GATHER_PHOTONS: usize = 100_000;
 
 /// How the map is made and read.
 #[derive(Clone, Debug, PartialEq)]
@@ -117,6 +119,7 @@ impl<'a> PhotonMap<'a> {
         options: &PhotonMapOptions,
         seed: u64,
         interrupt: Option<&Interrupt>,
+        progress: &dyn Progress,
     ) -> Result<PhotonMap<'a>, SolveError> {
         let frames: Vec<Option<PlaneFrame>> = scene
             .surfaces
@@ -132,6 +135,7 @@ impl<'a> PhotonMap<'a> {
         };
         let mut landings = Vec::new();
         let mut start = 0;
+        progress.start("photons", emission.count() as u64);
         while start < emission.count() {
             if interrupt.is_some_and(Interrupt::is_set) {
                 return Err(SolveError::Interrupted);
@@ -147,7 +151,9 @@ impl<'a> PhotonMap<'a> {
                 .collect();
             landings.extend(chunk.into_iter().flatten());
             start = end;
+            progress.set(start as u64);
         }
+        progress.finish();
         Ok(Self::store(
             scene,
             frames,

@@ -40,26 +40,22 @@ pub fn solve_photon_map(
         photons,
         options.seed,
         options.interrupt.as_ref(),
+        progress,
     )?;
-    let indirect: Vec<Rgb> = if photons.final_gather > 0 {
+    let (indirect, stop) = if photons.final_gather > 0 {
         let gather = FinalGather::new(scene, mesh, visibility, &map, disc.per_surface(&direct));
-        (0..disc.receiver_count())
-            .into_par_iter()
-            .map(|i| {
-                let mut rng = SplitMix64::keyed(options.seed, &[GATHER_KEY, i as u64]);
-                let r = &disc.receivers[i];
-                gather.indirect(r, disc.receiver_surface[i], photons.final_gather, &mut rng)
-            })
-            .collect()
+        gather_all(&gather, &disc, options, photons.final_gather, progress)
     } else {
-        disc.receivers
-            .par_iter()
-            .zip(&disc.receiver_surface)
-            .map(|(r, &s)| map.indirect_irradiance(r.point, s))
-            .collect()
+        let raw = disc.receivers.par_iter().zip(&disc.receiver_surface);
+        (
+            raw.map(|(r, &s)| map.indirect_irradiance(r.point, s))
+                .collect(),
+            None,
+        )
     };
     let irradiance: Vec<Rgb> = direct.iter().zip(&indirect).map(|(&d, &i)| d + i).collect();
     let mut stats = energy_stats(scene, &disc, &irradiance);
+    stats.stop = stop.unwrap_or(StopReason::Converged);
     stats.direct_seconds = direct_seconds;
     stats.direct_beyond_cap = direct_beyond_cap;
     stats.gather_seconds = started.elapsed().as_secs_f64();
@@ -114,7 +110,45 @@ fn energy_stats(scene: &Scene, disc: &Discretization, irradiance: &[Rgb]) -> Sol
         gathered: 0,
         gather_seconds: 0.0,
         hierarchy: None,
+        photon_map: None,
     }
+}
+
+/// Vertices gathered between two looks at the interrupt and the deadline.
+const GATHER_CHUNK: usize = 512;
+
+/// The final gather at every vertex, chunk by chunk; once the run must stop (an interrupt, the
+/// time budget), the vertices left read the map where they are, and the reason is returned.
+fn gather_all(
+    gather: &FinalGather<'_>,
+    disc: &Discretization,
+    options: &SolverOptions,
+    rays: usize,
+    progress: &dyn Progress,
+) -> (Vec<Rgb>, Option<StopReason>) {
+    let n = disc.receiver_count();
+    let mut values = Vec::with_capacity(n);
+    let mut stop = None;
+    progress.start("final gather", n as u64);
+    while values.len() < n {
+        let range = values.len()..(values.len() + GATHER_CHUNK).min(n);
+        stop = stop.or_else(|| options.stop_now());
+        let chunk: Vec<Rgb> = range
+            .into_par_iter()
+            .map(|i| {
+                let (r, s) = (&disc.receivers[i], disc.receiver_surface[i]);
+                if stop.is_some() {
+                    return gather.map.indirect_irradiance(r.point, s);
+                }
+                let mut rng = SplitMix64::keyed(options.seed, &[GATHER_KEY, i as u64]);
+                gather.indirect(r, s, rays, &mut rng)
+            })
+            .collect();
+        values.extend(chunk);
+        progress.set(values.len() as u64);
+    }
+    progress.finish();
+    (values, stop)
 }
 
 /// Keys the final gather's random streams apart from the photons' (keyed by their index alone).

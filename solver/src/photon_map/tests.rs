@@ -44,7 +44,8 @@ fn the_furnace_has_the_closed_form_indirect_light() {
             gather_photons: 1000,
             final_gather: 0,
         };
-        let map = PhotonMap::trace(&scene, &visibility, &options, 1, None).expect("traced");
+        let map = PhotonMap::trace(&scene, &visibility, &options, 1, None, &crate::NoProgress)
+            .expect("traced");
         assert_eq!(map.stats.emitted, photons);
         let exact = rho / (1.0 - rho);
         let spread = 1.0 / (options.gather_photons as f64).sqrt();
@@ -125,7 +126,8 @@ fn nothing_reflected_comes_back_in_the_textbook() {
         photons: 20_000,
         ..PhotonMapOptions::default()
     };
-    let map = PhotonMap::trace(&scene, &visibility, &options, 1, None).expect("traced");
+    let map = PhotonMap::trace(&scene, &visibility, &options, 1, None, &crate::NoProgress)
+        .expect("traced");
     let light = scene.surface_id("light").expect("a light");
     assert!(scene.surfaces[light].reflectance.is_zero());
     assert!(
@@ -160,7 +162,8 @@ fn the_map_does_not_depend_on_the_thread_count() {
             .build()
             .expect("a pool");
         pool.install(|| {
-            let map = PhotonMap::trace(&scene, &visibility, &options, 1, None).expect("traced");
+            let map = PhotonMap::trace(&scene, &visibility, &options, 1, None, &crate::NoProgress)
+                .expect("traced");
             let values: Vec<Rgb> = points
                 .iter()
                 .map(|&(x, s)| map.indirect_irradiance(x, s))

@@ -25,6 +25,19 @@ fn default_export() -> String {
     DEFAULT_EXPORT.to_owned()
 }
 
+// Reports written before photon mapping replay with its defaults.
+fn default_photons() -> usize {
+    penumbra_solver::photon_map::DEFAULT_PHOTONS
+}
+
+fn default_gather_photons() -> usize {
+    penumbra_solver::photon_map::DEFAULT_GATHER_PHOTONS
+}
+
+fn default_final_gather() -> usize {
+    penumbra_solver::photon_map::DEFAULT_FINAL_GATHER
+}
+
 /// `penumbra run --help`'s examples.
 pub(crate) const EXAMPLES: &str = "\
 Examples:
@@ -77,6 +90,7 @@ pub(crate) enum SolverArg {
     GaussSeidel,
     Direct,
     Hierarchical,
+    PhotonMap,
 }
 
 impl From<SolverArg> for penumbra_solver::SolverMethod {
@@ -87,6 +101,7 @@ impl From<SolverArg> for penumbra_solver::SolverMethod {
             SolverArg::GaussSeidel => Self::GaussSeidel,
             SolverArg::Direct => Self::Direct,
             SolverArg::Hierarchical => Self::Hierarchical,
+            SolverArg::PhotonMap => Self::PhotonMap,
         }
     }
 }
@@ -171,15 +186,30 @@ pub(crate) struct RunArgs {
     /// How the radiosity system is solved: hierarchical radiosity with clustering (links refined
     /// to --link-tol, then a final gather at every vertex), progressive refinement (shooting: an
     /// image at any moment), Jacobi or Gauss–Seidel gathering over the patch form-factor matrix,
-    /// or its dense direct solve (the discrete system's exact answer). Hierarchical, gathering
-    /// and direct solves stop at a relative residual of --epsilon, or after --max-shots sweeps;
-    /// progressive refinement when the unshot power is below --epsilon.
+    /// or its dense direct solve (the discrete system's exact answer), or photon mapping (the
+    /// light reflected more than once from --photons photons, the direct light exact).
+    /// Hierarchical, gathering and direct solves stop at a relative residual of --epsilon, or
+    /// after --max-shots sweeps; progressive refinement when the unshot power is below
+    /// --epsilon.
     #[arg(help_heading = SOLVER, long, value_enum, default_value_t = SolverArg::Hierarchical)]
     pub(crate) solver: SolverArg,
     /// With --solver hierarchical: the light a link may carry wrongly, as a fraction of the
     /// light the surfaces reflect of the direct light; smaller is finer and slower.
     #[arg(help_heading = SOLVER, long, default_value_t = penumbra_solver::hierarchical::DEFAULT_LINK_TOL)]
     pub(crate) link_tol: f64,
+    /// With --solver photon-map: photons emitted, shared among the lights by power.
+    #[arg(help_heading = SOLVER, long, default_value_t = penumbra_solver::photon_map::DEFAULT_PHOTONS)]
+    #[serde(default = "default_photons")]
+    pub(crate) photons: usize,
+    /// With --solver photon-map: photons each estimate of the indirect light gathers.
+    #[arg(help_heading = SOLVER, long, default_value_t = penumbra_solver::photon_map::DEFAULT_GATHER_PHOTONS)]
+    #[serde(default = "default_gather_photons")]
+    pub(crate) gather_photons: usize,
+    /// With --solver photon-map: rays per vertex of the final gather, which reads the photon
+    /// map where they land instead of at the vertex (0: none).
+    #[arg(help_heading = SOLVER, long, value_name = "RAYS", default_value_t = penumbra_solver::photon_map::DEFAULT_FINAL_GATHER)]
+    #[serde(default = "default_final_gather")]
+    pub(crate) final_gather: usize,
     /// How vertex-to-patch form factors are computed: Lambert's formula times a ray-sampled
     /// visibility fraction, Monte Carlo over each patch (--ff-samples points, each with a ray),
     /// or a hemicube z-buffer at each vertex (--hemicube-resolution; not with --refine-tol).
@@ -340,6 +370,11 @@ impl RunArgs {
             max_shots: self.max_shots,
             visibility_rays: self.rays,
             link_tol: self.link_tol,
+            photon_map: penumbra_solver::photon_map::PhotonMapOptions {
+                photons: self.photons,
+                gather_photons: self.gather_photons,
+                final_gather: self.final_gather,
+            },
             form_factors: match self.form_factors {
                 FormFactorArg::Analytic => FormFactorMethod::Analytic,
                 FormFactorArg::MonteCarlo => FormFactorMethod::MonteCarlo {
