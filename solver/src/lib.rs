@@ -105,6 +105,7 @@ pub mod path_trace;
 pub mod photon_map;
 mod progress;
 mod progressive;
+mod rays;
 mod shadow_union;
 mod solids;
 

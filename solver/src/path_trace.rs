@@ -24,6 +24,7 @@ use serde::Serialize;
 use crate::Interrupt;
 use crate::direct::DirectLight;
 use crate::lambert::ReceivingPoint;
+use crate::rays::{cosine_direction, front_hit};
 
 /// Paths whose throughput falls below this play Russian roulette with it as survival chance.
 const ROULETTE_BELOW: f64 = 0.5;
@@ -199,25 +200,12 @@ impl<'a> PathTracer<'a> {
             } else {
                 (rng.next_f64(), rng.next_f64())
             };
-            let (sin_phi, cos_phi) = (2.0 * std::f64::consts::PI * r1).sin_cos();
-            let radius = r2.sqrt();
-            let d = frame.u * (radius * cos_phi)
-                + frame.v * (radius * sin_phi)
-                + frame.normal * (1.0 - r2).max(0.0).sqrt();
-            let start = x + frame.normal * self.offset;
-            let Some(hit) =
-                self.visibility
-                    .closest_hit(start, d, self.offset, f64::INFINITY, Some(s))
+            let d = cosine_direction(&frame, (r1, r2));
+            // Leaving the scene, or arriving at a surface's back: nothing comes back.
+            let Some((hit, _)) = front_hit(self.visibility, &self.frames, (x, s), d, self.offset)
             else {
                 break;
             };
-            let Some(hit_frame) = self.frames[hit.surface] else {
-                break;
-            };
-            // Arriving at a surface's back: nothing comes back from there.
-            if d.dot(hit_frame.normal) >= 0.0 {
-                break;
-            }
             throughput = throughput.mul_rgb(self.scene.surfaces[hit.surface].reflectance);
             let strongest = throughput.r.max(throughput.g).max(throughput.b);
             if strongest <= 0.0 {

@@ -9,6 +9,7 @@ use penumbra_scenes::polygon::triangulate_ccw;
 use penumbra_scenes::{PlaneFrame, Rgb, Scene, SplitMix64, SurfaceId};
 
 use super::Photon;
+use crate::rays::cosine_direction;
 
 /// The R4 sequence's steps: the powers of 1/φ₄, where φ₄ = 1.1673... is the real root of
 /// x⁵ = x + 1.
@@ -150,15 +151,6 @@ impl Emitter {
         self.frame
             .to_3d(a * (1.0 - s) + b * (s * (1.0 - u2)) + c * (s * u2))
     }
-}
-
-/// A cosine-distributed direction about `frame`'s normal, picked by a point of the unit square.
-pub(super) fn cosine_direction(frame: &PlaneFrame, (r1, r2): (f64, f64)) -> DVec3 {
-    let (sin_phi, cos_phi) = (2.0 * std::f64::consts::PI * r1).sin_cos();
-    let radius = r2.sqrt();
-    frame.u * (radius * cos_phi)
-        + frame.v * (radius * sin_phi)
-        + frame.normal * (1.0 - r2).max(0.0).sqrt()
 }
 
 /// `total` shared in proportion to `weights` (largest remainders, ties to the first), at least

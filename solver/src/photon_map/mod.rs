@@ -21,6 +21,7 @@ use penumbra_scenes::{PlaneFrame, Rgb, Scene, SplitMix64, SurfaceId, Visibility}
 use rayon::prelude::*;
 use serde::Serialize;
 
+use crate::rays::{cosine_direction, front_hit};
 use crate::{Interrupt, Progress, SolveError};
 use emit::Emission;
 pub use solve::solve_photon_map;
@@ -261,21 +262,11 @@ impl Tracer<'_> {
         let mut power = photon.power;
         let start_strength = power.max_channel();
         for bounce in 0..MAX_BOUNCES {
-            let Some(frame) = self.frames[s] else { break };
-            let start = x + frame.normal * self.offset;
-            let Some(hit) =
-                self.visibility
-                    .closest_hit(start, d, self.offset, f64::INFINITY, Some(s))
+            let Some((hit, hit_frame)) =
+                front_hit(self.visibility, self.frames, (x, s), d, self.offset)
             else {
                 break;
             };
-            let Some(hit_frame) = self.frames[hit.surface] else {
-                break;
-            };
-            // Surfaces receive on their front only.
-            if d.dot(hit_frame.normal) >= 0.0 {
-                break;
-            }
             if bounce > 0 {
                 landings.push(Landing {
                     surface: hit.surface,
@@ -295,7 +286,7 @@ impl Tracer<'_> {
                 power *= 1.0 / strength;
             }
             (s, x) = (hit.surface, hit.point);
-            d = emit::cosine_direction(&hit_frame, (rng.next_f64(), rng.next_f64()));
+            d = cosine_direction(&hit_frame, (rng.next_f64(), rng.next_f64()));
         }
         landings
     }

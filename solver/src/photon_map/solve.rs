@@ -8,11 +8,11 @@ use penumbra_meshing::{SceneMesh, TriangleLocator};
 use penumbra_scenes::{Rgb, Scene, SplitMix64, SurfaceId, Visibility};
 use rayon::prelude::*;
 
-use super::emit::cosine_direction;
 use super::{PhotonMap, PhotonMapOptions, PhotonStats};
 use crate::elements::Discretization;
 use crate::lambert::ReceivingPoint;
 use crate::progressive::{check_mesh, direct_irradiance};
+use crate::rays::{cosine_direction, front_hit};
 use crate::{Progress, Solution, SolveError, SolveStats, SolverOptions, StopReason};
 
 /// Radiosity at every vertex of `mesh`: B = E + ρ (H_direct + H_indirect), the direct part
@@ -205,7 +205,6 @@ impl<'a> FinalGather<'a> {
         let side = ((rays as f64).sqrt().ceil() as usize).max(1);
         let cell = 1.0 / side as f64;
         let inside = x.point + x.inward * self.visibility.junction_offset();
-        let start = inside + frame.normal * self.offset;
         let mut sum = Rgb::ZERO;
         for i in 0..side {
             for j in 0..side {
@@ -214,27 +213,22 @@ impl<'a> FinalGather<'a> {
                     (j as f64 + rng.next_f64()) * cell,
                 );
                 let d = cosine_direction(frame, u);
-                let hit =
-                    self.visibility
-                        .closest_hit(start, d, self.offset, f64::INFINITY, Some(s));
-                if let Some(hit) = hit {
-                    sum += self.reflected(hit.point, hit.surface, d);
+                let frames = &self.map.frames;
+                if let Some((hit, _)) =
+                    front_hit(self.visibility, frames, (inside, s), d, self.offset)
+                {
+                    sum += self.reflected(hit.point, hit.surface);
                 }
             }
         }
         sum * (1.0 / (side * side) as f64)
     }
 
-    /// What surface `t` reflects at `y` towards a ray arriving along `d`: nothing from its back.
-    fn reflected(&self, y: DVec3, t: SurfaceId, d: DVec3) -> Rgb {
-        let (Some(Some(frame)), Some(Some((m, locator)))) =
-            (self.map.frames.get(t), self.surfaces.get(t))
-        else {
+    /// What surface `t` reflects at `y` (on its front).
+    fn reflected(&self, y: DVec3, t: SurfaceId) -> Rgb {
+        let Some(Some((m, locator))) = self.surfaces.get(t) else {
             return Rgb::ZERO;
         };
-        if d.dot(frame.normal) >= 0.0 {
-            return Rgb::ZERO;
-        }
         let direct = locator.interpolate(&self.mesh.surfaces[*m], &self.direct[*m], y);
         let h = direct + self.map.indirect_irradiance(y, t);
         self.scene.surfaces[t].reflectance.mul_rgb(h)
