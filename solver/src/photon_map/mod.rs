@@ -34,12 +34,14 @@ const MAX_BOUNCES: usize = 64;
 /// Photons traced between two looks at the interrupt.
 const CHUNK: usize = 4096;
 
-/// Photons a solve emits unless told otherwise.
-pub const DEFAULT_PHOTONS: usize = 1_000_000;
+/// Photons a solve emits unless told otherwise. With the defaults below the Cornell box is
+/// within 2 % RMS of the path-traced reference (`penumbra sweep cornell --solvers photon-map
+/// --methods discontinuity`: 1.96 % at 10,000 triangles in 12 s, 1.76 % at 25,000 in 26 s).
+pub const DEFAULT_PHOTONS: usize = 2_000_000;
 /// Photons an irradiance estimate gathers unless told otherwise.
-pub const DEFAULT_GATHER_PHOTONS: usize = 200;
+pub const DEFAULT_GATHER_PHOTONS: usize = 100;
 /// Final-gather rays per vertex unless told otherwise.
-pub const DEFAULT_FINAL_GATHER: usize = 64;
+pub const DEFAULT_FINAL_GATHER: usize = 256;
 /// Most photons a solve may emit: each stores about two landings of 72 bytes.
 pub const MAX_PHOTONS: usize = 200_000_000;
 /// Most photons an estimate may gather.
