@@ -148,10 +148,11 @@ impl SolverOptions {
 }
 
 /// Why the solver stopped.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum StopReason {
     /// Unshot power fell below epsilon of the emitted power.
+    #[default]
     Converged,
     /// The shot cap was reached first.
     ShotLimit,
@@ -164,7 +165,7 @@ pub enum StopReason {
 }
 
 /// Figures of a solve. Powers are in W per channel (radiosity times area in scene units).
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Default, Serialize)]
 pub struct SolveStats {
     /// Why the solver stopped.
     pub stop: StopReason,

@@ -20,18 +20,21 @@ fn in_triangle(a: DVec2, b: DVec2, radius: f64) -> f64 {
     let r2 = radius * radius;
     let d = b - a;
     let (qa, qb, qc) = (d.dot(d), a.dot(d), a.dot(a) - r2);
-    let mut cuts = vec![0.0];
+    // The edge's parameters 0, where it crosses the circle (at most twice), and 1.
+    let (mut cuts, mut n) = ([0.0; 4], 1);
     let discriminant = qb * qb - qa * qc;
     if qa > 0.0 && discriminant > 0.0 {
         let root = discriminant.sqrt();
         for t in [(-qb - root) / qa, (-qb + root) / qa] {
             if t > 0.0 && t < 1.0 {
-                cuts.push(t);
+                cuts[n] = t;
+                n += 1;
             }
         }
     }
-    cuts.push(1.0);
-    cuts.windows(2)
+    cuts[n] = 1.0;
+    cuts[..=n]
+        .windows(2)
         .map(|w| {
             let (p, q) = (a + d * w[0], a + d * w[1]);
             let middle = a + d * (0.5 * (w[0] + w[1]));

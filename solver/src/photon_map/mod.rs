@@ -15,7 +15,7 @@ mod solve;
 
 use std::num::NonZero;
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use penumbra_scenes::{PlaneFrame, Rgb, Scene, SplitMix64, SurfaceId, Visibility};
 use rayon::prelude::*;
@@ -91,6 +91,8 @@ struct Landing {
 struct SurfacePhotons {
     tree: ImmutableKdTree<f64, 3>,
     power: Vec<Rgb>,
+    /// The surface's polygon in its frame, for the disc's area.
+    polygon: Vec<DVec2>,
 }
 
 /// The indirect photons of a scene, surface by surface.
@@ -182,13 +184,20 @@ impl<'a> PhotonMap<'a> {
         let mut bytes = 0;
         let surfaces = by_surface
             .into_iter()
-            .map(|photons| {
+            .enumerate()
+            .map(|(s, photons)| {
+                let frame = frames[s]?;
                 let points: Vec<[f64; 3]> = photons.iter().map(|l| l.point.to_array()).collect();
                 let tree = ImmutableKdTree::new_from_slice(&points).ok()?;
                 bytes += points.len() * (3 * 8 + size_of::<Rgb>() + 3 * 8);
                 Some(SurfacePhotons {
                     tree,
                     power: photons.iter().map(|l| l.power).collect(),
+                    polygon: scene.surfaces[s]
+                        .polygon
+                        .iter()
+                        .map(|&p| frame.to_2d(p))
+                        .collect(),
                 })
             })
             .collect();
@@ -223,12 +232,8 @@ impl<'a> PhotonMap<'a> {
         let Some(radius_squared) = nearest.iter().map(|n| n.distance).reduce(f64::max) else {
             return Rgb::ZERO;
         };
-        let polygon: Vec<_> = self.scene.surfaces[s]
-            .polygon
-            .iter()
-            .map(|&p| frame.to_2d(p))
-            .collect();
-        let area = disc::area_in_polygon(frame.to_2d(x), radius_squared.sqrt(), &polygon);
+        let centre = frame.to_2d(x);
+        let area = disc::area_in_polygon(centre, radius_squared.sqrt(), &photons.polygon);
         if !(area > 0.0) {
             return Rgb::ZERO;
         }

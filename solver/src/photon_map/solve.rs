@@ -90,27 +90,11 @@ fn energy_stats(scene: &Scene, disc: &Discretization, irradiance: &[Rgb]) -> Sol
     let reflected = disc.integrate(irradiance, |e| rho(e.surface));
     let received = disc.integrate(irradiance, |_| Rgb::splat(1.0));
     SolveStats {
-        stop: StopReason::Converged,
-        shots: 0,
-        iterations: 0,
-        residual: 0.0,
-        patches: 0,
         receivers: disc.receiver_count(),
-        rays_cast: 0,
         emitted,
         absorbed,
-        unshot: Rgb::ZERO,
         escaped: emitted + reflected - received,
-        unshot_fraction: 0.0,
-        direct_seconds: 0.0,
-        direct_estimated: 0,
-        direct_beyond_cap: 0,
-        shooting_seconds: 0.0,
-        remeshes: 0,
-        gathered: 0,
-        gather_seconds: 0.0,
-        hierarchy: None,
-        photon_map: None,
+        ..SolveStats::default()
     }
 }
 
@@ -205,6 +189,7 @@ impl<'a> FinalGather<'a> {
         let side = ((rays as f64).sqrt().ceil() as usize).max(1);
         let cell = 1.0 / side as f64;
         let inside = x.point + x.inward * self.visibility.junction_offset();
+        let frames = &self.map.frames;
         let mut sum = Rgb::ZERO;
         for i in 0..side {
             for j in 0..side {
@@ -213,7 +198,6 @@ impl<'a> FinalGather<'a> {
                     (j as f64 + rng.next_f64()) * cell,
                 );
                 let d = cosine_direction(frame, u);
-                let frames = &self.map.frames;
                 if let Some((hit, _)) =
                     front_hit(self.visibility, frames, (inside, s), d, self.offset)
                 {

@@ -1,6 +1,11 @@
 use super::*;
 use penumbra_scenes::builtin;
 
+/// The root mean square of `errors`.
+fn rms(errors: &[f64]) -> f64 {
+    (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt()
+}
+
 /// Points spread over every face of a scene, corners and edges included: a jittered grid in
 /// each surface's frame, kept where it falls inside the polygon.
 fn points_on(scene: &Scene, per_side: usize) -> Vec<(DVec3, SurfaceId)> {
@@ -16,7 +21,7 @@ fn points_on(scene: &Scene, per_side: usize) -> Vec<(DVec3, SurfaceId)> {
             .fold((flat[0], flat[0]), |(lo, hi), &p| (lo.min(p), hi.max(p)));
         for i in 0..per_side {
             for j in 0..per_side {
-                let t = glam::DVec2::new(
+                let t = DVec2::new(
                     (i as f64 + rng.next_f64()) / per_side as f64,
                     (j as f64 + rng.next_f64()) / per_side as f64,
                 );
@@ -66,7 +71,7 @@ fn the_furnace_has_the_closed_form_indirect_light() {
             .collect();
         let n = errors.len() as f64;
         let mean = errors.iter().sum::<f64>() / n;
-        let rms = (errors.iter().map(|e| e * e).sum::<f64>() / n).sqrt();
+        let rms = rms(&errors);
         assert!(mean.abs() < 0.01, "ρ {rho}: mean error {mean}");
         assert!(
             rms < 1.3 * spread,
@@ -106,7 +111,7 @@ fn the_furnace_solution_is_the_closed_form() {
                 .flatten()
                 .map(|b| b.mean() / exact - 1.0)
                 .collect();
-            let rms = (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt();
+            let rms = rms(&errors);
             assert!(
                 rms < 0.02,
                 "ρ {rho}, final gather {final_gather}: RMS {rms}"
@@ -304,7 +309,7 @@ fn the_cornell_box_against_path_tracing() {
             .iter()
             .map(|&(s, v, r)| solution.radiosity[s][v].mean() / r.mean() - 1.0)
             .collect();
-        let rms = (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt();
+        let rms = rms(&errors);
         let worst = errors.iter().fold(0.0_f64, |m, e| m.max(e.abs()));
         eprintln!(
             "final gather {final_gather}: {} points, RMS error {rms:.4}, worst {worst:.4}, \
