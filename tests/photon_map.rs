@@ -1,5 +1,6 @@
 //! `--solver photon-map` from the command line: the textbook's light against the exact direct
-//! light, the report's figures, and the same bytes whatever the thread count.
+//! light, the report's figures, the same bytes whatever the thread count, and sweeps with the
+//! photon count as the budget.
 
 mod common;
 use common::{json, penumbra, run_quietly, stderr};
@@ -55,6 +56,19 @@ fn the_textbook_is_its_direct_light() {
         figures["stored"].as_u64().expect("stored") > 0,
         "the light receives the floor's"
     );
+    // The photons' tally of what leaves, and the time of each stage.
+    let escaped = figures["escaped"].as_array().expect("escaped per channel");
+    let emitted = report["energy"]["emitted"].as_array().expect("emitted");
+    for (lost, given) in escaped.iter().zip(emitted) {
+        let (lost, given) = (
+            lost.as_f64().expect("a number"),
+            given.as_f64().expect("a number"),
+        );
+        assert!(lost > 0.0 && lost < given, "{lost} of {given}");
+    }
+    for stage in ["trace_seconds", "estimate_seconds"] {
+        assert!(figures[stage].as_f64().expect(stage) > 0.0, "{stage}");
+    }
 }
 
 #[test]
@@ -122,4 +136,93 @@ fn bad_photon_options_are_refused() {
         out,
     ]);
     assert_eq!(o.status.code(), Some(2));
+}
+
+/// `penumbra sweep --solvers photon-map` runs photon mapping at each photon budget, on one mesh,
+/// a line per final gather; the other solvers keep their element budgets. Photon-map lines
+/// appear against time, not against triangles (their triangles do not change).
+#[test]
+fn sweeps_take_photons_as_the_photon_maps_budget() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("sweep");
+    let o = penumbra(&[
+        "sweep",
+        "cornell",
+        "--budgets",
+        "700",
+        "--samples",
+        "60",
+        "--reference-paths",
+        "64",
+        "--methods",
+        "discontinuity",
+        "--solvers",
+        "hierarchical,photon-map",
+        "--photons",
+        "20000,40000",
+        "--final-gather",
+        "0,4",
+        "--photon-elements",
+        "900",
+        "--out",
+        out.to_str().expect("utf-8"),
+        "--quiet",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let sweep = json(&out.join("sweep.json"));
+    let rows = sweep["rows"].as_array().expect("rows");
+    let runs: Vec<(String, u64, Option<u64>, Option<u64>)> = rows
+        .iter()
+        .map(|r| {
+            (
+                r["solver"].as_str().expect("solver").to_owned(),
+                r["max_elements"].as_u64().expect("budget"),
+                r["photons"].as_u64(),
+                r["final_gather"].as_u64(),
+            )
+        })
+        .collect();
+    let pm = |photons, rays| ("photon-map".to_owned(), 900, Some(photons), Some(rays));
+    assert_eq!(
+        runs,
+        vec![
+            ("hierarchical".to_owned(), 700, None, None),
+            pm(20000, 0),
+            pm(40000, 0),
+            pm(20000, 4),
+            pm(40000, 4),
+        ]
+    );
+    for r in rows {
+        assert!(r["rms"].as_f64().expect("rms").is_finite());
+    }
+    let csv = std::fs::read_to_string(out.join("sweep.csv")).expect("csv");
+    assert!(
+        csv.lines()
+            .next()
+            .expect("header")
+            .ends_with(",solver,photons,final_gather")
+    );
+    assert!(
+        csv.lines().any(|l| l.ends_with(",photon-map,40000,4")),
+        "{csv}"
+    );
+    let time = std::fs::read_to_string(out.join("error-vs-time.svg")).expect("svg");
+    assert!(time.contains("discontinuity (photon-map, 4 rays)"));
+    assert!(time.contains("discontinuity (photon-map, 0 rays)"));
+    let elements = std::fs::read_to_string(out.join("error-vs-elements.svg")).expect("svg");
+    assert!(!elements.contains("photon-map") && elements.contains("hierarchical"));
+    // A photon budget of 0 is refused, naming the flag, before anything is traced.
+    let o = penumbra(&[
+        "sweep",
+        "cornell",
+        "--solvers",
+        "photon-map",
+        "--photons",
+        "1000,0",
+        "--out",
+        out.to_str().expect("utf-8"),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("--photons"), "{}", stderr(&o));
 }

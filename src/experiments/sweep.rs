@@ -13,6 +13,7 @@ use penumbra_meshing::{DEFAULT_PENUMBRA_DENSITY, TriangleLocator};
 use penumbra_scenes::SplitMix64;
 use penumbra_scenes::{LoadedScene, Scene, SurfaceId, Visibility};
 use penumbra_solver::path_trace::ReferenceValue;
+use penumbra_solver::photon_map::MAX_PHOTONS;
 use penumbra_solver::{DirectLight, Progress, ReceivingPoint, SolverMethod, SolverOptions};
 use penumbra_viz::{LogLogChart, Series};
 use serde::Serialize;
@@ -119,7 +120,18 @@ pub struct SweepOptions {
     /// progressive refinement and the hierarchical solver; direct-light sweeps use progressive
     /// refinement only).
     pub solvers: Vec<SolverMethod>,
+    /// The photon-map solver's budgets: photons emitted. Its runs take these in place of
+    /// `budgets`, each on the mesh of `photon_elements` triangles.
+    pub photons: Vec<usize>,
+    /// The photon-map solver's final gathers, rays per vertex (0: none): a line of photon
+    /// budgets for each.
+    pub final_gathers: Vec<usize>,
+    /// The element budget of the photon-map runs' meshes.
+    pub photon_elements: usize,
 }
+
+/// Photon budgets of a sweep unless told otherwise: a ladder up to twice the run's default.
+pub const DEFAULT_PHOTON_BUDGETS: [usize; 5] = [250_000, 500_000, 1_000_000, 2_000_000, 4_000_000];
 
 /// Most sample points a sweep scores at: the error of the error is long below a percent there.
 pub const MAX_SAMPLES: usize = 10_000_000;
@@ -156,6 +168,18 @@ impl SweepOptions {
                 ),
             );
         }
+        if self.photon_elements == 0 {
+            return bad("photon elements", "must be at least 1 triangle".into());
+        }
+        if self.final_gathers.is_empty() {
+            return bad("final gather", "give at least one count of rays".into());
+        }
+        if self.photons.is_empty() || self.photons.iter().any(|&p| p == 0 || p > MAX_PHOTONS) {
+            return bad(
+                "photons",
+                format!("every photon budget must be from 1 to {MAX_PHOTONS}"),
+            );
+        }
         self.solver.validate()?;
         Ok(())
     }
@@ -182,6 +206,10 @@ pub struct SweepRow {
     pub solver: &'static str,
     /// The run's element budget, in triangles for the whole scene.
     pub max_elements: usize,
+    /// The photon-map runs' budget: photons emitted; `None` for the other solvers.
+    pub photons: Option<usize>,
+    /// The photon-map runs' final gather, rays per vertex; `None` for the other solvers.
+    pub final_gather: Option<usize>,
     /// The adaptive runs' tolerance (a fraction of the mean reflected radiosity); `None` for
     /// the others.
     pub refine_tol: Option<f64>,
@@ -254,10 +282,66 @@ pub struct Sample {
     pub penumbra: bool,
 }
 
+/// One run of a sweep: how it meshes and solves, its element budget and, for photon mapping,
+/// its photons and final-gather rays.
+#[derive(Clone, Copy, Debug)]
+struct Job {
+    method: SweepMethod,
+    solver: SolverMethod,
+    budget: usize,
+    photons: Option<(usize, usize)>,
+}
+
+/// The runs of a sweep: every method at every budget with every solver (adaptive methods with
+/// the progressive and hierarchical solvers only); then photon mapping with every final gather
+/// at every photon budget, on each non-adaptive method's mesh of `photon_elements` triangles.
+fn jobs(options: &SweepOptions) -> Vec<Job> {
+    let solvers: Vec<SolverMethod> = if options.solver.direct_only || options.solvers.is_empty() {
+        vec![SolverMethod::Progressive]
+    } else {
+        options.solvers.clone()
+    };
+    let mut jobs = Vec::new();
+    for &budget in &options.budgets {
+        for &method in &options.methods {
+            for &solver in &solvers {
+                let allowed = match solver {
+                    SolverMethod::PhotonMap => false,
+                    SolverMethod::Progressive | SolverMethod::Hierarchical => true,
+                    _ => !method.adaptive(),
+                };
+                if allowed {
+                    jobs.push(Job {
+                        method,
+                        solver,
+                        budget,
+                        photons: None,
+                    });
+                }
+            }
+        }
+    }
+    if solvers.contains(&SolverMethod::PhotonMap) {
+        for &rays in &options.final_gathers {
+            for &photons in &options.photons {
+                for &method in options.methods.iter().filter(|m| !m.adaptive()) {
+                    jobs.push(Job {
+                        method,
+                        solver: SolverMethod::PhotonMap,
+                        budget: options.photon_elements,
+                        photons: Some((photons, rays)),
+                    });
+                }
+            }
+        }
+    }
+    jobs
+}
+
 /// Runs the sweep at `samples` (from [`sample_points`]) against `reference`: every method of
 /// `options` at every budget (and, in full solutions, with every solver; adaptive methods with
-/// the progressive and hierarchical solvers only), each a whole [`run`] with a 1 × 1 render.
-/// Fails with the first run that fails.
+/// the progressive and hierarchical solvers only; photon mapping at its photon budgets), each a
+/// whole [`run`] with a 1 × 1 render. Fails with the first run that fails.
 pub fn sweep(
     loaded: &LoadedScene,
     options: &SweepOptions,
@@ -283,100 +367,63 @@ pub fn sweep(
                 / mean.max(f64::MIN_POSITIVE)
         }
     };
-    let methods = &options.methods;
     let first = options.budgets.first().copied().unwrap_or(1);
+    let jobs = jobs(options);
     let mut rows = Vec::new();
-    let solvers: Vec<SolverMethod> = if options.solver.direct_only || options.solvers.is_empty() {
-        vec![SolverMethod::Progressive]
-    } else {
-        options.solvers.clone()
-    };
-    let combinations: Vec<(SweepMethod, SolverMethod)> = methods
-        .iter()
-        .flat_map(|&m| solvers.iter().map(move |&s| (m, s)))
-        .filter(|&(m, s)| {
-            !m.adaptive() || matches!(s, SolverMethod::Progressive | SolverMethod::Hierarchical)
-        })
-        .collect();
-    progress.start("sweep", (options.budgets.len() * combinations.len()) as u64);
-    for &budget in &options.budgets {
-        for &(method, solver) in &combinations {
-            let run_options = RunOptions {
-                method: solver,
-                mesh: method.mesh(),
-                max_elements: budget.into(),
-                penumbra_density: if method.adaptive() {
-                    1.0
-                } else {
-                    DEFAULT_PENUMBRA_DENSITY
-                },
-                refine: method.adaptive().then(|| RefineOptions {
-                    tolerance: options.refine_tol * first as f64 / budget.max(1) as f64,
-                    initial_elements: ((budget as f64 * options.initial_fraction) as usize).max(1),
-                    max_rounds: crate::adaptive::DEFAULT_MAX_ROUNDS,
-                    indirect: Default::default(),
-                }),
-                solver: options.solver.clone(),
-                render: penumbra_viz::RenderOptions {
-                    width: 1,
-                    height: 1,
-                    ..Default::default()
-                },
-                discontinuity: DiscontinuityOptions {
-                    events: method.events(),
-                    ..DiscontinuityOptions::default()
-                },
-                ..RunOptions::default()
-            };
-            let result = run(loaded.clone(), &run_options, &penumbra_solver::NoProgress)?;
-            let (mut sum2, mut max, mut pen2, mut pen_n) = (0.0, 0.0f64, 0.0, 0usize);
-            let mut worst = None;
-            let locators: Vec<TriangleLocator> = result
-                .mesh
-                .surfaces
-                .iter()
-                .map(TriangleLocator::new)
-                .collect();
-            for (s, &reference) in samples.iter().zip(&values) {
-                let value = locators[s.surface]
-                    .interpolate(
-                        &result.mesh.surfaces[s.surface],
-                        &result.solution.radiosity[s.surface],
-                        s.point,
-                    )
-                    .mean();
-                let e = value - reference;
-                sum2 += e * e;
-                if e.abs() > max {
-                    max = e.abs();
-                    worst = Some(WorstSample {
-                        surface: scene.surfaces[s.surface].name.clone(),
-                        point: s.point.to_array(),
-                        reference,
-                        value,
-                    });
-                }
-                if s.penumbra {
-                    pen2 += e * e;
-                    pen_n += 1;
-                }
-            }
-            let scale = mean.max(f64::MIN_POSITIVE);
-            rows.push(SweepRow {
-                method: method.name(),
-                solver: solver.name(),
-                max_elements: budget,
-                refine_tol: run_options.refine.as_ref().map(|r| r.tolerance),
-                triangles: result.mesh.triangle_count(),
-                vertices: result.mesh.vertex_count(),
-                seconds: result.times.total - result.times.render,
-                rms: (sum2 / n).sqrt() / scale,
-                max: max / scale,
-                penumbra_rms: (pen2 / pen_n.max(1) as f64).sqrt() / scale,
-                worst,
-            });
-            progress.set(rows.len() as u64);
+    progress.start("sweep", jobs.len() as u64);
+    for job in jobs {
+        let method = job.method;
+        let mut solver = options.solver.clone();
+        if let Some((photons, rays)) = job.photons {
+            solver.photon_map.photons = photons;
+            solver.photon_map.final_gather = rays;
         }
+        let run_options = RunOptions {
+            method: job.solver,
+            mesh: method.mesh(),
+            max_elements: job.budget.into(),
+            penumbra_density: if method.adaptive() {
+                1.0
+            } else {
+                DEFAULT_PENUMBRA_DENSITY
+            },
+            refine: method.adaptive().then(|| RefineOptions {
+                tolerance: options.refine_tol * first as f64 / job.budget.max(1) as f64,
+                initial_elements: ((job.budget as f64 * options.initial_fraction) as usize).max(1),
+                max_rounds: crate::adaptive::DEFAULT_MAX_ROUNDS,
+                indirect: Default::default(),
+            }),
+            solver,
+            render: penumbra_viz::RenderOptions {
+                width: 1,
+                height: 1,
+                ..Default::default()
+            },
+            discontinuity: DiscontinuityOptions {
+                events: method.events(),
+                ..DiscontinuityOptions::default()
+            },
+            ..RunOptions::default()
+        };
+        let result = run(loaded.clone(), &run_options, &penumbra_solver::NoProgress)?;
+        let score = Score::of(&result, scene, samples, &values);
+        let scale = mean.max(f64::MIN_POSITIVE);
+        rows.push(SweepRow {
+            method: method.name(),
+            solver: job.solver.name(),
+            max_elements: job.budget,
+            photons: job.photons.map(|p| p.0),
+            final_gather: job.photons.map(|p| p.1),
+            refine_tol: run_options.refine.as_ref().map(|r| r.tolerance),
+            triangles: result.mesh.triangle_count(),
+            vertices: result.mesh.vertex_count(),
+            seconds: result.times.total - result.times.render,
+            rms: (score.sum2 / n).sqrt() / scale,
+            max: score.max / scale,
+            penumbra_rms: (score.penumbra_sum2 / score.penumbra_count.max(1) as f64).sqrt() / scale,
+            worst: score.worst,
+        });
+        progress.set(rows.len() as u64);
     }
     progress.finish();
     Ok(Sweep {
@@ -393,6 +440,64 @@ pub fn sweep(
         reference_mean: mean,
         rows,
     })
+}
+
+/// A run's errors at the samples, in W/m² (channel mean).
+struct Score {
+    sum2: f64,
+    max: f64,
+    penumbra_sum2: f64,
+    penumbra_count: usize,
+    worst: Option<WorstSample>,
+}
+
+impl Score {
+    /// The run's interpolated radiosity against `values`, the reference at `samples`.
+    fn of(
+        result: &crate::pipeline::RunResult,
+        scene: &Scene,
+        samples: &[Sample],
+        values: &[f64],
+    ) -> Score {
+        let mut score = Score {
+            sum2: 0.0,
+            max: 0.0,
+            penumbra_sum2: 0.0,
+            penumbra_count: 0,
+            worst: None,
+        };
+        let locators: Vec<TriangleLocator> = result
+            .mesh
+            .surfaces
+            .iter()
+            .map(TriangleLocator::new)
+            .collect();
+        for (s, &reference) in samples.iter().zip(values) {
+            let value = locators[s.surface]
+                .interpolate(
+                    &result.mesh.surfaces[s.surface],
+                    &result.solution.radiosity[s.surface],
+                    s.point,
+                )
+                .mean();
+            let e = value - reference;
+            score.sum2 += e * e;
+            if e.abs() > score.max {
+                score.max = e.abs();
+                score.worst = Some(WorstSample {
+                    surface: scene.surfaces[s.surface].name.clone(),
+                    point: s.point.to_array(),
+                    reference,
+                    value,
+                });
+            }
+            if s.penumbra {
+                score.penumbra_sum2 += e * e;
+                score.penumbra_count += 1;
+            }
+        }
+        score
+    }
 }
 
 /// Seeded points spread over the scene's surfaces by area (emitters left out; only `surfaces`
@@ -460,29 +565,36 @@ pub fn sample_points(
 }
 
 /// The sweep's log–log charts, one line per method: RMS error against triangles and against
-/// seconds, with their file stems.
+/// seconds, with their file stems. Photon-map runs, whose budget is photons on one mesh, are
+/// lines against seconds only.
 pub fn sweep_charts(sweep: &Sweep) -> Vec<(&'static str, LogLogChart)> {
-    // One line per method, or per method and solver when the sweep compares solvers.
-    let mut lines: Vec<(&str, &str)> = Vec::new();
+    // One line per method, or per method and solver when the sweep compares solvers, and per
+    // final gather of the photon map.
+    type Line<'a> = (&'a str, &'a str, Option<usize>);
+    let line_of =
+        |r: &SweepRow| -> (&str, &str, Option<usize>) { (r.method, r.solver, r.final_gather) };
+    let mut lines: Vec<Line> = Vec::new();
     for r in &sweep.rows {
-        if !lines.contains(&(r.method, r.solver)) {
-            lines.push((r.method, r.solver));
+        if !lines.contains(&line_of(r)) {
+            lines.push(line_of(r));
         }
     }
     let several_solvers = lines.iter().any(|l| l.1 != lines[0].1);
-    let series = |x: fn(&SweepRow) -> f64| -> Vec<Series> {
+    let name = |&(m, solver, rays): &Line| match (several_solvers, rays) {
+        (_, Some(rays)) => format!("{m} ({solver}, {rays} rays)"),
+        (true, None) => format!("{m} ({solver})"),
+        (false, None) => m.to_owned(),
+    };
+    let series = |x: fn(&SweepRow) -> f64, photons: bool| -> Vec<Series> {
         lines
             .iter()
-            .map(|&(m, solver)| Series {
-                name: if several_solvers {
-                    format!("{m} ({solver})")
-                } else {
-                    m.to_owned()
-                },
+            .filter(|l| photons || l.2.is_none())
+            .map(|l| Series {
+                name: name(l),
                 points: sweep
                     .rows
                     .iter()
-                    .filter(|r| r.method == m && r.solver == solver)
+                    .filter(|r| line_of(r) == *l)
                     .map(|r| (x(r), 100.0 * r.rms))
                     .collect(),
             })
@@ -501,7 +613,7 @@ pub fn sweep_charts(sweep: &Sweep) -> Vec<(&'static str, LogLogChart)> {
                 title: format!("{scene}: error against triangles"),
                 x_label: "triangles in the scene".to_owned(),
                 y_label: y_label.clone(),
-                series: series(|r| r.triangles as f64),
+                series: series(|r| r.triangles as f64, false),
             },
         ),
         (
@@ -510,7 +622,7 @@ pub fn sweep_charts(sweep: &Sweep) -> Vec<(&'static str, LogLogChart)> {
                 title: format!("{scene}: error against time"),
                 x_label: "seconds (mesh and solve, no render)".to_owned(),
                 y_label,
-                series: series(|r| r.seconds),
+                series: series(|r| r.seconds, true),
             },
         ),
     ]
@@ -519,11 +631,11 @@ pub fn sweep_charts(sweep: &Sweep) -> Vec<(&'static str, LogLogChart)> {
 /// The sweep as CSV, a row per run.
 pub fn sweep_csv(sweep: &Sweep) -> String {
     let mut out = String::from(
-        "method,max_elements,refine_tol,triangles,vertices,seconds,rms_relative,max_relative,penumbra_rms_relative,solver\n",
+        "method,max_elements,refine_tol,triangles,vertices,seconds,rms_relative,max_relative,penumbra_rms_relative,solver,photons,final_gather\n",
     );
     for r in &sweep.rows {
         out += &format!(
-            "{},{},{},{},{},{:.6},{:.6e},{:.6e},{:.6e},{}\n",
+            "{},{},{},{},{},{:.6},{:.6e},{:.6e},{:.6e},{},{},{}\n",
             r.method,
             r.max_elements,
             r.refine_tol.map_or(String::new(), |t| format!("{t:e}")),
@@ -533,7 +645,9 @@ pub fn sweep_csv(sweep: &Sweep) -> String {
             r.rms,
             r.max,
             r.penumbra_rms,
-            r.solver
+            r.solver,
+            r.photons.map_or(String::new(), |p| p.to_string()),
+            r.final_gather.map_or(String::new(), |p| p.to_string())
         );
     }
     out

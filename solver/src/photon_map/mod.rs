@@ -77,6 +77,13 @@ pub struct PhotonStats {
     pub stored: usize,
     /// Bytes the map holds: positions, powers and the trees.
     pub bytes: usize,
+    /// The power of the photons that reached no surface's front (they left the scene or met a
+    /// back), W per channel: the photons' own tally of what the scene loses.
+    pub escaped: Rgb,
+    /// Seconds spent tracing the photons and building the trees.
+    pub trace_seconds: f64,
+    /// Seconds spent estimating the indirect light at the vertices (the final gather, if any).
+    pub estimate_seconds: f64,
 }
 
 /// A photon where it landed: its position and the power it brought, W per channel.
@@ -138,7 +145,9 @@ impl<'a> PhotonMap<'a> {
             frames: &frames,
             offset: visibility.contact_distance(),
         };
+        let started = std::time::Instant::now();
         let mut landings = Vec::new();
+        let mut escaped = Rgb::ZERO;
         let mut start = 0;
         progress.start("photons", emission.count() as u64);
         while start < emission.count() {
@@ -146,7 +155,7 @@ impl<'a> PhotonMap<'a> {
                 return Err(SolveError::Interrupted);
             }
             let end = (start + CHUNK).min(emission.count());
-            let chunk: Vec<Vec<Landing>> = (start..end)
+            let chunk: Vec<(Vec<Landing>, Rgb)> = (start..end)
                 .into_par_iter()
                 .map(|i| {
                     let mut rng = SplitMix64::keyed(seed, &[i as u64]);
@@ -154,18 +163,18 @@ impl<'a> PhotonMap<'a> {
                     tracer.landings(photon, &mut rng)
                 })
                 .collect();
-            landings.extend(chunk.into_iter().flatten());
+            for (photon_landings, lost) in chunk {
+                landings.extend(photon_landings);
+                escaped += lost;
+            }
             start = end;
             progress.set(start as u64);
         }
         progress.finish();
-        Ok(Self::store(
-            scene,
-            frames,
-            landings,
-            emission.count(),
-            options,
-        ))
+        let mut map = Self::store(scene, frames, landings, emission.count(), options);
+        map.stats.escaped = escaped;
+        map.stats.trace_seconds = started.elapsed().as_secs_f64();
+        Ok(map)
     }
 
     /// The map of `landings`, sorted by surface in the order they came.
@@ -210,6 +219,7 @@ impl<'a> PhotonMap<'a> {
                 emitted,
                 stored,
                 bytes,
+                ..PhotonStats::default()
             },
         }
     }
@@ -262,8 +272,9 @@ struct Tracer<'s> {
 
 impl Tracer<'_> {
     /// Where `photon` lands after its first reflection, bounce after bounce, until it leaves the
-    /// scene, reaches a surface's back or loses at Russian roulette.
-    fn landings(&self, photon: Photon, rng: &mut SplitMix64) -> Vec<Landing> {
+    /// scene, reaches a surface's back or loses at Russian roulette; with the power it took out
+    /// of the scene (leaving or at a back).
+    fn landings(&self, photon: Photon, rng: &mut SplitMix64) -> (Vec<Landing>, Rgb) {
         let mut landings = Vec::new();
         let (mut s, mut x, mut d) = (photon.surface, photon.origin, photon.direction);
         let mut power = photon.power;
@@ -272,7 +283,7 @@ impl Tracer<'_> {
             let Some((hit, hit_frame)) =
                 front_hit(self.visibility, self.frames, (x, s), d, self.offset)
             else {
-                break;
+                return (landings, power);
             };
             if bounce > 0 {
                 landings.push(Landing {
@@ -295,7 +306,7 @@ impl Tracer<'_> {
             (s, x) = (hit.surface, hit.point);
             d = cosine_direction(&hit_frame, (rng.next_f64(), rng.next_f64()));
         }
-        landings
+        (landings, Rgb::ZERO)
     }
 }
 

@@ -34,7 +34,7 @@ pub fn solve_photon_map(
     let direct_seconds = started.elapsed().as_secs_f64();
 
     let started = Instant::now();
-    let map = PhotonMap::trace(
+    let mut map = PhotonMap::trace(
         scene,
         visibility,
         photons,
@@ -42,6 +42,7 @@ pub fn solve_photon_map(
         options.interrupt.as_ref(),
         progress,
     )?;
+    let estimating = Instant::now();
     let (indirect, stop) = if photons.final_gather > 0 {
         let gather = FinalGather::new(scene, mesh, visibility, &map, disc.per_surface(&direct));
         gather_all(&gather, &disc, options, photons.final_gather, progress)
@@ -53,6 +54,7 @@ pub fn solve_photon_map(
             None,
         )
     };
+    map.stats.estimate_seconds = estimating.elapsed().as_secs_f64();
     let irradiance: Vec<Rgb> = direct.iter().zip(&indirect).map(|(&d, &i)| d + i).collect();
     let mut stats = energy_stats(scene, &disc, &irradiance);
     stats.stop = stop.unwrap_or(StopReason::Converged);

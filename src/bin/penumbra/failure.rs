@@ -66,6 +66,7 @@ fn flag(option: &str, command: Command) -> Option<&'static str> {
         ("epsilon", _) => "--epsilon",
         ("link tolerance", _) => "--link-tol",
         ("photons", _) => "--photons",
+        ("photon elements", _) => "--photon-elements",
         ("gather photons", _) => "--gather-photons",
         ("final gather", _) => "--final-gather",
         ("visibility rays", _) => "--rays",

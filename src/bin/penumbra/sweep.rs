@@ -75,6 +75,20 @@ pub(crate) struct SweepArgs {
     /// light the surfaces reflect of the direct light.
     #[arg(long, default_value_t = penumbra_solver::hierarchical::DEFAULT_LINK_TOL)]
     link_tol: f64,
+    /// With --solvers photon-map: its budgets, photons emitted (comma-separated), in place of
+    /// --budgets.
+    #[arg(long, value_delimiter = ',', default_values_t = penumbra::experiments::sweep::DEFAULT_PHOTON_BUDGETS)]
+    photons: Vec<usize>,
+    /// With --solvers photon-map: the element budget of its meshes.
+    #[arg(long, default_value_t = penumbra::DEFAULT_MAX_ELEMENTS)]
+    photon_elements: usize,
+    /// With --solvers photon-map: photons each estimate of the indirect light gathers.
+    #[arg(long, default_value_t = penumbra_solver::photon_map::DEFAULT_GATHER_PHOTONS)]
+    gather_photons: usize,
+    /// With --solvers photon-map: rays per vertex of the final gather (0: none); several,
+    /// comma-separated, give a line of photon budgets each.
+    #[arg(long, value_name = "RAYS", value_delimiter = ',', default_values_t = [penumbra_solver::photon_map::DEFAULT_FINAL_GATHER])]
+    final_gather: Vec<usize>,
     /// No progress bar and no table.
     #[arg(long)]
     quiet: bool,
@@ -104,9 +118,16 @@ pub(crate) fn sweep(args: &SweepArgs) -> Result<(), Failure> {
             epsilon: args.epsilon,
             visibility_rays: args.rays,
             link_tol: args.link_tol,
+            photon_map: penumbra_solver::photon_map::PhotonMapOptions {
+                gather_photons: args.gather_photons,
+                ..Default::default()
+            },
             ..SolverOptions::default()
         },
         solvers: args.solvers.iter().map(|&s| s.into()).collect(),
+        photons: args.photons.clone(),
+        final_gathers: args.final_gather.clone(),
+        photon_elements: args.photon_elements,
     };
     options
         .validate()
@@ -180,15 +201,19 @@ pub(crate) fn sweep(args: &SweepArgs) -> Result<(), Failure> {
             100.0 * result.reference_standard_error
         );
         println!(
-            "{:<24} {:<13} {:>8} {:>9} {:>9} {:>10} {:>10} {:>12}",
+            "{:<24} {:<13} {:>16} {:>9} {:>9} {:>10} {:>10} {:>12}",
             "method", "solver", "budget", "triangles", "seconds", "rms", "max", "penumbra rms"
         );
         for r in &result.rows {
+            let budget = match (r.photons, r.final_gather) {
+                (Some(p), Some(rays)) => format!("{p}ph/{rays}r"),
+                _ => r.max_elements.to_string(),
+            };
             println!(
-                "{:<24} {:<13} {:>8} {:>9} {:>9.3} {:>9.4}% {:>9.3}% {:>11.4}%",
+                "{:<24} {:<13} {:>16} {:>9} {:>9.3} {:>9.4}% {:>9.3}% {:>11.4}%",
                 r.method,
                 r.solver,
-                r.max_elements,
+                budget,
                 r.triangles,
                 r.seconds,
                 100.0 * r.rms,
