@@ -126,8 +126,9 @@ pub fn estimate(scene: &Scene, options: &RunOptions, counts: MeshCounts) -> Memo
             (SolverMethod::Hierarchical, _) => {
                 penumbra_solver::hierarchical::estimated_bytes(counts.triangles, solver.link_tol)
             }
-            // About two landings per photon, each a position, a power and its tree's share.
-            (SolverMethod::PhotonMap, _) => (solver.photon_map.photons as u64).saturating_mul(144),
+            // About two landings per photon, each a position, a power and its tree's share, and
+            // for a final gather an estimate made in advance at every fourth.
+            (SolverMethod::PhotonMap, _) => (solver.photon_map.photons as u64).saturating_mul(180),
             // K per channel, plus its copy under elimination.
             (SolverMethod::Direct, _) => columns(p).saturating_add(matrix.saturating_mul(4)),
             _ => columns(p).saturating_add(matrix.saturating_mul(3)),

@@ -31,17 +31,21 @@ pub use solve::solve_photon_map;
 const ROULETTE_BELOW: f64 = 0.5;
 /// Bounces at most: a photon this old carries ρ^64 of its power.
 const MAX_BOUNCES: usize = 64;
-/// Photons traced between two looks at the interrupt.
+/// Photons traced, or estimates made, between two looks at the interrupt.
 const CHUNK: usize = 4096;
+/// For a final gather, irradiance is estimated in advance at every this many stored photons
+/// (Christensen 1999: a quarter).
+const PRECOMPUTE_EVERY: usize = 4;
 
 /// Photons a solve emits unless told otherwise. With the defaults below the Cornell box is
-/// within 2 % RMS of the path-traced reference (`penumbra sweep cornell --solvers photon-map
-/// --methods discontinuity`: 1.96 % at 10,000 triangles in 12 s, 1.76 % at 25,000 in 26 s).
-pub const DEFAULT_PHOTONS: usize = 2_000_000;
+/// within 1.5 % RMS of the path-traced reference (`penumbra sweep cornell --solvers photon-map
+/// --methods discontinuity --photons 1000000`: 1.48 % at 10,000 triangles in 5.4 s); its error
+/// is then the mesh's and the final gather's, not the photons'.
+pub const DEFAULT_PHOTONS: usize = 1_000_000;
 /// Photons an irradiance estimate gathers unless told otherwise.
 pub const DEFAULT_GATHER_PHOTONS: usize = 100;
 /// Final-gather rays per vertex unless told otherwise.
-pub const DEFAULT_FINAL_GATHER: usize = 256;
+pub const DEFAULT_FINAL_GATHER: usize = 1024;
 /// Most photons a solve may emit: each stores about two landings of 72 bytes.
 pub const MAX_PHOTONS: usize = 200_000_000;
 /// Most photons an estimate may gather.
@@ -75,8 +79,11 @@ pub struct PhotonStats {
     pub emitted: usize,
     /// Photons stored: landings after at least one reflection.
     pub stored: usize,
-    /// Bytes the map holds: positions, powers and the trees.
+    /// Bytes the map holds: positions, powers, precomputed estimates and the trees.
     pub bytes: usize,
+    /// Irradiance estimates made in advance at stored photons, which the final gather reads
+    /// (none without a final gather).
+    pub precomputed: usize,
     /// The power of the photons that reached no surface's front (they left the scene or met a
     /// back), W per channel: the photons' own tally of what the scene loses.
     pub escaped: Rgb,
@@ -100,6 +107,40 @@ struct SurfacePhotons {
     power: Vec<Rgb>,
     /// The surface's polygon in its frame, for the disc's area.
     polygon: Vec<DVec2>,
+    /// Where estimates may be made in advance for a final gather: every
+    /// [`PRECOMPUTE_EVERY`]th photon's position (none without a final gather).
+    sites: Vec<[f64; 3]>,
+    /// Estimates made in advance at the sites, for the final gather.
+    precomputed: Option<Precomputed>,
+}
+
+/// Irradiance estimated in advance at a share of a surface's photons: the final gather reads
+/// the nearest of them, one neighbour, instead of gathering k photons at every ray's end.
+struct Precomputed {
+    tree: ImmutableKdTree<f64, 3>,
+    irradiance: Vec<Rgb>,
+}
+
+impl SurfacePhotons {
+    /// The irradiance at `x` (on the surface, whose frame is `frame`) from the `k` nearest
+    /// photons, over the part of the surface the disc through the farthest of them covers.
+    fn estimate(&self, frame: &PlaneFrame, x: DVec3, k: NonZero<usize>) -> Rgb {
+        let nearest = self
+            .tree
+            .query(&x.to_array())
+            .nearest_n::<SquaredEuclidean<f64>>(k)
+            .execute();
+        let Some(radius_squared) = nearest.iter().map(|n| n.distance).reduce(f64::max) else {
+            return Rgb::ZERO;
+        };
+        let centre = frame.to_2d(x);
+        let area = disc::area_in_polygon(centre, radius_squared.sqrt(), &self.polygon);
+        if !(area > 0.0) {
+            return Rgb::ZERO;
+        }
+        let power: Rgb = nearest.iter().map(|n| self.power[n.item as usize]).sum();
+        power * (1.0 / area)
+    }
 }
 
 /// The indirect photons of a scene, surface by surface.
@@ -177,6 +218,61 @@ impl<'a> PhotonMap<'a> {
         Ok(map)
     }
 
+    /// For a final gather that will read the map `lookups` times: estimates the irradiance at
+    /// the sites, surface by surface, for [`PhotonMap::gathered_irradiance`], unless there are
+    /// as many sites as lookups (then each lookup gathers its own photons).
+    pub(crate) fn precompute(
+        &mut self,
+        lookups: usize,
+        interrupt: Option<&Interrupt>,
+        progress: &dyn Progress,
+    ) -> Result<(), SolveError> {
+        let mut sites: Vec<Vec<[f64; 3]>> = self
+            .surfaces
+            .iter_mut()
+            .map(|p| {
+                p.as_mut()
+                    .map(|p| std::mem::take(&mut p.sites))
+                    .unwrap_or_default()
+            })
+            .collect();
+        let total = sites.iter().map(Vec::len).sum::<usize>();
+        if total >= lookups {
+            sites.clear();
+        }
+        let k = NonZero::new(self.gather).unwrap_or(NonZero::<usize>::MIN);
+        progress.start("irradiance at photons", total as u64);
+        let mut done = 0;
+        for (s, sites) in sites.into_iter().enumerate() {
+            let (Some(Some(photons)), Some(Some(frame))) =
+                (self.surfaces.get_mut(s), self.frames.get(s))
+            else {
+                continue;
+            };
+            let mut irradiance = Vec::with_capacity(sites.len());
+            for chunk in sites.chunks(CHUNK) {
+                if interrupt.is_some_and(Interrupt::is_set) {
+                    return Err(SolveError::Interrupted);
+                }
+                let values: Vec<Rgb> = chunk
+                    .par_iter()
+                    .map(|&p| photons.estimate(frame, DVec3::from_array(p), k))
+                    .collect();
+                irradiance.extend(values);
+                done += chunk.len();
+                progress.set(done as u64);
+            }
+            let Ok(tree) = ImmutableKdTree::new_from_slice(&sites) else {
+                continue;
+            };
+            self.stats.precomputed += sites.len();
+            self.stats.bytes += sites.len() * (3 * 8 + size_of::<Rgb>() + 3 * 8);
+            photons.precomputed = Some(Precomputed { tree, irradiance });
+        }
+        progress.finish();
+        Ok(())
+    }
+
     /// The map of `landings`, sorted by surface in the order they came.
     fn store(
         scene: &'a Scene,
@@ -199,6 +295,10 @@ impl<'a> PhotonMap<'a> {
                 let points: Vec<[f64; 3]> = photons.iter().map(|l| l.point.to_array()).collect();
                 let tree = ImmutableKdTree::new_from_slice(&points).ok()?;
                 bytes += points.len() * (3 * 8 + size_of::<Rgb>() + 3 * 8);
+                let sites = match options.final_gather {
+                    0 => Vec::new(),
+                    _ => points.iter().step_by(PRECOMPUTE_EVERY).copied().collect(),
+                };
                 Some(SurfacePhotons {
                     tree,
                     power: photons.iter().map(|l| l.power).collect(),
@@ -207,6 +307,8 @@ impl<'a> PhotonMap<'a> {
                         .iter()
                         .map(|&p| frame.to_2d(p))
                         .collect(),
+                    sites,
+                    precomputed: None,
                 })
             })
             .collect();
@@ -233,22 +335,30 @@ impl<'a> PhotonMap<'a> {
         else {
             return Rgb::ZERO;
         };
-        let k = NonZero::new(self.gather).unwrap_or(NonZero::<usize>::MIN);
-        let nearest = photons
+        photons.estimate(
+            frame,
+            x,
+            NonZero::new(self.gather).unwrap_or(NonZero::<usize>::MIN),
+        )
+    }
+
+    /// The indirect irradiance at `x` on surface `s` as the final gather reads it: the estimate
+    /// made in advance at the nearest of the surface's photons that have one, else
+    /// [`PhotonMap::indirect_irradiance`] at `x`.
+    fn gathered_irradiance(&self, x: DVec3, s: SurfaceId) -> Rgb {
+        let Some(Some(SurfacePhotons {
+            precomputed: Some(precomputed),
+            ..
+        })) = self.surfaces.get(s)
+        else {
+            return self.indirect_irradiance(x, s);
+        };
+        let nearest = precomputed
             .tree
             .query(&x.to_array())
-            .nearest_n::<SquaredEuclidean<f64>>(k)
+            .nearest_one::<SquaredEuclidean<f64>>()
             .execute();
-        let Some(radius_squared) = nearest.iter().map(|n| n.distance).reduce(f64::max) else {
-            return Rgb::ZERO;
-        };
-        let centre = frame.to_2d(x);
-        let area = disc::area_in_polygon(centre, radius_squared.sqrt(), &photons.polygon);
-        if !(area > 0.0) {
-            return Rgb::ZERO;
-        }
-        let power: Rgb = nearest.iter().map(|n| photons.power[n.item as usize]).sum();
-        power * (1.0 / area)
+        precomputed.irradiance[nearest.item as usize]
     }
 }
 

@@ -44,6 +44,8 @@ pub fn solve_photon_map(
     )?;
     let estimating = Instant::now();
     let (indirect, stop) = if photons.final_gather > 0 {
+        let lookups = disc.receiver_count().saturating_mul(photons.final_gather);
+        map.precompute(lookups, options.interrupt.as_ref(), progress)?;
         let gather = FinalGather::new(scene, mesh, visibility, &map, disc.per_surface(&direct));
         gather_all(&gather, &disc, options, photons.final_gather, progress)
     } else {
@@ -216,7 +218,7 @@ impl<'a> FinalGather<'a> {
             return Rgb::ZERO;
         };
         let direct = locator.interpolate(&self.mesh.surfaces[*m], &self.direct[*m], y);
-        let h = direct + self.map.indirect_irradiance(y, t);
+        let h = direct + self.map.gathered_irradiance(y, t);
         self.scene.surfaces[t].reflectance.mul_rgb(h)
     }
 }
