@@ -227,7 +227,7 @@ impl<'a> PhotonMap<'a> {
         interrupt: Option<&Interrupt>,
         progress: &dyn Progress,
     ) -> Result<(), SolveError> {
-        let mut sites: Vec<Vec<[f64; 3]>> = self
+        let sites: Vec<Vec<[f64; 3]>> = self
             .surfaces
             .iter_mut()
             .map(|p| {
@@ -238,12 +238,15 @@ impl<'a> PhotonMap<'a> {
             .collect();
         let total = sites.iter().map(Vec::len).sum::<usize>();
         if total >= lookups {
-            sites.clear();
+            return Ok(());
         }
         let k = NonZero::new(self.gather).unwrap_or(NonZero::<usize>::MIN);
         progress.start("irradiance at photons", total as u64);
         let mut done = 0;
         for (s, sites) in sites.into_iter().enumerate() {
+            if sites.is_empty() {
+                continue;
+            }
             let (Some(Some(photons)), Some(Some(frame))) =
                 (self.surfaces.get_mut(s), self.frames.get(s))
             else {
@@ -265,6 +268,7 @@ impl<'a> PhotonMap<'a> {
             let Ok(tree) = ImmutableKdTree::new_from_slice(&sites) else {
                 continue;
             };
+
             self.stats.precomputed += sites.len();
             self.stats.bytes += sites.len() * (3 * 8 + size_of::<Rgb>() + 3 * 8);
             photons.precomputed = Some(Precomputed { tree, irradiance });
@@ -358,7 +362,11 @@ impl<'a> PhotonMap<'a> {
             .query(&x.to_array())
             .nearest_one::<SquaredEuclidean<f64>>()
             .execute();
-        precomputed.irradiance[nearest.item as usize]
+        precomputed
+            .irradiance
+            .get(nearest.item as usize)
+            .copied()
+            .unwrap_or(Rgb::ZERO)
     }
 }
 
