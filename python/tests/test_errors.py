@@ -40,6 +40,9 @@ BAD_RUNS = [
     (dict(max_elements=3), ValueError, "max_elements"),  # below the scene's least mesh
     (dict(solver="jacobi", refine_tol=0.01), ValueError, "solver"),
     (dict(epsilon=0.0), ValueError, "epsilon"),
+    (dict(solver="photon-map", photons=0), ValueError, "photons"),
+    (dict(solver="photon-map", gather_photons=0), ValueError, "gather_photons"),
+    (dict(solver="photon-map", final_gather=-1), ValueError, "final_gather"),
 ]
 
 

@@ -24,6 +24,9 @@ SAME_RUNS = [
      dict(solver="progressive", refine_tol=0.01, max_elements=4000)),
     ("bars", ["--solver", "gauss-seidel", "--max-elements", "2500", "--events", "extremal"],
      dict(solver="gauss-seidel", max_elements=2500, events="extremal")),
+    ("cornell", ["--solver", "photon-map", "--max-elements", "2000", "--photons", "50000",
+                 "--gather-photons", "40", "--final-gather", "64"],
+     dict(solver="photon-map", max_elements=2000, photons=50000, gather_photons=40, final_gather=64)),
 ]
 
 
