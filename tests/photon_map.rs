@@ -71,6 +71,8 @@ fn the_textbook_is_its_direct_light() {
     }
 }
 
+/// Tracing, the estimates made in advance and the final gather give the same `solution.json`
+/// on 1 and 2 threads.
 #[test]
 fn photon_maps_are_the_same_bytes_on_one_and_two_threads() {
     let dir = tempfile::tempdir().expect("temp dir");
@@ -82,7 +84,7 @@ fn photon_maps_are_the_same_bytes_on_one_and_two_threads() {
         "--photons",
         "30000",
         "--final-gather",
-        "9",
+        "25",
         "--export",
         "none",
     ];
@@ -95,11 +97,48 @@ fn photon_maps_are_the_same_bytes_on_one_and_two_threads() {
             &[&options[..], &["--threads", threads]].concat(),
         );
         solutions.push(std::fs::read(out.join("solution.json")).expect("written"));
+        // The gather reads estimates made in advance, made in parallel too.
+        let report = json(&out.join("report.json"));
+        assert!(report["solver"]["photon_map"]["precomputed"].as_u64() > Some(0));
     }
     assert!(
         solutions[0] == solutions[1],
         "solution.json differs with the thread count"
     );
+}
+
+/// A spent `--time-budget` stops the estimates made in advance and the final gather, and says
+/// so; every vertex keeps the map's raw estimate, finite and not negative.
+#[test]
+fn a_spent_time_budget_stops_the_gather() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("out");
+    run_quietly(
+        "cornell",
+        &out,
+        &[
+            "--solver",
+            "photon-map",
+            "--time-budget",
+            "0.3",
+            "--export",
+            "none",
+        ],
+    );
+    let report = json(&out.join("report.json"));
+    assert_eq!(report["solver"]["stop"], "time_budget");
+    let solution = json(&out.join("solution.json"));
+    let mut values = 0;
+    for surface in solution["surfaces"].as_array().expect("surfaces") {
+        for b in surface["radiosity"].as_array().expect("radiosity") {
+            for c in b.as_array().expect("rgb") {
+                let c = c.as_f64().expect("a number");
+                assert!(c.is_finite() && c >= 0.0, "{c}");
+                values += 1;
+            }
+        }
+    }
+    assert!(values > 1000);
 }
 
 #[test]

@@ -220,13 +220,14 @@ impl<'a> PhotonMap<'a> {
 
     /// For a final gather that will read the map `lookups` times: estimates the irradiance at
     /// the sites, surface by surface, for [`PhotonMap::gathered_irradiance`], unless there are
-    /// as many sites as lookups (then each lookup gathers its own photons).
+    /// as many sites as lookups (then each lookup gathers its own photons). Once `stop` says so
+    /// (an interrupt, the time budget) it leaves the surfaces not yet done without estimates.
     pub(crate) fn precompute(
         &mut self,
         lookups: usize,
-        interrupt: Option<&Interrupt>,
+        stop: &(dyn Fn() -> bool + Sync),
         progress: &dyn Progress,
-    ) -> Result<(), SolveError> {
+    ) {
         let sites: Vec<Vec<[f64; 3]>> = self
             .surfaces
             .iter_mut()
@@ -238,7 +239,7 @@ impl<'a> PhotonMap<'a> {
             .collect();
         let total = sites.iter().map(Vec::len).sum::<usize>();
         if total >= lookups {
-            return Ok(());
+            return;
         }
         let k = NonZero::new(self.gather).unwrap_or(NonZero::<usize>::MIN);
         progress.start("irradiance at photons", total as u64);
@@ -254,8 +255,9 @@ impl<'a> PhotonMap<'a> {
             };
             let mut irradiance = Vec::with_capacity(sites.len());
             for chunk in sites.chunks(CHUNK) {
-                if interrupt.is_some_and(Interrupt::is_set) {
-                    return Err(SolveError::Interrupted);
+                if stop() {
+                    progress.finish();
+                    return;
                 }
                 let values: Vec<Rgb> = chunk
                     .par_iter()
@@ -274,7 +276,6 @@ impl<'a> PhotonMap<'a> {
             photons.precomputed = Some(Precomputed { tree, irradiance });
         }
         progress.finish();
-        Ok(())
     }
 
     /// The map of `landings`, sorted by surface in the order they came.

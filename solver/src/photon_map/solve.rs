@@ -45,7 +45,7 @@ pub fn solve_photon_map(
     let estimating = Instant::now();
     let (indirect, stop) = if photons.final_gather > 0 {
         let lookups = disc.receiver_count().saturating_mul(photons.final_gather);
-        map.precompute(lookups, options.interrupt.as_ref(), progress)?;
+        map.precompute(lookups, &|| options.stop_now().is_some(), progress);
         let gather = FinalGather::new(scene, mesh, visibility, &map, disc.per_surface(&direct));
         gather_all(&gather, &disc, options, photons.final_gather, progress)
     } else {

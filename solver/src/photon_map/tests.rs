@@ -94,8 +94,7 @@ fn precomputed_estimates_have_the_closed_form() {
     };
     let mut map = PhotonMap::trace(&scene, &visibility, &options, 3, None, &crate::NoProgress)
         .expect("traced");
-    map.precompute(usize::MAX, None, &crate::NoProgress)
-        .expect("precomputed");
+    map.precompute(usize::MAX, &|| false, &crate::NoProgress);
     let stored = map.stats.stored;
     assert!(
         map.stats.precomputed >= stored / 4 && map.stats.precomputed <= stored / 4 + 6,
@@ -122,8 +121,7 @@ fn precomputed_estimates_have_the_closed_form() {
     // A gather that reads the map less often than there are sites gathers at each reading.
     let mut map = PhotonMap::trace(&scene, &visibility, &options, 3, None, &crate::NoProgress)
         .expect("traced");
-    map.precompute(1000, None, &crate::NoProgress)
-        .expect("skipped");
+    map.precompute(1000, &|| false, &crate::NoProgress);
     assert_eq!(map.stats.precomputed, 0);
 }
 
@@ -197,7 +195,8 @@ fn nothing_reflected_comes_back_in_the_textbook() {
     }
 }
 
-/// The same photons and the same estimates on 1 and 2 threads.
+/// The same photons, the same estimates and the same estimates made in advance on 1 and 2
+/// threads.
 #[test]
 fn the_map_does_not_depend_on_the_thread_count() {
     let scene = builtin::cornell();
@@ -205,7 +204,7 @@ fn the_map_does_not_depend_on_the_thread_count() {
     let options = PhotonMapOptions {
         photons: 30_000,
         gather_photons: 50,
-        final_gather: 0,
+        final_gather: 1,
     };
     let points = points_on(&scene, 3);
     let estimates = |threads: usize| {
@@ -214,18 +213,21 @@ fn the_map_does_not_depend_on_the_thread_count() {
             .build()
             .expect("a pool");
         pool.install(|| {
-            let map = PhotonMap::trace(&scene, &visibility, &options, 1, None, &crate::NoProgress)
-                .expect("traced");
-            let values: Vec<Rgb> = points
+            let mut map =
+                PhotonMap::trace(&scene, &visibility, &options, 1, None, &crate::NoProgress)
+                    .expect("traced");
+            map.precompute(usize::MAX, &|| false, &crate::NoProgress);
+            let values: Vec<(Rgb, Rgb)> = points
                 .iter()
-                .map(|&(x, s)| map.indirect_irradiance(x, s))
+                .map(|&(x, s)| (map.indirect_irradiance(x, s), map.gathered_irradiance(x, s)))
                 .collect();
             (map.stats.clone(), values)
         })
     };
     let (one, two) = (estimates(1), estimates(2));
     assert!(one.0.stored > 0);
-    let counts = |s: &PhotonStats| (s.emitted, s.stored, s.bytes, s.escaped);
+    assert!(one.0.precomputed > 0);
+    let counts = |s: &PhotonStats| (s.emitted, s.stored, s.bytes, s.precomputed, s.escaped);
     assert_eq!(counts(&one.0), counts(&two.0));
     assert!(
         one.1.iter().zip(&two.1).all(|(a, b)| a == b),
