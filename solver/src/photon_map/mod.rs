@@ -105,8 +105,9 @@ struct Landing {
 struct SurfacePhotons {
     tree: ImmutableKdTree<f64, 3>,
     power: Vec<Rgb>,
-    /// The surface's polygon in its frame, for the disc's area.
+    /// The surface's polygon in its frame, for the disc's area, and its area.
     polygon: Vec<DVec2>,
+    area: f64,
     /// Where estimates may be made in advance for a final gather: every
     /// [`PRECOMPUTE_EVERY`]th photon's position (none without a final gather).
     sites: Vec<[f64; 3]>,
@@ -123,7 +124,9 @@ struct Precomputed {
 
 impl SurfacePhotons {
     /// The irradiance at `x` (on the surface, whose frame is `frame`) from the `k` nearest
-    /// photons, over the part of the surface the disc through the farthest of them covers.
+    /// photons, over the part of the surface the disc through the farthest of them covers; when
+    /// the surface holds fewer than `k`, all of them over all of it (a disc fitted to a few
+    /// photons that landed close together would make a spike).
     fn estimate(&self, frame: &PlaneFrame, x: DVec3, k: NonZero<usize>) -> Rgb {
         let nearest = self
             .tree
@@ -133,8 +136,10 @@ impl SurfacePhotons {
         let Some(radius_squared) = nearest.iter().map(|n| n.distance).reduce(f64::max) else {
             return Rgb::ZERO;
         };
-        let centre = frame.to_2d(x);
-        let area = disc::area_in_polygon(centre, radius_squared.sqrt(), &self.polygon);
+        let area = match nearest.len() < k.get() {
+            true => self.area,
+            false => disc::area_in_polygon(frame.to_2d(x), radius_squared.sqrt(), &self.polygon),
+        };
         if !(area > 0.0) {
             return Rgb::ZERO;
         }
@@ -300,6 +305,11 @@ impl<'a> PhotonMap<'a> {
                 let points: Vec<[f64; 3]> = photons.iter().map(|l| l.point.to_array()).collect();
                 let tree = ImmutableKdTree::new_from_slice(&points).ok()?;
                 bytes += points.len() * (3 * 8 + size_of::<Rgb>() + 3 * 8);
+                let polygon: Vec<DVec2> = scene.surfaces[s]
+                    .polygon
+                    .iter()
+                    .map(|&p| frame.to_2d(p))
+                    .collect();
                 let sites = match options.final_gather {
                     0 => Vec::new(),
                     _ => points.iter().step_by(PRECOMPUTE_EVERY).copied().collect(),
@@ -307,11 +317,8 @@ impl<'a> PhotonMap<'a> {
                 Some(SurfacePhotons {
                     tree,
                     power: photons.iter().map(|l| l.power).collect(),
-                    polygon: scene.surfaces[s]
-                        .polygon
-                        .iter()
-                        .map(|&p| frame.to_2d(p))
-                        .collect(),
+                    area: penumbra_scenes::polygon::signed_area_2d(&polygon).abs(),
+                    polygon,
                     sites,
                     precomputed: None,
                 })

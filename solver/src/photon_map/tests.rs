@@ -80,6 +80,36 @@ fn the_furnace_has_the_closed_form_indirect_light() {
     }
 }
 
+/// A surface holding fewer photons than an estimate gathers gives their power over its whole
+/// area, wherever it is read: two photons that landed a hair apart on a unit square give 2 W
+/// over 1 m², not 2 W over the disc between them (which k = 2 does find, as it should).
+#[test]
+fn a_surface_with_few_photons_spreads_them_over_its_area() {
+    let square = [
+        DVec3::new(0.0, 0.0, 0.0),
+        DVec3::new(1.0, 0.0, 0.0),
+        DVec3::new(1.0, 1.0, 0.0),
+        DVec3::new(0.0, 1.0, 0.0),
+    ];
+    let frame = PlaneFrame::of_polygon(&square).expect("a plane");
+    let points = [[0.5, 0.5, 0.0], [0.5001, 0.5, 0.0]];
+    let photons = SurfacePhotons {
+        tree: ImmutableKdTree::new_from_slice(&points).expect("a tree"),
+        power: vec![Rgb::splat(1.0); 2],
+        polygon: square.iter().map(|&p| frame.to_2d(p)).collect(),
+        area: 1.0,
+        sites: Vec::new(),
+        precomputed: None,
+    };
+    let k = |n: usize| NonZero::new(n).expect("positive");
+    for x in [DVec3::new(0.5, 0.5, 0.0), DVec3::new(0.05, 0.9, 0.0)] {
+        let h = photons.estimate(&frame, x, k(100));
+        assert!((h.r - 2.0).abs() < 1e-12, "{h:?} at {x}");
+    }
+    let spike = photons.estimate(&frame, DVec3::new(0.5, 0.5, 0.0), k(2)).r;
+    assert!(spike > 1e7, "{spike}");
+}
+
 /// The estimates a final gather reads, made in advance at every fourth photon and read at the
 /// nearest, are as unbiased in the furnace as those made where they are read.
 #[test]
