@@ -128,7 +128,14 @@ pub fn estimate(scene: &Scene, options: &RunOptions, counts: MeshCounts) -> Memo
             }
             // About two landings per photon, each a position, a power and its tree's share, and
             // for a final gather an estimate made in advance at every fourth.
-            (SolverMethod::PhotonMap, _) => (solver.photon_map.photons as u64).saturating_mul(180),
+            (SolverMethod::PhotonMap, _) => {
+                let per_photon = if solver.photon_map.final_gather > 0 {
+                    180
+                } else {
+                    144
+                };
+                (solver.photon_map.photons as u64).saturating_mul(per_photon)
+            }
             // K per channel, plus its copy under elimination.
             (SolverMethod::Direct, _) => columns(p).saturating_add(matrix.saturating_mul(4)),
             _ => columns(p).saturating_add(matrix.saturating_mul(3)),

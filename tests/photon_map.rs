@@ -127,6 +127,8 @@ fn a_spent_time_budget_stops_the_gather() {
     );
     let report = json(&out.join("report.json"));
     assert_eq!(report["solver"]["stop"], "time_budget");
+    assert_eq!(report["solver"]["photon_map"]["precomputed"], 0);
+    assert_eq!(report["solver"]["gathered"], 0);
     let solution = json(&out.join("solution.json"));
     let mut values = 0;
     for surface in solution["surfaces"].as_array().expect("surfaces") {
@@ -251,17 +253,49 @@ fn sweeps_take_photons_as_the_photon_maps_budget() {
     assert!(time.contains("discontinuity (photon-map, 0 rays)"));
     let elements = std::fs::read_to_string(out.join("error-vs-elements.svg")).expect("svg");
     assert!(!elements.contains("photon-map") && elements.contains("hierarchical"));
-    // A photon budget of 0 is refused, naming the flag, before anything is traced.
+    // Bad photon options are refused naming their flag, before a reference is traced.
+    let fresh = dir.path().join("refused");
+    for (flag, value, methods) in [
+        ("--photons", "1000,0", "discontinuity"),
+        ("--final-gather", "0,70000", "discontinuity"),
+        ("--photon-elements", "0", "discontinuity"),
+        ("--solvers", "photon-map", "uniform+adaptive"),
+    ] {
+        let o = penumbra(&[
+            "sweep",
+            "cornell",
+            "--solvers",
+            "photon-map",
+            "--methods",
+            methods,
+            flag,
+            value,
+            "--out",
+            fresh.to_str().expect("utf-8"),
+        ]);
+        assert_eq!(o.status.code(), Some(2), "{flag} {value}");
+        assert!(stderr(&o).contains(flag), "{flag}: {}", stderr(&o));
+        assert!(!fresh.join("reference.json").exists(), "{flag}: traced");
+    }
+    // A mesh budget too small for the scene is told as --photon-elements.
     let o = penumbra(&[
         "sweep",
         "cornell",
+        "--budgets",
+        "700",
+        "--samples",
+        "20",
+        "--reference-paths",
+        "16",
+        "--methods",
+        "discontinuity",
         "--solvers",
         "photon-map",
-        "--photons",
-        "1000,0",
+        "--photon-elements",
+        "50",
         "--out",
-        out.to_str().expect("utf-8"),
+        fresh.to_str().expect("utf-8"),
     ]);
     assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("--photons"), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--photon-elements 50 is too small"), "{}", stderr(&o));
 }

@@ -174,6 +174,11 @@ impl SweepOptions {
         if self.final_gathers.is_empty() {
             return bad("final gather", "give at least one count of rays".into());
         }
+        for &rays in &self.final_gathers {
+            let mut solver = self.solver.clone();
+            solver.photon_map.final_gather = rays;
+            solver.validate()?;
+        }
         if self.photons.is_empty() || self.photons.iter().any(|&p| p == 0 || p > MAX_PHOTONS) {
             return bad(
                 "photons",
@@ -181,6 +186,14 @@ impl SweepOptions {
             );
         }
         self.solver.validate()?;
+        if jobs(self).is_empty() {
+            return bad(
+                "solver",
+                "photon mapping runs only on meshes that are not refined: add a method without \
+                 +adaptive"
+                    .into(),
+            );
+        }
         Ok(())
     }
 }

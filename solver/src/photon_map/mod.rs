@@ -36,11 +36,13 @@ const CHUNK: usize = 4096;
 /// For a final gather, irradiance is estimated in advance at every this many stored photons
 /// (Christensen 1999: a quarter).
 const PRECOMPUTE_EVERY: usize = 4;
+/// Bytes an estimate made in advance holds: its site, its value and its tree's share.
+const PRECOMPUTED_BYTES: usize = 3 * 8 + size_of::<Rgb>() + 3 * 8;
 
 /// Photons a solve emits unless told otherwise. With the defaults below the Cornell box is
-/// within 1.5 % RMS of the path-traced reference (`penumbra sweep cornell --solvers photon-map
-/// --methods discontinuity --photons 1000000`: 1.48 % at 10,000 triangles in 5.4 s); its error
-/// is then the mesh's and the final gather's, not the photons'.
+/// within 1.5 % RMS of the path-traced reference at 10,000 triangles (the README's side-by-side
+/// table, `scripts/regen-docs --only methods`); its error is then the mesh's and the final
+/// gather's, not the photons'.
 pub const DEFAULT_PHOTONS: usize = 1_000_000;
 /// Photons an irradiance estimate gathers unless told otherwise.
 pub const DEFAULT_GATHER_PHOTONS: usize = 100;
@@ -225,8 +227,8 @@ impl<'a> PhotonMap<'a> {
 
     /// For a final gather that will read the map `lookups` times: estimates the irradiance at
     /// the sites, surface by surface, for [`PhotonMap::gathered_irradiance`], unless there are
-    /// as many sites as lookups (then each lookup gathers its own photons). Once `stop` says so
-    /// (an interrupt, the time budget) it leaves the surfaces not yet done without estimates.
+    /// at least as many sites as lookups (then each lookup gathers its own photons). Once `stop`
+    /// says so (an interrupt, the time budget), the gather will not run, and it keeps none.
     pub(crate) fn precompute(
         &mut self,
         lookups: usize,
@@ -261,6 +263,12 @@ impl<'a> PhotonMap<'a> {
             let mut irradiance = Vec::with_capacity(sites.len());
             for chunk in sites.chunks(CHUNK) {
                 if stop() {
+                    // The gather will not run: no estimate made in advance is read.
+                    for photons in self.surfaces.iter_mut().flatten() {
+                        photons.precomputed = None;
+                    }
+                    self.stats.bytes -= self.stats.precomputed * PRECOMPUTED_BYTES;
+                    self.stats.precomputed = 0;
                     progress.finish();
                     return;
                 }
@@ -277,7 +285,7 @@ impl<'a> PhotonMap<'a> {
             };
 
             self.stats.precomputed += sites.len();
-            self.stats.bytes += sites.len() * (3 * 8 + size_of::<Rgb>() + 3 * 8);
+            self.stats.bytes += sites.len() * PRECOMPUTED_BYTES;
             photons.precomputed = Some(Precomputed { tree, irradiance });
         }
         progress.finish();
@@ -370,11 +378,8 @@ impl<'a> PhotonMap<'a> {
             .query(&x.to_array())
             .nearest_one::<SquaredEuclidean<f64>>()
             .execute();
-        precomputed
-            .irradiance
-            .get(nearest.item as usize)
-            .copied()
-            .unwrap_or(Rgb::ZERO)
+        // The tree holds the sites the estimates were made at, in their order.
+        precomputed.irradiance[nearest.item as usize]
     }
 }
 

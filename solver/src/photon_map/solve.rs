@@ -43,7 +43,7 @@ pub fn solve_photon_map(
         progress,
     )?;
     let estimating = Instant::now();
-    let (indirect, stop) = if photons.final_gather > 0 {
+    let (indirect, stop, gathered) = if photons.final_gather > 0 {
         let lookups = disc.receiver_count().saturating_mul(photons.final_gather);
         map.precompute(lookups, &|| options.stop_now().is_some(), progress);
         let gather = FinalGather::new(scene, mesh, visibility, &map, disc.per_surface(&direct));
@@ -54,12 +54,14 @@ pub fn solve_photon_map(
             raw.map(|(r, &s)| map.indirect_irradiance(r.point, s))
                 .collect(),
             None,
+            0,
         )
     };
     map.stats.estimate_seconds = estimating.elapsed().as_secs_f64();
     let irradiance: Vec<Rgb> = direct.iter().zip(&indirect).map(|(&d, &i)| d + i).collect();
     let mut stats = energy_stats(scene, &disc, &irradiance);
     stats.stop = stop.unwrap_or(StopReason::Converged);
+    stats.gathered = gathered;
     stats.direct_seconds = direct_seconds;
     stats.direct_beyond_cap = direct_beyond_cap;
     stats.gather_seconds = started.elapsed().as_secs_f64();
@@ -106,21 +108,25 @@ fn energy_stats(scene: &Scene, disc: &Discretization, irradiance: &[Rgb]) -> Sol
 const GATHER_CHUNK: usize = 512;
 
 /// The final gather at every vertex, chunk by chunk; once the run must stop (an interrupt, the
-/// time budget), the vertices left read the map where they are, and the reason is returned.
+/// time budget), the vertices left read the map where they are. With the reason it stopped, if
+/// it did, and the vertices that gathered.
 fn gather_all(
     gather: &FinalGather<'_>,
     disc: &Discretization,
     options: &SolverOptions,
     rays: usize,
     progress: &dyn Progress,
-) -> (Vec<Rgb>, Option<StopReason>) {
+) -> (Vec<Rgb>, Option<StopReason>, usize) {
     let n = disc.receiver_count();
     let mut values = Vec::with_capacity(n);
-    let mut stop = None;
+    let (mut stop, mut gathered) = (None, 0);
     progress.start("final gather", n as u64);
     while values.len() < n {
         let range = values.len()..(values.len() + GATHER_CHUNK).min(n);
         stop = stop.or_else(|| options.stop_now());
+        if stop.is_none() {
+            gathered = range.end;
+        }
         let chunk: Vec<Rgb> = range
             .into_par_iter()
             .map(|i| {
@@ -136,7 +142,7 @@ fn gather_all(
         progress.set(values.len() as u64);
     }
     progress.finish();
-    (values, stop)
+    (values, stop, gathered)
 }
 
 /// Keys the final gather's random streams apart from the photons' (keyed by their index alone).

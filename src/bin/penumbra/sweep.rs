@@ -176,7 +176,9 @@ pub(crate) fn sweep(args: &SweepArgs) -> Result<(), Failure> {
     let bars = Bars::new(args.quiet);
     let result =
         penumbra::experiments::sweep::sweep(&loaded, &options, &samples, &reference, &bars)
-            .map_err(|e| run_failure(e, Command::Sweep))?;
+            .map_err(|e| {
+                photon_budget_failure(&e, args).unwrap_or_else(|| run_failure(e, Command::Sweep))
+            })?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
     let csv = penumbra::experiments::sweep::sweep_csv(&result);
@@ -297,4 +299,22 @@ fn traced_reference(
     };
     penumbra::outputs::write_atomic(&path, serde_json::to_string(&cached)?.as_bytes())?;
     Ok(cached.values)
+}
+
+/// A photon-map mesh budget too small for the scene, told as `--photon-elements`.
+fn photon_budget_failure(e: &penumbra::RunError, args: &SweepArgs) -> Option<Failure> {
+    let penumbra::RunError::Mesh(penumbra_meshing::MeshError::BudgetTooSmall {
+        max_elements,
+        needed,
+        ..
+    }) = e
+    else {
+        return None;
+    };
+    (*max_elements == args.photon_elements && !args.budgets.contains(max_elements)).then(|| {
+        usage(anyhow::anyhow!(
+            "--photon-elements {max_elements} is too small: the scene needs at least {needed} \
+             triangles; use --photon-elements {needed} or more"
+        ))
+    })
 }
