@@ -297,5 +297,9 @@ fn sweeps_take_photons_as_the_photon_maps_budget() {
         fresh.to_str().expect("utf-8"),
     ]);
     assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("--photon-elements 50 is too small"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("--photon-elements 50 is too small"),
+        "{}",
+        stderr(&o)
+    );
 }
