@@ -180,7 +180,8 @@ fn bad_photon_options_are_refused() {
 }
 
 /// `penumbra sweep --solvers photon-map` runs photon mapping at each photon budget, on one mesh,
-/// a line per final gather; the other solvers keep their element budgets. Photon-map lines
+/// a line per final gather (a value given twice runs once); the other solvers keep their element
+/// budgets. Photon-map lines
 /// appear against time, not against triangles (their triangles do not change).
 #[test]
 fn sweeps_take_photons_as_the_photon_maps_budget() {
@@ -202,7 +203,7 @@ fn sweeps_take_photons_as_the_photon_maps_budget() {
         "--photons",
         "20000,40000",
         "--final-gather",
-        "0,4",
+        "0,4,0",
         "--photon-elements",
         "900",
         "--out",

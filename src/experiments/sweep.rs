@@ -13,7 +13,6 @@ use penumbra_meshing::{DEFAULT_PENUMBRA_DENSITY, TriangleLocator};
 use penumbra_scenes::SplitMix64;
 use penumbra_scenes::{LoadedScene, Scene, SurfaceId, Visibility};
 use penumbra_solver::path_trace::ReferenceValue;
-use penumbra_solver::photon_map::MAX_PHOTONS;
 use penumbra_solver::{DirectLight, Progress, ReceivingPoint, SolverMethod, SolverOptions};
 use penumbra_viz::{LogLogChart, Series};
 use serde::Serialize;
@@ -168,22 +167,8 @@ impl SweepOptions {
                 ),
             );
         }
-        if self.photon_elements == 0 {
-            return bad("photon elements", "must be at least 1 triangle".into());
-        }
-        if self.final_gathers.is_empty() {
-            return bad("final gather", "give at least one count of rays".into());
-        }
-        for &rays in &self.final_gathers {
-            let mut solver = self.solver.clone();
-            solver.photon_map.final_gather = rays;
-            solver.validate()?;
-        }
-        if self.photons.is_empty() || self.photons.iter().any(|&p| p == 0 || p > MAX_PHOTONS) {
-            return bad(
-                "photons",
-                format!("every photon budget must be from 1 to {MAX_PHOTONS}"),
-            );
+        if !self.solver.direct_only && self.solvers.contains(&SolverMethod::PhotonMap) {
+            self.validate_photon_budgets()?;
         }
         self.solver.validate()?;
         if jobs(self).is_empty() {
@@ -193,6 +178,37 @@ impl SweepOptions {
                  +adaptive"
                     .into(),
             );
+        }
+        Ok(())
+    }
+}
+
+impl SweepOptions {
+    /// The photon-map runs' options: each photon budget and each final gather as a run takes it.
+    fn validate_photon_budgets(&self) -> Result<(), InvalidOption> {
+        let bad = |option, reason: &str| {
+            Err(InvalidOption {
+                option,
+                reason: reason.into(),
+            })
+        };
+        if self.photon_elements == 0 {
+            return bad("photon elements", "must be at least 1 triangle");
+        }
+        if self.photons.is_empty() {
+            return bad("photons", "give at least one photon budget");
+        }
+        if self.final_gathers.is_empty() {
+            return bad("final gather", "give at least one count of rays");
+        }
+        let mut solver = self.solver.clone();
+        for &photons in &self.photons {
+            solver.photon_map.photons = photons;
+            solver.validate()?;
+        }
+        for &rays in &self.final_gathers {
+            solver.photon_map.final_gather = rays;
+            solver.validate()?;
         }
         Ok(())
     }

@@ -125,8 +125,8 @@ pub(crate) fn sweep(args: &SweepArgs) -> Result<(), Failure> {
             ..SolverOptions::default()
         },
         solvers: args.solvers.iter().map(|&s| s.into()).collect(),
-        photons: args.photons.clone(),
-        final_gathers: args.final_gather.clone(),
+        photons: distinct(&args.photons),
+        final_gathers: distinct(&args.final_gather),
         photon_elements: args.photon_elements,
     };
     options
@@ -317,4 +317,15 @@ fn photon_budget_failure(e: &penumbra::RunError, args: &SweepArgs) -> Option<Fai
              triangles; use --photon-elements {needed} or more"
         ))
     })
+}
+
+/// `values` without repeats, in the order given.
+fn distinct(values: &[usize]) -> Vec<usize> {
+    let mut seen = Vec::new();
+    for &v in values {
+        if !seen.contains(&v) {
+            seen.push(v);
+        }
+    }
+    seen
 }
