@@ -181,9 +181,7 @@ impl SweepOptions {
         }
         Ok(())
     }
-}
 
-impl SweepOptions {
     /// The photon-map runs' options: each photon budget and each final gather as a run takes it.
     fn validate_photon_budgets(&self) -> Result<(), InvalidOption> {
         let bad = |option, reason: &str| {

@@ -36,8 +36,9 @@ const CHUNK: usize = 4096;
 /// For a final gather, irradiance is estimated in advance at every this many stored photons
 /// (Christensen 1999: a quarter).
 const PRECOMPUTE_EVERY: usize = 4;
-/// Bytes an estimate made in advance holds: its site, its value and its tree's share.
-const PRECOMPUTED_BYTES: usize = 3 * 8 + size_of::<Rgb>() + 3 * 8;
+/// Bytes a stored photon, or an estimate made in advance, holds: its position, its power or
+/// value, and its tree's share.
+const POINT_BYTES: usize = 3 * 8 + size_of::<Rgb>() + 3 * 8;
 
 /// Photons a solve emits unless told otherwise. With the defaults below the Cornell box is
 /// within 1.5 % RMS of the path-traced reference at 10,000 triangles (the README's side-by-side
@@ -250,25 +251,18 @@ impl<'a> PhotonMap<'a> {
         }
         let k = NonZero::new(self.gather).unwrap_or(NonZero::<usize>::MIN);
         progress.start("irradiance at photons", total as u64);
+        // Kept only once every surface is done: a gather that is stopped reads none.
+        let mut made = Vec::new();
         let mut done = 0;
         for (s, sites) in sites.into_iter().enumerate() {
-            if sites.is_empty() {
-                continue;
-            }
             let (Some(Some(photons)), Some(Some(frame))) =
-                (self.surfaces.get_mut(s), self.frames.get(s))
+                (self.surfaces.get(s), self.frames.get(s))
             else {
                 continue;
             };
             let mut irradiance = Vec::with_capacity(sites.len());
             for chunk in sites.chunks(CHUNK) {
                 if stop() {
-                    // The gather will not run: no estimate made in advance is read.
-                    for photons in self.surfaces.iter_mut().flatten() {
-                        photons.precomputed = None;
-                    }
-                    self.stats.bytes -= self.stats.precomputed * PRECOMPUTED_BYTES;
-                    self.stats.precomputed = 0;
                     progress.finish();
                     return;
                 }
@@ -280,15 +274,21 @@ impl<'a> PhotonMap<'a> {
                 done += chunk.len();
                 progress.set(done as u64);
             }
-            let Ok(tree) = ImmutableKdTree::new_from_slice(&sites) else {
-                continue;
-            };
-
-            self.stats.precomputed += sites.len();
-            self.stats.bytes += sites.len() * PRECOMPUTED_BYTES;
-            photons.precomputed = Some(Precomputed { tree, irradiance });
+            // An empty surface gives no tree: its readings gather their own photons.
+            if let Ok(tree) = ImmutableKdTree::new_from_slice(&sites)
+                && !sites.is_empty()
+            {
+                made.push((s, Precomputed { tree, irradiance }));
+            }
         }
         progress.finish();
+        for (s, precomputed) in made {
+            self.stats.precomputed += precomputed.irradiance.len();
+            self.stats.bytes += precomputed.irradiance.len() * POINT_BYTES;
+            if let Some(Some(photons)) = self.surfaces.get_mut(s) {
+                photons.precomputed = Some(precomputed);
+            }
+        }
     }
 
     /// The map of `landings`, sorted by surface in the order they came.
@@ -312,7 +312,7 @@ impl<'a> PhotonMap<'a> {
                 let frame = frames[s]?;
                 let points: Vec<[f64; 3]> = photons.iter().map(|l| l.point.to_array()).collect();
                 let tree = ImmutableKdTree::new_from_slice(&points).ok()?;
-                bytes += points.len() * (3 * 8 + size_of::<Rgb>() + 3 * 8);
+                bytes += points.len() * POINT_BYTES;
                 let polygon: Vec<DVec2> = scene.surfaces[s]
                     .polygon
                     .iter()

@@ -6,6 +6,35 @@ fn rms(errors: &[f64]) -> f64 {
     (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt()
 }
 
+/// The map of `scene` traced with `options` and `seed`.
+fn trace<'a>(
+    scene: &'a Scene,
+    visibility: &Visibility,
+    options: &PhotonMapOptions,
+    seed: u64,
+) -> PhotonMap<'a> {
+    PhotonMap::trace(scene, visibility, options, seed, None, &crate::NoProgress).expect("traced")
+}
+
+/// `mesh` of `scene` solved by photon mapping with `photons`, the other options the defaults.
+fn solve(
+    scene: &Scene,
+    visibility: &Visibility,
+    mesh: &penumbra_meshing::SceneMesh,
+    photons: &PhotonMapOptions,
+) -> (crate::Solution, PhotonStats) {
+    let options = crate::SolverOptions::default();
+    solve_photon_map(
+        scene,
+        mesh,
+        visibility,
+        &options,
+        photons,
+        &crate::NoProgress,
+    )
+    .expect("solved")
+}
+
 /// Points spread over every face of a scene, corners and edges included: a jittered grid in
 /// each surface's frame, kept where it falls inside the polygon.
 fn points_on(scene: &Scene, per_side: usize) -> Vec<(DVec3, SurfaceId)> {
@@ -49,8 +78,7 @@ fn the_furnace_has_the_closed_form_indirect_light() {
             gather_photons: 1000,
             final_gather: 0,
         };
-        let map = PhotonMap::trace(&scene, &visibility, &options, 1, None, &crate::NoProgress)
-            .expect("traced");
+        let map = trace(&scene, &visibility, &options, 1);
         assert_eq!(map.stats.emitted, photons);
         let exact = rho / (1.0 - rho);
         let spread = 1.0 / (options.gather_photons as f64).sqrt();
@@ -123,8 +151,7 @@ fn precomputed_estimates_have_the_closed_form() {
         gather_photons: 200,
         final_gather: 1,
     };
-    let mut map = PhotonMap::trace(&scene, &visibility, &options, 3, None, &crate::NoProgress)
-        .expect("traced");
+    let mut map = trace(&scene, &visibility, &options, 3);
     map.precompute(usize::MAX, &|| false, &crate::NoProgress);
     let stored = map.stats.stored;
     assert!(
@@ -150,16 +177,14 @@ fn precomputed_estimates_have_the_closed_form() {
         rms(&errors)
     );
     // A gather that reads the map less often than there are sites gathers at each reading.
-    let mut map = PhotonMap::trace(&scene, &visibility, &options, 3, None, &crate::NoProgress)
-        .expect("traced");
+    let mut map = trace(&scene, &visibility, &options, 3);
     map.precompute(1000, &|| false, &crate::NoProgress);
     assert_eq!(map.stats.precomputed, 0);
     // In the Cornell box, where the light differs from place to place, the estimate read at a
     // site is the one made there, to the bit.
     let cornell = builtin::cornell();
     let visibility = Visibility::build(&cornell);
-    let mut map = PhotonMap::trace(&cornell, &visibility, &options, 3, None, &crate::NoProgress)
-        .expect("traced");
+    let mut map = trace(&cornell, &visibility, &options, 3);
     let sites: Vec<(DVec3, SurfaceId)> = map
         .surfaces
         .iter()
@@ -201,16 +226,7 @@ fn the_furnace_solution_is_the_closed_form() {
                 gather_photons: 4000,
                 final_gather,
             };
-            let options = crate::SolverOptions::default();
-            let (solution, _) = solve_photon_map(
-                &scene,
-                &mesh,
-                &visibility,
-                &options,
-                &photons,
-                &crate::NoProgress,
-            )
-            .expect("solved");
+            let (solution, _) = solve(&scene, &visibility, &mesh, &photons);
             let errors: Vec<f64> = solution
                 .radiosity
                 .iter()
@@ -237,8 +253,7 @@ fn nothing_reflected_comes_back_in_the_textbook() {
         photons: 20_000,
         ..PhotonMapOptions::default()
     };
-    let map = PhotonMap::trace(&scene, &visibility, &options, 1, None, &crate::NoProgress)
-        .expect("traced");
+    let map = trace(&scene, &visibility, &options, 1);
     let light = scene.surface_id("light").expect("a light");
     assert!(scene.surfaces[light].reflectance.is_zero());
     assert!(
@@ -274,9 +289,7 @@ fn the_map_does_not_depend_on_the_thread_count() {
             .build()
             .expect("a pool");
         pool.install(|| {
-            let mut map =
-                PhotonMap::trace(&scene, &visibility, &options, 1, None, &crate::NoProgress)
-                    .expect("traced");
+            let mut map = trace(&scene, &visibility, &options, 1);
             map.precompute(usize::MAX, &|| false, &crate::NoProgress);
             let values: Vec<(Rgb, Rgb)> = points
                 .iter()
@@ -412,15 +425,7 @@ fn the_cornell_box_against_path_tracing() {
             gather_photons: 400,
             final_gather,
         };
-        let (solution, stats) = solve_photon_map(
-            &scene,
-            &mesh,
-            &visibility,
-            &options,
-            &photons,
-            &crate::NoProgress,
-        )
-        .expect("solved");
+        let (solution, stats) = solve(&scene, &visibility, &mesh, &photons);
         assert!(stats.stored > photons.photons / 2, "{stats:?}");
         for b in solution.radiosity.iter().flatten() {
             assert!(
@@ -474,7 +479,6 @@ fn the_error_falls_as_the_photons_grow() {
         / references.len() as f64;
     assert!(references.len() > 50, "{} points", references.len());
     let counts = [50_000, 100_000, 200_000, 400_000];
-    let options = crate::SolverOptions::default();
     let rms_errors: Vec<f64> = counts
         .iter()
         .map(|&photons| {
@@ -483,15 +487,7 @@ fn the_error_falls_as_the_photons_grow() {
                 gather_photons: photons / 1000,
                 final_gather: 0,
             };
-            let (solution, _) = solve_photon_map(
-                &scene,
-                &mesh,
-                &visibility,
-                &options,
-                &map_options,
-                &crate::NoProgress,
-            )
-            .expect("solved");
+            let (solution, _) = solve(&scene, &visibility, &mesh, &map_options);
             let errors = relative_errors(&solution, &references);
             let square = rms(&errors).powi(2);
             (square - reference_noise).max(0.0).sqrt()
@@ -532,19 +528,10 @@ fn least_squares_slope(points: &[(f64, f64)]) -> f64 {
 /// leaves, and the surfaces absorb what they emit.
 #[test]
 fn what_escapes_is_what_the_photons_carry_out() {
-    let options = crate::SolverOptions::default();
-    let solve = |scene: &Scene, triangles: usize, map_options: &PhotonMapOptions| {
+    let solve_meshed = |scene: &Scene, triangles: usize, map_options: &PhotonMapOptions| {
         let visibility = Visibility::build(scene);
         let mesh = penumbra_meshing::mesh_scene_uniform(scene, triangles).expect("a mesh");
-        solve_photon_map(
-            scene,
-            &mesh,
-            &visibility,
-            &options,
-            map_options,
-            &crate::NoProgress,
-        )
-        .expect("solved")
+        solve(scene, &visibility, &mesh, map_options)
     };
     let map_options = PhotonMapOptions {
         photons: 400_000,
@@ -552,7 +539,7 @@ fn what_escapes_is_what_the_photons_carry_out() {
         final_gather: 0,
     };
     let cornell = builtin::cornell();
-    let (solution, stats) = solve(&cornell, 3000, &map_options);
+    let (solution, stats) = solve_meshed(&cornell, 3000, &map_options);
     let (tally, account) = (stats.escaped, solution.stats.escaped);
     let emitted = solution.stats.emitted;
     eprintln!("escaped: photons' tally {tally:?}, solution's {account:?}, emitted {emitted:?}");
@@ -569,7 +556,7 @@ fn what_escapes_is_what_the_photons_carry_out() {
     }
     for rho in [0.5, 0.9] {
         let furnace = builtin::furnace(1.0, rho);
-        let (solution, stats) = solve(&furnace, 600, &map_options);
+        let (solution, stats) = solve_meshed(&furnace, 600, &map_options);
         let emitted = solution.stats.emitted.mean();
         assert!(
             stats.escaped.mean() < 1e-6 * emitted,
