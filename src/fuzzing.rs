@@ -1,11 +1,19 @@
 //! The whole pipeline on small arbitrary scenes, shared by the `pipeline` fuzz target and the
 //! seeded property test over the same generator: a scene may be rejected, but a run must never
-//! panic, hang, or give a NaN, an infinity, a negative radiosity or an unbalanced energy account.
+//! panic, hang, or give a NaN, an infinity, a negative radiosity or an energy account that does
+//! not close (within [`FUZZ_CLOSURE`]).
 
 use penumbra_scenes::{LoadedScene, Scene};
 use penumbra_solver::{NoProgress, SolverOptions};
 
 use crate::{RunOptions, run};
+
+/// How far the energy account of a fuzzed run may be from closing, as a share of the emitted
+/// power. The hierarchical solver measures what escapes from its own solution, at a budget of
+/// 400 triangles over surfaces that pierce each other: each vertex's total is interpolated over
+/// triangles as large as a surface, and the account closes to a few percent (7 % at worst over
+/// the seeded generator's scenes). A solver error is larger: a furnace solved 14 % too bright.
+pub const FUZZ_CLOSURE: f64 = 0.1;
 
 /// Validates `scene` and, if it is valid, runs it with a small budget; `Err` says what broke.
 pub fn run_small(scene: Scene) -> Result<(), String> {
@@ -44,10 +52,9 @@ pub fn run_small(scene: Scene) -> Result<(), String> {
             }
         }
     }
-    let stats = &result.solution.stats;
-    let balance = stats.emitted - stats.absorbed - stats.unshot - stats.escaped;
-    if !(balance.mean().abs() <= 1e-6 * stats.emitted.mean()) {
-        return Err(format!("energy does not balance: {stats:?}"));
+    let account = crate::energy::EnergyBalance::of(&result.solution.stats);
+    if !(account.closure_error.abs() <= FUZZ_CLOSURE) {
+        return Err(format!("the energy account does not close: {account:?}"));
     }
     Ok(())
 }

@@ -701,7 +701,7 @@ pub fn merge(
     // every shard's), with the light's figures joined.
     let solver_absorbed = serde_json::to_value(absorbed).unwrap_or_default();
     let escaped = emitted - received;
-    let energy = EnergyBalance::new(emitted, absorbed, escaped, unshot);
+    let energy = EnergyBalance::new(emitted, absorbed, escaped, unshot, None);
     let mut all_warnings = warnings;
     all_warnings.extend(energy.warning());
     let triangles = surfaces.iter().map(|s| s.triangles.len()).sum();

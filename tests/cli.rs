@@ -1305,7 +1305,7 @@ fn an_energy_balance_that_does_not_close_is_flagged() {
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{stderr}");
     assert!(
-        stderr.contains("warning: the energy balance does not close"),
+        stderr.contains("warning: the energy account does not balance"),
         "{stderr}"
     );
     let report = json(&out.join("report.json"));

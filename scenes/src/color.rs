@@ -65,6 +65,16 @@ impl Rgb {
         Rgb::new(self.r * o.r, self.g * o.g, self.b * o.b)
     }
 
+    /// Channel-wise minimum.
+    pub fn min(self, o: Rgb) -> Rgb {
+        Rgb::new(self.r.min(o.r), self.g.min(o.g), self.b.min(o.b))
+    }
+
+    /// Channel-wise maximum.
+    pub fn max(self, o: Rgb) -> Rgb {
+        Rgb::new(self.r.max(o.r), self.g.max(o.g), self.b.max(o.b))
+    }
+
     /// `f` applied to each channel.
     pub fn map(self, f: impl Fn(f64) -> f64) -> Rgb {
         Rgb::new(f(self.r), f(self.g), f(self.b))

@@ -244,6 +244,11 @@ impl Visibility {
         &self.triangles
     }
 
+    /// The unit normal of triangle `index`'s plane, toward its surface's front.
+    pub fn triangle_normal(&self, index: usize) -> DVec3 {
+        self.normals[index]
+    }
+
     /// Distance below which a point counts as lying on a surface.
     pub fn contact_distance(&self) -> f64 {
         self.contact

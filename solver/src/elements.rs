@@ -180,21 +180,22 @@ impl Discretization {
         self.receivers.len()
     }
 
-    /// Two per-receiver fields of `old` carried over to this discretization where receivers
-    /// match ([`Self::matching_receivers`]; zero elsewhere), and the receivers that match none.
-    pub fn carried(
+    /// Per-receiver fields of `old` carried over to this discretization where receivers match
+    /// ([`Self::matching_receivers`]; zero elsewhere), and the receivers that match none.
+    pub fn carried<T: Copy + Default, const N: usize>(
         &self,
         old: &Discretization,
-        fields: [&[Rgb]; 2],
-    ) -> ([Vec<Rgb>; 2], Vec<usize>) {
+        fields: [&[T]; N],
+    ) -> ([Vec<T>; N], Vec<usize>) {
         let n = self.receiver_count();
-        let mut out = [vec![Rgb::ZERO; n], vec![Rgb::ZERO; n]];
+        let mut out = std::array::from_fn(|_| vec![T::default(); n]);
         let mut fresh = Vec::new();
         for (v, same) in self.matching_receivers(old).into_iter().enumerate() {
             match same {
                 Some(o) => {
-                    out[0][v] = fields[0][o];
-                    out[1][v] = fields[1][o];
+                    for (field, values) in out.iter_mut().zip(fields) {
+                        field[v] = values[o];
+                    }
                 }
                 None => fresh.push(v),
             }
@@ -272,6 +273,23 @@ impl Discretization {
                 let mean =
                     (values[e.vertices[0]] + values[e.vertices[1]] + values[e.vertices[2]]) / 3.0;
                 mean.mul_rgb(weight(e)) * e.area
+            })
+            .sum()
+    }
+}
+
+impl Discretization {
+    /// ∫ f g over the mesh, with `values` (f) and `weights` (g) at the vertices, both linear
+    /// over each triangle: A/12 (Σ fᵢ gᵢ + Σ fᵢ Σ gⱼ) per triangle, exact for the interpolants.
+    pub fn integrate_product(&self, values: &[Rgb], weights: &[f64]) -> Rgb {
+        self.elements
+            .iter()
+            .map(|e| {
+                let [a, b, c] = e.vertices;
+                let own = values[a] * weights[a] + values[b] * weights[b] + values[c] * weights[c];
+                let all =
+                    (values[a] + values[b] + values[c]) * (weights[a] + weights[b] + weights[c]);
+                (own + all) * (e.area / 12.0)
             })
             .sum()
     }

@@ -380,6 +380,7 @@ pub fn solve_gathering(
         gather_seconds: 0.0,
         hierarchy: None,
         photon_map: None,
+        closed: Some(crate::solids::closed_scene(scene, visibility, disc)),
     };
     Ok((
         Solution {

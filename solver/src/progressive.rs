@@ -215,6 +215,9 @@ pub struct SolveStats {
     /// The hierarchical solver's own figures.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub hierarchy: Option<crate::hierarchical::HierarchyStats>,
+    /// Whether every vertex lies inside a room, so that no light can leave the scene (see
+    /// `Enclosures`); `None` where the solver does not find out.
+    pub closed: Option<bool>,
     /// The photon-map solver's figures: photons emitted and stored, the map's memory.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub photon_map: Option<crate::photon_map::PhotonStats>,
@@ -562,6 +565,8 @@ pub struct ProgressiveSolver<'a> {
     columns: Option<crate::coupling::Columns>,
     shot_power: Rgb,
     escaped: Rgb,
+    /// Whether every vertex lies inside a room (nothing may escape).
+    closed: bool,
     stop: StopReason,
     shots: usize,
     convergence: Vec<ConvergencePoint>,
@@ -621,6 +626,7 @@ impl<'a> ProgressiveSolver<'a> {
         } else {
             None
         };
+        let closed = crate::solids::closed_scene(scene, visibility, &disc);
         Ok(ProgressiveSolver {
             scene,
             visibility,
@@ -638,6 +644,7 @@ impl<'a> ProgressiveSolver<'a> {
             columns,
             shot_power: Rgb::ZERO,
             escaped: scene.emitted_power() - received,
+            closed,
             stop: if direct_estimated.late > 0 {
                 StopReason::TimeBudget
             } else if options.direct_only {
@@ -1000,6 +1007,7 @@ impl<'a> ProgressiveSolver<'a> {
             gather_seconds: self.gather_seconds,
             hierarchy: None,
             photon_map: None,
+            closed: Some(self.closed),
         };
         Solution {
             radiosity: self.radiosity(),

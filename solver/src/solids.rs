@@ -2,12 +2,18 @@
 //! one other face of the group, oriented consistently. Light that reaches a closed solid enters
 //! it through a face turned towards the light's source, so faces turned away can never be the
 //! first thing a ray meets and are skipped as occluders.
+//!
+//! A closed solid also encloses: no ray from a point inside it leaves the scene, so every form
+//! factor from there sums to exactly one ([`Enclosures`]).
 
 use std::collections::HashMap;
 
 use glam::DVec3;
-use penumbra_scenes::Scene;
-use penumbra_scenes::UnionFind;
+use penumbra_scenes::{Scene, SurfaceId, UnionFind, Visibility};
+use rayon::prelude::*;
+
+use crate::elements::Discretization;
+use crate::lambert::ReceivingPoint;
 
 /// A corner identified by its exact coordinates (faces of a welded mesh share them).
 fn key(p: DVec3) -> [u64; 3] {
@@ -57,6 +63,75 @@ pub(crate) fn closed_solid_orientation(scene: &Scene) -> Vec<Option<f64>> {
             (is_closed && volume != 0.0).then(|| volume.signum())
         })
         .collect()
+}
+
+/// Probe rays a point tries before it is taken to be open: each leans off the normal toward one
+/// of these directions of its tangent plane, by [`PROBE_LEAN`].
+const PROBE_TURNS: [f64; 4] = [0.0, 1.7, 3.3, 4.9];
+const PROBE_LEAN: f64 = 0.37;
+
+/// A probe whose direction is within this cosine of a face's plane grazes it: it proves nothing,
+/// and the next probe is tried.
+const GRAZING: f64 = 1e-6;
+
+/// Which points lie inside a *room*: a closed solid whose faces turn inward. From inside a room
+/// every ray meets a face's front, of the room or of a solid in it, provided every surface of the
+/// scene is a face of a closed solid (a lone polygon would show its black back to some points),
+/// so the form factors from such a point sum to exactly one.
+pub(crate) struct Enclosures<'a> {
+    visibility: &'a Visibility,
+    /// Whether each surface is a face of a room.
+    room: Vec<bool>,
+    /// Whether every surface is a face of a closed solid; else nothing is taken to be enclosed.
+    solid: bool,
+}
+
+impl<'a> Enclosures<'a> {
+    pub(crate) fn new(scene: &Scene, visibility: &'a Visibility) -> Enclosures<'a> {
+        let orientation = closed_solid_orientation(scene);
+        Enclosures {
+            visibility,
+            room: orientation.iter().map(|o| *o == Some(-1.0)).collect(),
+            solid: orientation.iter().all(Option::is_some),
+        }
+    }
+
+    /// Whether the front of surface `surface` at `x` lies inside a room, proved by a probe ray
+    /// that meets a room's face first, on its front. A probe that meets a solid's outside, or
+    /// grazes a face, proves nothing, and the next is tried; one that leaves the scene proves
+    /// the point open. A point no probe decides is taken to be open: its total is then estimated
+    /// instead of known, which is less exact, never wrong.
+    pub(crate) fn encloses(&self, x: &ReceivingPoint, surface: SurfaceId) -> bool {
+        if !self.solid {
+            return false;
+        }
+        let contact = self.visibility.contact_distance();
+        let origin = x.point + x.inward * self.visibility.junction_offset();
+        let (u, v) = x.normal.any_orthonormal_pair();
+        for turn in PROBE_TURNS {
+            let lean = (u * turn.cos() + v * turn.sin()) * PROBE_LEAN;
+            let d = (x.normal + lean).normalize();
+            let Some(hit) =
+                self.visibility
+                    .closest_hit(origin, d, contact, f64::INFINITY, Some(surface))
+            else {
+                return false;
+            };
+            let facing = -self.visibility.triangle_normal(hit.triangle).dot(d);
+            if self.room[hit.surface] && facing > GRAZING {
+                return true;
+            }
+        }
+        false
+    }
+}
+
+/// Whether every vertex of `disc` lies inside a room: then no light can leave the scene.
+pub(crate) fn closed_scene(scene: &Scene, visibility: &Visibility, disc: &Discretization) -> bool {
+    let enclosures = Enclosures::new(scene, visibility);
+    (0..disc.receiver_count())
+        .into_par_iter()
+        .all(|v| enclosures.encloses(&disc.receivers[v], disc.receiver_surface[v]))
 }
 
 #[cfg(test)]

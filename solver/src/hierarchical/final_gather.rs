@@ -10,6 +10,10 @@
 //! on average (it sees the first surface's dark strip in turn), so a leaf's mean radiosity
 //! overstates it. Near leaves are therefore gathered again with their radiosity linear over them,
 //! from their vertices' values of the gather before.
+//!
+//! Each point also sums the form factors it gathers along (`unit`, the irradiance a radiosity of
+//! one everywhere would give), so that its light can be scaled to its total as the leaves' are
+//! ([`super::totals`]): to one inside a closed solid, and never above one.
 
 use std::f64::consts::PI;
 
@@ -34,11 +38,13 @@ pub(crate) struct FinalGather<'a> {
     pub seed: u64,
 }
 
-/// What a point gathers: from near leaves, and from everything else, and the rays cast.
+/// What a point gathers: from near leaves, and from everything else, the sum of the form factors
+/// it gathered along, and the rays cast.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Gathered {
     pub near: Rgb,
     pub far: Rgb,
+    pub unit: f64,
     pub rays: u64,
     /// The fraction of each partial near leaf seen, in the order of the links, for the gathers
     /// that follow.
@@ -85,7 +91,7 @@ impl FinalGather<'_> {
                 if linear.is_some() && !near {
                     continue;
                 }
-                let unoccluded = match linear {
+                let (unoccluded, unit) = match linear {
                     Some((vertex_b, _)) => self.linear_leaf(x, link.source, vertex_b),
                     None => self.unoccluded(x, link),
                 };
@@ -99,9 +105,9 @@ impl FinalGather<'_> {
                     Transfer::Far { visible, .. } => Some(visible),
                     Transfer::Factor { .. } => None,
                 };
-                let value = match known.or(cluster_visible) {
-                    Some(visible) => unoccluded * visible,
-                    None if link.partial && (near || unoccluded.max_channel() > 0.0) => {
+                let visible = match known.or(cluster_visible) {
+                    Some(visible) => visible,
+                    None if link.partial && (near || unit > 0.0) => {
                         let rays = if unoccluded.mean() < minor {
                             MINOR_RAYS.min(self.rays)
                         } else {
@@ -113,10 +119,12 @@ impl FinalGather<'_> {
                         if near {
                             out.near_visible.push(visible as f32);
                         }
-                        unoccluded * visible
+                        visible
                     }
-                    None => unoccluded,
+                    None => 1.0,
                 };
+                let value = unoccluded * visible;
+                out.unit += unit * visible;
                 if near {
                     out.near += value;
                 } else {
@@ -127,8 +135,9 @@ impl FinalGather<'_> {
         out
     }
 
-    /// What `x` receives from `link`'s source, unoccluded, at the source's mean radiosity.
-    fn unoccluded(&self, x: &ReceivingPoint, link: &Link) -> Rgb {
+    /// What `x` receives from `link`'s source, unoccluded, at the source's mean radiosity, and
+    /// what it would receive at a radiosity of one.
+    fn unoccluded(&self, x: &ReceivingPoint, link: &Link) -> (Rgb, f64) {
         let h = self.system.hierarchy;
         let s = link.source;
         let sn = h.node(s);
@@ -136,28 +145,32 @@ impl FinalGather<'_> {
             let offset = x.point - sn.centroid;
             let distance2 = offset.length_squared();
             let direction = offset / distance2.sqrt();
-            let facing = x.normal.dot(-direction).max(0.0);
-            self.system
-                .radiosities(self.field)
-                .intensity(sn, s, direction)
-                * (facing / distance2)
+            let facing = x.normal.dot(-direction).max(0.0) / distance2;
+            let intensity = |field| self.system.radiosities(field).intensity(sn, s, direction);
+            (
+                intensity(self.field) * facing,
+                intensity(&self.system.unit).mean() * facing,
+            )
         } else {
             self.element_source(x, s, SOURCE_LEVELS)
         }
     }
 
     /// What `x` receives from element `s`, unoccluded, with the radiosities of its descendants
-    /// `levels` down: a source's mean would miss how its brighter parts lie toward `x` (the
-    /// floor's bright middle under the ceiling's middle).
-    fn element_source(&self, x: &ReceivingPoint, s: u32, levels: u32) -> Rgb {
+    /// `levels` down (a source's mean would miss how its brighter parts lie toward `x`: the
+    /// floor's bright middle under the ceiling's middle), and the form factor.
+    fn element_source(&self, x: &ReceivingPoint, s: u32, levels: u32) -> (Rgb, f64) {
         let h = self.system.hierarchy;
         match h.node(s).children {
             Some([a, b]) if levels > 0 => {
-                self.element_source(x, a, levels - 1) + self.element_source(x, b, levels - 1)
+                let (la, fa) = self.element_source(x, a, levels - 1);
+                let (lb, fb) = self.element_source(x, b, levels - 1);
+                (la + lb, fa + fb)
             }
             _ => {
                 let tol = self.visibility.contact_distance();
-                self.field.b[s as usize] * point_factor(h, x, s, tol)
+                let factor = point_factor(h, x, s, tol);
+                (self.field.b[s as usize] * factor, factor)
             }
         }
     }
@@ -165,14 +178,14 @@ impl FinalGather<'_> {
     /// What `x` receives from leaf `s` with its radiosity linear over it, from the values at its
     /// vertices: the value at the point of `s` nearest to `x` times the exact form factor (which
     /// takes the one-sided limit at a junction), plus the rest, which vanishes at that point,
-    /// integrated over `s`.
-    fn linear_leaf(&self, x: &ReceivingPoint, s: u32, vertex_b: &[Rgb]) -> Rgb {
+    /// integrated over `s`; and the form factor.
+    fn linear_leaf(&self, x: &ReceivingPoint, s: u32, vertex_b: &[Rgb]) -> (Rgb, f64) {
         let h = self.system.hierarchy;
         let triangle = &h.triangles[h.node(s).first as usize];
         let t = triangle.points;
         let tol = self.visibility.contact_distance();
         if !x.in_front_of(t[0], triangle.normal, tol) {
-            return Rgb::ZERO;
+            return (Rgb::ZERO, 0.0);
         }
         let b = self.elements[triangle.element as usize]
             .vertices
@@ -182,7 +195,7 @@ impl FinalGather<'_> {
         let b0 = at(nearest);
         let factor = leaf_factor(x, &t, triangle.normal, tol);
         let rest = linear_rest(x, triangle.normal, t, b, b0, LINEAR_DEPTH);
-        b0 * factor + rest
+        (b0 * factor + rest, factor)
     }
 
     /// The fraction of node `s` that `x` sees, weighted by the form-factor kernel, from

@@ -4,6 +4,13 @@
 //! direction, read by each surface for its own normal), the leaves reflect it on top of the
 //! direct light they reflect, and radiosities are pulled up again as area means (powers per
 //! axis direction for clusters).
+//!
+//! Each leaf's gathered light is scaled so that its form factors sum to its true total (see
+//! [`super::totals`]): every row of the system then sums to ρ T ≤ ρ < 1, so the sweeps are a
+//! contraction at any reflectance below one. The sweeps slow down as ρ nears one, along the
+//! field's near-uniform part; after each sweep the residual's area mean is removed along the
+//! uniform field (a one-unknown coarse correction, like Cohen et al.'s ambient term but exact
+//! for that unknown), which leaves only the faster parts.
 
 use penumbra_scenes::Rgb;
 use rayon::prelude::*;
@@ -24,9 +31,35 @@ pub(crate) struct Field {
     /// Per node: the least and greatest radiosity of its leaves.
     low: Vec<Rgb>,
     high: Vec<Rgb>,
+    /// Per element: the mean radiosity it gathers, its irradiance over the sum of its form
+    /// factors (zero before any light is gathered).
+    incoming: Vec<Rgb>,
 }
 
 impl Field {
+    /// This field plus `gamma` times `other` (per channel), with `extra` times `gamma` more
+    /// irradiance on each node: the sum of two solutions of the same links.
+    pub(super) fn add_scaled(&mut self, other: &Field, gamma: Rgb, extra: &[f64]) {
+        let add = |mine: &mut [Rgb], theirs: &[Rgb]| {
+            for (m, t) in mine.iter_mut().zip(theirs) {
+                *m += t.mul_rgb(gamma);
+            }
+        };
+        add(&mut self.b, &other.b);
+        add(&mut self.low, &other.low);
+        add(&mut self.high, &other.high);
+        add(&mut self.incoming, &other.incoming);
+        add(&mut self.irradiance, &other.irradiance);
+        for (h, &x) in self.irradiance.iter_mut().zip(extra) {
+            *h += gamma * x;
+        }
+        for (q, t) in self.q.iter_mut().zip(&other.q) {
+            for (a, b) in q.iter_mut().zip(t) {
+                *a += b.mul_rgb(gamma);
+            }
+        }
+    }
+
     fn new(nodes: usize, clusters: usize) -> Field {
         Field {
             b: vec![Rgb::ZERO; nodes],
@@ -34,6 +67,7 @@ impl Field {
             irradiance: vec![Rgb::ZERO; nodes],
             low: vec![Rgb::ZERO; nodes],
             high: vec![Rgb::ZERO; nodes],
+            incoming: vec![Rgb::ZERO; nodes],
         }
     }
 }
@@ -50,11 +84,36 @@ pub(crate) struct System<'a> {
     /// Links sorted by receiver, and for each node the range of its own.
     pub links: Vec<Link>,
     pub first_link: Vec<u32>,
+    /// Per node: what a leaf's gathered light is multiplied by, its true total over the sum of
+    /// its form factors (one elsewhere, and until totals are set).
+    pub scale: Vec<f64>,
+    /// Per node: a leaf's true total of form factors (what its links sum to after scaling).
+    pub totals: Vec<f64>,
+    /// Per node: the part of a leaf's total that surfaces which reflect cover.
+    pub reflecting: Vec<f64>,
+    /// Per node: the sum of the form factors along its links and its ancestors', unscaled
+    /// (empty before the links are set).
+    sums: Vec<f64>,
+    /// Per node: whether a leaf lies inside a closed solid (its total is then one).
+    pub enclosed: Vec<bool>,
+    /// Distance under which a point counts as lying on a plane.
+    pub tol: f64,
+    /// The field of unit radiosity on every element: what the links carry per unit.
+    pub unit: Field,
+    /// The field of unit radiosity on every element that reflects, zero on the others.
+    pub unit_reflecting: Field,
 }
 
 impl<'a> System<'a> {
-    /// `leaf_direct` is each leaf's reflected direct radiosity (by node; anything elsewhere).
-    pub(super) fn new(hierarchy: &'a Hierarchy, leaf_direct: Vec<Rgb>) -> System<'a> {
+    /// `leaf_direct` is each leaf's reflected direct radiosity and `enclosed` whether it lies
+    /// inside a closed solid (both by node; anything elsewhere); `tol` the distance under which
+    /// a point counts as lying on a plane.
+    pub(super) fn new(
+        hierarchy: &'a Hierarchy,
+        leaf_direct: Vec<Rgb>,
+        enclosed: Vec<bool>,
+        tol: f64,
+    ) -> System<'a> {
         let mut slot = vec![NONE; hierarchy.nodes.len()];
         let mut clusters = 0;
         for (i, n) in hierarchy.nodes.iter().enumerate() {
@@ -63,18 +122,43 @@ impl<'a> System<'a> {
                 clusters += 1;
             }
         }
+        let n = hierarchy.nodes.len();
         let mut system = System {
             hierarchy,
             slot,
             clusters: clusters as usize,
-            direct: leaf_direct,
+            direct: vec![Rgb::splat(1.0); n],
             links: Vec::new(),
-            first_link: vec![0; hierarchy.nodes.len() + 1],
+            first_link: vec![0; n + 1],
+            scale: vec![1.0; n],
+            totals: Vec::new(),
+            reflecting: Vec::new(),
+            sums: Vec::new(),
+            enclosed,
+            tol,
+            unit: Field::new(0, 0),
+            unit_reflecting: Field::new(0, 0),
         };
-        if let Some(root) = hierarchy.root {
-            system.pull_direct(root);
-        }
+        system.unit = system.initial_field();
+        let lit = hierarchy
+            .nodes
+            .iter()
+            .map(|node| Rgb::splat(if node.reflects() { 1.0 } else { 0.0 }))
+            .collect();
+        system.set_direct(lit);
+        system.unit_reflecting = system.initial_field();
+        system.set_direct(leaf_direct);
         system
+    }
+
+    /// Replaces what each leaf reflects of the light that comes from outside the links (by
+    /// node; anything elsewhere), and returns the old.
+    pub(super) fn set_direct(&mut self, leaf_direct: Vec<Rgb>) -> Vec<Rgb> {
+        let old = std::mem::replace(&mut self.direct, leaf_direct);
+        if let Some(root) = self.hierarchy.root {
+            self.pull_direct(root);
+        }
+        old
     }
 
     /// Means of the leaves' direct light up the element trees.
@@ -90,8 +174,38 @@ impl<'a> System<'a> {
         self.direct[id as usize]
     }
 
-    /// Replaces the links (in any order; sorted here by receiver, stably).
-    pub(super) fn set_links(&mut self, mut links: Vec<Link>) {
+    /// Each node's sum of form factors along its links and its ancestors': the irradiance it
+    /// gathers, unscaled, when every element's radiosity is one.
+    pub(super) fn row_sums(&self) -> Vec<f64> {
+        let gathered = self.gather(&self.unit);
+        let mut out = Field::new(self.hierarchy.nodes.len(), self.clusters);
+        if let Some(root) = self.hierarchy.root {
+            self.push_pull(root, Down::Axes([Rgb::ZERO; 6]), &gathered, false, &mut out);
+        }
+        out.irradiance.iter().map(|h| h.mean()).collect()
+    }
+
+    /// Each leaf's gathered light scaled so that its form factors sum to its total
+    /// ([`super::totals`]), for the links as they are.
+    fn set_totals(&mut self, changed: Option<&[u32]>) {
+        let (totals, reflecting) = self.leaf_totals(changed);
+        let sums = self.row_sums();
+        for (i, n) in self.hierarchy.nodes.iter().enumerate() {
+            self.scale[i] = if n.is_leaf() && !n.is_cluster() && sums[i] > 0.0 {
+                totals[i] / sums[i]
+            } else {
+                1.0
+            };
+        }
+        self.totals = totals;
+        self.reflecting = reflecting;
+        self.sums = sums;
+    }
+
+    /// Replaces the links (in any order; sorted here by receiver, stably), and scales the
+    /// leaves to their totals along them. `changed` lists the receivers whose links were
+    /// replaced, when only theirs were (the totals of leaves below no other node stay).
+    pub(super) fn set_links(&mut self, mut links: Vec<Link>, changed: Option<&[u32]>) {
         links.sort_by_key(|l| l.receiver);
         self.first_link.iter_mut().for_each(|f| *f = 0);
         for l in &links {
@@ -101,6 +215,7 @@ impl<'a> System<'a> {
             self.first_link[i] += self.first_link[i - 1];
         }
         self.links = links;
+        self.set_totals(changed);
     }
 
     /// The links `id` receives along.
@@ -118,6 +233,7 @@ impl<'a> System<'a> {
             q: &field.q,
             low: &field.low,
             high: &field.high,
+            incoming: &field.incoming,
             slot: &self.slot,
         }
     }
@@ -131,7 +247,13 @@ impl<'a> System<'a> {
                 h: vec![Rgb::ZERO; n],
                 g: vec![[Rgb::ZERO; 6]; self.clusters],
             };
-            self.push_pull(root, Down::Axes([Rgb::ZERO; 6]), &gathered, &mut field);
+            self.push_pull(
+                root,
+                Down::Axes([Rgb::ZERO; 6]),
+                &gathered,
+                true,
+                &mut field,
+            );
         }
         field
     }
@@ -141,7 +263,7 @@ impl<'a> System<'a> {
         let gathered = self.gather(field);
         let mut next = Field::new(field.b.len(), self.clusters);
         if let Some(root) = self.hierarchy.root {
-            self.push_pull(root, Down::Axes([Rgb::ZERO; 6]), &gathered, &mut next);
+            self.push_pull(root, Down::Axes([Rgb::ZERO; 6]), &gathered, true, &mut next);
         }
         next
     }
@@ -197,43 +319,33 @@ impl<'a> System<'a> {
         gathered
     }
 
-    /// Pushes `down` and what `id` gathered to its leaves, which reflect it, and pulls the
-    /// radiosities (or powers) back up into `out`.
-    fn push_pull(&self, id: u32, down: Down, gathered: &Gathered, out: &mut Field) {
+    /// Pushes `down` and what `id` gathered to its leaves, which reflect it (scaled to their
+    /// totals when `scaled`), and pulls the radiosities (or powers) back up into `out`.
+    fn push_pull(&self, id: u32, down: Down, gathered: &Gathered, scaled: bool, out: &mut Field) {
         let node = self.hierarchy.node(id);
-        match self.slot[id as usize] {
+        let i = id as usize;
+        match self.slot[i] {
             NONE => {
                 let down = match down {
                     Down::Irradiance(h) => h,
                     Down::Axes(g) => irradiance_from_axes(&g, node.normal),
                 };
-                let total = down + gathered.h[id as usize];
-                out.irradiance[id as usize] = total;
-                let i = id as usize;
+                let total = down + gathered.h[i];
                 match node.children {
                     None => {
-                        let b = self.direct[i] + node.reflectance.mul_rgb(total);
+                        let h = if scaled { total * self.scale[i] } else { total };
+                        out.irradiance[i] = h;
+                        out.incoming[i] = self.incoming(i, total);
+                        let b = self.direct[i] + node.reflectance.mul_rgb(h);
                         (out.b[i], out.low[i], out.high[i]) = (b, b, b);
                     }
                     Some(children) => {
-                        let mut sum = Rgb::ZERO;
-                        let (mut low, mut high) = (Rgb::splat(f64::INFINITY), Rgb::ZERO);
+                        out.irradiance[i] = total;
+                        out.incoming[i] = self.incoming(i, total);
                         for c in children {
-                            self.push_pull(c, Down::Irradiance(total), gathered, out);
-                            let c = c as usize;
-                            sum += out.b[c] * self.hierarchy.nodes[c].area;
-                            low = Rgb::new(
-                                low.r.min(out.low[c].r),
-                                low.g.min(out.low[c].g),
-                                low.b.min(out.low[c].b),
-                            );
-                            high = Rgb::new(
-                                high.r.max(out.high[c].r),
-                                high.g.max(out.high[c].g),
-                                high.b.max(out.high[c].b),
-                            );
+                            self.push_pull(c, Down::Irradiance(total), gathered, scaled, out);
                         }
-                        (out.b[i], out.low[i], out.high[i]) = (sum / node.area, low, high);
+                        self.aggregate(id, out);
                     }
                 }
             }
@@ -245,20 +357,62 @@ impl<'a> System<'a> {
                 for (t, g) in total.iter_mut().zip(&gathered.g[slot as usize]) {
                     *t += *g;
                 }
-                let mut power = [Rgb::ZERO; 6];
                 for c in node.children.into_iter().flatten() {
-                    let child = self.hierarchy.node(c);
+                    let down = match self.slot[c as usize] {
+                        NONE => Down::Irradiance(irradiance_from_axes(
+                            &total,
+                            self.hierarchy.node(c).normal,
+                        )),
+                        _ => Down::Axes(total),
+                    };
+                    self.push_pull(c, down, gathered, scaled, out);
+                }
+                self.aggregate(id, out);
+            }
+        }
+    }
+
+    /// The mean radiosity node `i` gathers with unscaled irradiance `h`.
+    fn incoming(&self, i: usize, h: Rgb) -> Rgb {
+        match self.sums.get(i) {
+            Some(&sum) if sum > 0.0 => h / sum,
+            _ => Rgb::ZERO,
+        }
+    }
+
+    /// Node `id`'s light from its children's in `out`: an element's radiosity is their area
+    /// mean (and its range theirs), a cluster's power per axis direction their sum.
+    fn aggregate(&self, id: u32, out: &mut Field) {
+        let h = self.hierarchy;
+        let node = h.node(id);
+        let Some(children) = node.children else {
+            return;
+        };
+        match self.slot[id as usize] {
+            NONE => {
+                let mut sum = Rgb::ZERO;
+                let (mut low, mut high) =
+                    (Rgb::splat(f64::INFINITY), Rgb::splat(f64::NEG_INFINITY));
+                for c in children.map(|c| c as usize) {
+                    sum += out.b[c] * h.nodes[c].area;
+                    low = low.min(out.low[c]);
+                    high = high.max(out.high[c]);
+                }
+                let i = id as usize;
+                (out.b[i], out.low[i], out.high[i]) = (sum / node.area, low, high);
+            }
+            slot => {
+                let mut power = [Rgb::ZERO; 6];
+                for c in children {
                     match self.slot[c as usize] {
                         NONE => {
-                            let h = irradiance_from_axes(&total, child.normal);
-                            self.push_pull(c, Down::Irradiance(h), gathered, out);
+                            let child = h.node(c);
                             let sent = out.b[c as usize] * child.area;
                             for (p, share) in power.iter_mut().zip(power_shares(child.normal)) {
                                 *p += sent * share;
                             }
                         }
                         s => {
-                            self.push_pull(c, Down::Axes(total), gathered, out);
                             for (p, q) in power.iter_mut().zip(&out.q[s as usize]) {
                                 *p += *q;
                             }
@@ -268,6 +422,51 @@ impl<'a> System<'a> {
                 out.q[slot as usize] = power;
             }
         }
+    }
+
+    /// Pulls the leaves' radiosities up the hierarchy from `id`.
+    fn pull(&self, id: u32, out: &mut Field) {
+        for c in self.hierarchy.node(id).children.into_iter().flatten() {
+            self.pull(c, out);
+        }
+        self.aggregate(id, out);
+    }
+
+    /// The coarse correction after a sweep from `before` to `after`: the error is taken to be
+    /// uniform, α per channel, with α the residual's area mean over that of (1 − ρT) (the
+    /// residual a uniform field of one leaves, T the reflecting part of each leaf's total);
+    /// `after` becomes the sweep from `before` + α, which adds α ρ T to each leaf's radiosity.
+    /// Returns α.
+    pub(super) fn correct(&self, before: &Field, after: &mut Field) -> Rgb {
+        let h = self.hierarchy;
+        let (mut residual, mut weight) = (Rgb::ZERO, Rgb::ZERO);
+        for (i, n) in h.nodes.iter().enumerate() {
+            if n.is_leaf() && !n.is_cluster() {
+                residual += (after.b[i] - before.b[i]) * n.area;
+                weight += (Rgb::splat(1.0) - n.reflectance * self.reflecting[i]) * n.area;
+            }
+        }
+        let alpha = Rgb::new(
+            ratio(residual.r, weight.r),
+            ratio(residual.g, weight.g),
+            ratio(residual.b, weight.b),
+        );
+        for (i, n) in h.nodes.iter().enumerate() {
+            if n.is_cluster() {
+                continue;
+            }
+            after.incoming[i] += alpha;
+            if n.is_leaf() {
+                let lift = alpha * self.reflecting[i];
+                after.irradiance[i] += lift;
+                after.b[i] += n.reflectance.mul_rgb(lift);
+                (after.low[i], after.high[i]) = (after.b[i], after.b[i]);
+            }
+        }
+        if let Some(root) = h.root {
+            self.pull(root, after);
+        }
+        alpha
     }
 
     /// Σ area × |change of radiosity| over the leaves, relative to Σ area × reflected direct
@@ -298,4 +497,9 @@ enum Down {
 struct Gathered {
     h: Vec<Rgb>,
     g: Vec<Axes>,
+}
+
+/// `a / b`, zero where `b` is not positive.
+fn ratio(a: f64, b: f64) -> f64 {
+    if b > 0.0 { a / b } else { 0.0 }
 }

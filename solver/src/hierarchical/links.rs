@@ -36,8 +36,13 @@ use crate::lambert::ReceivingPoint;
 #[derive(Clone, Copy, Debug)]
 pub(crate) enum Transfer {
     /// Element to element: the receiver's mean irradiance is `factor` times the source's
-    /// radiosity; `spread` is the form factor's range over the receiver (unoccluded).
-    Factor { factor: f64, spread: f64 },
+    /// radiosity; `spread` is the form factor's range over the receiver (unoccluded), `visible`
+    /// the fraction of it left by occlusion (already in `factor`).
+    Factor {
+        factor: f64,
+        spread: f64,
+        visible: f64,
+    },
     /// From or to a cluster: the source's intensity along unit `direction` (source to receiver),
     /// over the squared `distance`, times the fraction `visible` of open segments.
     Far {
@@ -65,6 +70,8 @@ pub(crate) struct Radiosities<'s> {
     /// The least and greatest radiosity of each element's leaves.
     pub low: &'s [Rgb],
     pub high: &'s [Rgb],
+    /// The mean radiosity each element gathers (zero before any is gathered).
+    pub incoming: &'s [Rgb],
     pub slot: &'s [u32],
 }
 
@@ -73,6 +80,15 @@ impl Radiosities<'_> {
     /// parts (a light in the middle of a wall leaves halves of equal means).
     pub(super) fn spread(&self, id: u32) -> Rgb {
         (self.high[id as usize] - self.low[id as usize]) * 0.5
+    }
+
+    /// How far element `s`'s light may be from what element `r` gathers on average, per unit
+    /// form factor: a leaf's gathered light is scaled to its total, so a form factor off by δ
+    /// brings δ times the source's difference from that mean wrongly, not δ times the source;
+    /// and the source's mean stands for parts up to its spread away.
+    pub(super) fn excess(&self, r: u32, s: u32) -> Rgb {
+        let difference = (self.b[s as usize] - self.incoming[r as usize]).map(f64::abs);
+        difference + self.spread(s)
     }
 
     /// The power the source sends (W).
@@ -292,15 +308,16 @@ impl Refiner<'_> {
                 rn.normal.dot(-direction).max(0.0)
             };
             let irradiance = state.intensity(sn, s, direction) * (facing / distance2);
-            return (
-                transfer,
-                rn.reflectance.mul_rgb(irradiance).mean() * rn.area,
-            );
+            return (transfer, weight(rn).mul_rgb(irradiance).mean() * rn.area);
         }
         // A quick estimate decides, and a kept link gets its factor the careful way (the quick
         // spread is kept for judging it again).
         let (factor, spread) = self.quick_factor(r, s);
-        let transfer = Transfer::Factor { factor, spread };
+        let transfer = Transfer::Factor {
+            factor,
+            spread,
+            visible: 1.0,
+        };
         (transfer, self.factor_error(r, s, factor, spread, state))
     }
 
@@ -325,22 +342,19 @@ impl Refiner<'_> {
         (factor, spread(&factors, rn, at))
     }
 
-    /// What a link can carry at most: the receiver reflects at most all the light the source
-    /// sends, and at most its own area times the source's radiosity.
+    /// What a link can carry wrongly at most: between clusters all the light the source sends;
+    /// between elements a form factor is at most one and at most the source's area over the
+    /// receiver's, so the receiver reflects at most the smaller area times the source's
+    /// [`Radiosities::excess`] wrongly.
     fn bound(&self, r: u32, s: u32, state: &Radiosities) -> f64 {
         let (rn, sn) = (self.hierarchy.node(r), self.hierarchy.node(s));
         let power = state.power(sn, s);
         let limit = if sn.is_cluster() || rn.is_cluster() {
             power
         } else {
-            let b = state.b[s as usize];
-            Rgb::new(
-                power.r.min(b.r * rn.area),
-                power.g.min(b.g * rn.area),
-                power.b.min(b.b * rn.area),
-            )
+            state.excess(r, s) * rn.area.min(sn.area)
         };
-        rn.reflectance.mul_rgb(limit).mean()
+        weight(rn).mul_rgb(limit).mean()
     }
 
     /// The link from element `s` to element `r` with its mean form factor computed carefully
@@ -358,7 +372,11 @@ impl Refiner<'_> {
             let t = &h.triangles[rn.first as usize].points;
             factor = triangle_mean(t, &at, LEAF_DEPTH);
         }
-        Transfer::Factor { factor, spread }
+        Transfer::Factor {
+            factor,
+            spread,
+            visible: 1.0,
+        }
     }
 
     /// The light an element-to-element link with form factor `factor` (spread `spread` over
@@ -370,8 +388,9 @@ impl Refiner<'_> {
             return self.bound(r, s, state);
         }
         // The source's mean stands for parts up to its spread away from it.
-        let wrong = state.b[s as usize] * spread + state.spread(s) * factor;
-        rn.reflectance.mul_rgb(wrong).mean() * rn.area
+        let difference = (state.b[s as usize] - state.incoming[r as usize]).map(f64::abs);
+        let wrong = difference * spread + state.spread(s) * factor;
+        weight(rn).mul_rgb(wrong).mean() * rn.area
     }
 
     /// The error a kept link still carries, with the radiosities as they are now: links over
@@ -379,7 +398,9 @@ impl Refiner<'_> {
     pub(super) fn error_of(&self, link: &Link, state: &Radiosities) -> f64 {
         let (r, s) = (link.receiver, link.source);
         match link.transfer {
-            Transfer::Factor { factor, spread } => self.factor_error(r, s, factor, spread, state),
+            Transfer::Factor { factor, spread, .. } => {
+                self.factor_error(r, s, factor, spread, state)
+            }
             Transfer::Far { .. } => self.estimate(r, s, state).1,
         }
     }
@@ -413,9 +434,10 @@ impl Refiner<'_> {
         }
         let visible = if weight > 0.0 { seen / weight } else { 1.0 };
         match transfer {
-            Transfer::Factor { factor, spread } => Transfer::Factor {
+            Transfer::Factor { factor, spread, .. } => Transfer::Factor {
                 factor: factor * visible,
                 spread,
+                visible,
             },
             Transfer::Far {
                 direction,
@@ -446,6 +468,18 @@ fn spread(factors: &[f64], rn: &Node, at: impl Fn(DVec3) -> f64) -> f64 {
             (lo.min(f), hi.max(f))
         });
     (hi - lo).max(0.0)
+}
+
+/// What an error of a receiver's irradiance weighs: its reflectance, since what it reflects is
+/// what the solution carries on; for a surface that reflects nothing, all of it, since what it
+/// receives is the light it absorbs, which the energy account and its total rest on (an emitter's
+/// total says how much of its light leaves the scene).
+fn weight(receiver: &Node) -> Rgb {
+    if receiver.reflects() {
+        receiver.reflectance
+    } else {
+        Rgb::splat(1.0)
+    }
 }
 
 /// Whether two nodes' bounding spheres overlap: then no estimate holds, only a bound.

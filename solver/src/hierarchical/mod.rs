@@ -19,10 +19,12 @@
 //! so the links grow about linearly with the scene. Results do not depend on the thread count:
 //! every parallel step collects in order.
 
+mod balance;
 mod final_gather;
 mod iterate;
 mod links;
 mod shaft;
+mod totals;
 mod transfer;
 mod tree;
 
@@ -42,6 +44,7 @@ use crate::progressive::{
     ConvergencePoint, OVERLAY_CAP, Solution, SolveStats, SolverOptions, StopReason, check_mesh,
     direct_at_new, direct_irradiance,
 };
+use crate::solids::Enclosures;
 use final_gather::{FinalGather, Gathered};
 use iterate::{Field, System};
 use links::{Link, RefineCounts, Refiner};
@@ -108,6 +111,14 @@ pub struct HierarchyStats {
     pub gather_rays: u64,
     /// Jacobi sweeps, over all passes.
     pub sweeps: usize,
+    /// Sweeps of the solve that balances the leaves' energy (see `links_lost`).
+    pub balance_sweeps: usize,
+    /// The share of the light the leaves send toward surfaces that their links lost, before it
+    /// was given back as ambient light (channel means).
+    pub links_lost: f64,
+    /// The share of the light the balanced leaves receive that the final gather lost, before it
+    /// was given back as ambient light (channel means).
+    pub gather_lost: f64,
     /// Seconds spent making and refining links.
     pub link_seconds: f64,
     /// Seconds spent sweeping.
@@ -168,7 +179,20 @@ pub fn solve_hierarchical_refining(
 
     let started = Instant::now();
     let hierarchy = Hierarchy::build(&first, |s| scene.surfaces[s].reflectance);
-    let mut system = System::new(&hierarchy, leaf_direct(scene, &first, &hierarchy, &direct));
+    let enclosures = Enclosures::new(scene, visibility);
+    let (enclosed_leaves, enclosed) = totals::enclosed_leaves(
+        &first,
+        &hierarchy.leaf_of_element,
+        hierarchy.nodes.len(),
+        &enclosures,
+    );
+    let tol = visibility.contact_distance();
+    let mut system = System::new(
+        &hierarchy,
+        leaf_direct(scene, &first, &hierarchy, &direct),
+        enclosed_leaves,
+        tol,
+    );
     let shafts = Shafts::new(scene, visibility);
     let refiner = Refiner {
         hierarchy: &hierarchy,
@@ -176,7 +200,7 @@ pub fn solve_hierarchical_refining(
         tolerance: options.link_tol * reflected_power(&system),
         rays: options.visibility_rays,
         seed: options.seed,
-        tol: visibility.contact_distance(),
+        tol,
         stop: Some(options),
     };
     let mut stats = HierarchyStats {
@@ -204,24 +228,38 @@ pub fn solve_hierarchical_refining(
     let all: Vec<usize> = (0..first.receiver_count()).collect();
     let leaves = vertex_leaves(&first, &hierarchy);
     let mut stop = solved.stop;
-    let (reflected, first_b) = match final_gather_at(
-        &first, &all, &leaves, &direct, &gather, None, options, progress,
-    ) {
-        Some((values, rays, first_b)) => {
-            stats.gather_rays += rays;
-            (values, first_b)
-        }
-        None => {
-            stop = options.stop_now().unwrap_or(stop);
-            (leaf_values(&leaves, &solved.field), Vec::new())
-        }
+    let light = final_gather_at(
+        &first, &all, &leaves, &direct, &enclosed, &gather, None, options, progress,
+    )
+    .unwrap_or_else(|| {
+        stop = options.stop_now().unwrap_or(stop);
+        leaf_values(&leaves, &solved.field, &system)
+    });
+    stats.gather_rays += light.rays;
+    let display_gain = if light.first_b.is_empty() {
+        Rgb::ZERO
+    } else {
+        let (gain, lost) = balance::display_gain(
+            &system,
+            &solved.field,
+            &first,
+            &light.reflected,
+            &light.totals,
+        );
+        stats.gather_lost = lost;
+        gain
     };
+    let mut light = light;
+    light.add_ambient(&first, &all, display_gain);
+    let first_b = light.first_b;
     let mut gather_seconds = t.elapsed().as_secs_f64();
     let mut current = Current {
         mesh: mesh.clone(),
         disc: first.clone(),
         direct,
-        reflected,
+        reflected: light.reflected,
+        totals: light.totals,
+        enclosed,
     };
 
     // Rounds of refinement: new vertices gather through the links of the first mesh's leaves.
@@ -234,32 +272,43 @@ pub fn solve_hierarchical_refining(
             let disc = Discretization::new(scene, &next, options.elements_per_patch);
             let ([mut direct, mut reflected], fresh) =
                 disc.carried(&current.disc, [&current.direct, &current.reflected]);
+            let ([mut totals], _) = disc.carried(&current.disc, [&current.totals]);
+            let ([mut enclosed], _) = disc.carried(&current.disc, [&current.enclosed]);
             let t = Instant::now();
             let new_direct = direct_at_new(&exact, &disc, &fresh, options, progress)?;
             direct_seconds += t.elapsed().as_secs_f64();
             let t = Instant::now();
             let leaves: Vec<u32> = fresh.iter().map(|&v| locate.leaf(&disc, v)).collect();
+            let new_enclosed: Vec<bool> = fresh
+                .par_iter()
+                .map(|&v| enclosures.encloses(&disc.receivers[v], disc.receiver_surface[v]))
+                .collect();
             let unstoppable = SolverOptions {
                 deadline: None,
                 interrupt: None,
                 ..options.clone()
             };
-            let (values, rays, _) = final_gather_at(
+            let light = final_gather_at(
                 &disc,
                 &fresh,
                 &leaves,
                 &new_direct,
+                &new_enclosed,
                 &gather,
                 Some(&first_b),
                 &unstoppable,
                 progress,
             )
             .unwrap_or_default();
-            stats.gather_rays += rays;
+            let mut light = light;
+            light.add_ambient(&disc, &fresh, display_gain);
+            stats.gather_rays += light.rays;
             gather_seconds += t.elapsed().as_secs_f64();
             for (k, &v) in fresh.iter().enumerate() {
                 direct[v] = new_direct[k];
-                reflected[v] = values[k];
+                reflected[v] = light.reflected[k];
+                totals[v] = light.totals[k];
+                enclosed[v] = new_enclosed[k];
             }
             gathered += fresh.len();
             remeshes += 1;
@@ -268,6 +317,8 @@ pub fn solve_hierarchical_refining(
                 disc,
                 direct,
                 reflected,
+                totals,
+                enclosed,
             };
         }
     }
@@ -279,6 +330,13 @@ pub fn solve_hierarchical_refining(
         .zip(&current.reflected)
         .map(|(&d, &r)| d + r)
         .collect();
+    let account = Account {
+        scene,
+        disc,
+        irradiance: &irradiance,
+        totals: &current.totals,
+        enclosed: &current.enclosed,
+    };
     let solve_stats = SolveStats {
         stop,
         iterations: stats.sweeps,
@@ -290,7 +348,7 @@ pub fn solve_hierarchical_refining(
         remeshes,
         gathered,
         gather_seconds,
-        ..energy_stats(scene, disc, &irradiance, &system, &solved.field, &stats)
+        ..account.stats(solved.unshot, &stats)
     };
     let radiosity: Vec<Rgb> = (0..disc.receiver_count())
         .map(|v| disc.emission[v] + disc.reflectance[v].mul_rgb(irradiance[v]))
@@ -309,12 +367,15 @@ pub fn solve_hierarchical_refining(
     Ok((current.mesh, solution))
 }
 
-/// The display mesh of the latest round and the light at its vertices.
+/// The display mesh of the latest round and the light at its vertices, with each vertex's total
+/// and whether a closed solid encloses it.
 struct Current {
     mesh: SceneMesh,
     disc: Discretization,
     direct: Vec<Rgb>,
     reflected: Vec<Rgb>,
+    totals: Vec<f64>,
+    enclosed: Vec<bool>,
 }
 
 impl Current {
@@ -377,16 +438,21 @@ impl<'h> LeafLocator<'h> {
 /// How far into its own triangles a new vertex is looked for, in its surface's scale.
 const LOCATE_NUDGE: f64 = 1e-9;
 
-/// Each vertex's leaf's own irradiance (zero where it has no leaf): what a vertex keeps when
-/// the run stops before the final gather.
-fn leaf_values(leaves: &[u32], field: &Field) -> Vec<Rgb> {
-    leaves
+/// Each vertex's leaf's own irradiance and total (zero and one where it has no leaf): what a
+/// vertex keeps when the run stops before the final gather.
+fn leaf_values(leaves: &[u32], field: &Field, system: &System) -> PointLight {
+    let (reflected, totals) = leaves
         .iter()
         .map(|&l| match l {
-            NONE => Rgb::ZERO,
-            l => field.irradiance[l as usize],
+            NONE => (Rgb::ZERO, 1.0),
+            l => (field.irradiance[l as usize], system.totals[l as usize]),
         })
-        .collect()
+        .unzip();
+    PointLight {
+        reflected,
+        totals,
+        ..PointLight::default()
+    }
 }
 
 /// The power the leaves reflect of the direct light (W, channel mean): the light the hierarchy
@@ -425,6 +491,8 @@ struct Solved {
     field: Field,
     stop: StopReason,
     residual: f64,
+    /// The leaves' power still to be propagated: Σ area × the last sweep's change (W).
+    unshot: Rgb,
     history: Vec<ConvergencePoint>,
 }
 
@@ -445,6 +513,7 @@ fn link_and_sweep(
         field: system.initial_field(),
         stop: StopReason::Converged,
         residual: 0.0,
+        unshot: Rgb::ZERO,
         history: vec![ConvergencePoint {
             iteration: 0,
             residual: 1.0,
@@ -459,54 +528,114 @@ fn link_and_sweep(
     let (links, counts) = refine_pair(refiner, root, root, &system.radiosities(&solved.field));
     progress.finish();
     add_counts(stats, counts);
-    system.set_links(links);
+    system.set_links(links, None);
     stats.link_seconds += t.elapsed().as_secs_f64();
     loop {
         let t = Instant::now();
-        let stop = sweep_until(system, &mut solved, options, stats, clock, progress);
+        let stop = sweep_until(
+            system,
+            &mut solved,
+            options,
+            &mut stats.sweeps,
+            clock,
+            progress,
+        );
         stats.sweep_seconds += t.elapsed().as_secs_f64();
         stats.refinement_passes += 1;
         if stop.is_some() || stats.refinement_passes >= MAX_PASSES {
             solved.stop = stop.unwrap_or(StopReason::Converged);
+            if stop.is_none() {
+                balance_energy(system, &mut solved, options, stats, clock, progress);
+            }
             return solved;
         }
         let t = Instant::now();
         let relinked = relink(refiner, system, &solved.field);
         stats.link_seconds += t.elapsed().as_secs_f64();
-        let Some((links, counts)) = relinked else {
+        let Some((links, counts, changed)) = relinked else {
+            balance_energy(system, &mut solved, options, stats, clock, progress);
             return solved;
         };
         add_counts(stats, counts);
-        system.set_links(links);
+        system.set_links(links, Some(&changed));
     }
 }
 
-/// Jacobi sweeps until the relative residual is below `epsilon`; `Some` reason if the sweeps
-/// must stop before that (the sweep cap, the deadline, an interrupt).
-fn sweep_until(
-    system: &System,
+/// Corrects a converged solution by the light its links lose, received as ambient light
+/// ([`balance`]): the response to that light is solved by the same sweeps, and added so that
+/// what the leaves send is what they receive. Left as it is if the sweeps must stop first.
+fn balance_energy(
+    system: &mut System,
     solved: &mut Solved,
     options: &SolverOptions,
     stats: &mut HierarchyStats,
     clock: &dyn Fn() -> f64,
     progress: &dyn Progress,
+) {
+    let t = Instant::now();
+    let direct = system.set_direct(system.ambient_source());
+    let mut response = Solved {
+        field: system.initial_field(),
+        stop: StopReason::Converged,
+        residual: 0.0,
+        unshot: Rgb::ZERO,
+        history: Vec::new(),
+    };
+    let stop = sweep_until(
+        system,
+        &mut response,
+        options,
+        &mut stats.balance_sweeps,
+        clock,
+        progress,
+    );
+    system.set_direct(direct);
+    if stop.is_none() {
+        let (sent, received) = system.transport(&solved.field);
+        stats.links_lost = 1.0 - received.mean() / sent.mean().max(f64::MIN_POSITIVE);
+        let gain = balance::ambient_gain(system, &solved.field, &response.field);
+        solved
+            .field
+            .add_scaled(&response.field, gain, &system.reflecting);
+    }
+    stats.sweep_seconds += t.elapsed().as_secs_f64();
+}
+
+/// Jacobi sweeps, each followed by the coarse correction ([`System::correct`]), until the
+/// relative residual is below `epsilon`; `Some` reason if the sweeps must stop before that (the
+/// sweep cap, the deadline, an interrupt). Should a correction ever make the residual grow, the
+/// sweeps go on without it: plain sweeps are a contraction.
+fn sweep_until(
+    system: &System,
+    solved: &mut Solved,
+    options: &SolverOptions,
+    sweeps: &mut usize,
+    clock: &dyn Fn() -> f64,
+    progress: &dyn Progress,
 ) -> Option<StopReason> {
     progress.start("sweeps", 1000);
     let goal = -options.epsilon.log10();
+    let (mut correcting, mut previous) = (true, f64::INFINITY);
     let stop = loop {
         if let Some(reason) = options.stop_now() {
             break Some(reason);
         }
-        if stats.sweeps >= options.max_shots {
+        if *sweeps >= options.max_shots {
             break Some(StopReason::ShotLimit);
         }
-        let next = system.sweep(&solved.field);
-        let (change, _) = system.change(&solved.field, &next);
+        let mut next = system.sweep(&solved.field);
+        if correcting {
+            system.correct(&solved.field, &mut next);
+        }
+        let (change, signed) = system.change(&solved.field, &next);
+        correcting &= change <= previous;
+        previous = change;
         solved.field = next;
         solved.residual = change;
-        stats.sweeps += 1;
+        solved.unshot = signed;
+        *sweeps += 1;
         solved.history.push(ConvergencePoint {
-            iteration: stats.sweeps,
+            iteration: *sweeps,
             residual: change,
             seconds: clock(),
         });
@@ -519,54 +648,52 @@ fn sweep_until(
     stop
 }
 
-/// The energy figures of a solution with `irradiance` at the vertices: what is absorbed, what
-/// the hierarchy's leaves send, what escapes, and the rest (as in the gathering solvers: the
-/// light the vertices reflect less what the leaves send).
-fn energy_stats(
-    scene: &Scene,
-    disc: &Discretization,
-    irradiance: &[Rgb],
-    system: &System,
-    field: &Field,
-    stats: &HierarchyStats,
-) -> SolveStats {
-    let emitted = scene.emitted_power();
-    let absorbed = disc.integrate(irradiance, |e| {
-        Rgb::splat(1.0) - scene.surfaces[e.surface].reflectance
-    });
-    let reflected = disc.integrate(irradiance, |e| scene.surfaces[e.surface].reflectance);
-    let received = disc.integrate(irradiance, |_| Rgb::splat(1.0));
-    let sent: Rgb = system
-        .hierarchy
-        .nodes
-        .iter()
-        .enumerate()
-        .filter(|(_, n)| n.is_leaf() && !n.is_cluster())
-        .map(|(i, n)| field.b[i] * n.area)
-        .sum();
-    let unshot = reflected - sent;
-    SolveStats {
-        stop: StopReason::Converged,
-        shots: 0,
-        iterations: 0,
-        residual: 0.0,
-        patches: stats.leaves,
-        receivers: disc.receiver_count(),
-        rays_cast: stats.link_rays + stats.gather_rays,
-        emitted,
-        absorbed,
-        unshot,
-        escaped: emitted + sent - received,
-        unshot_fraction: unshot.mean().abs() / emitted.mean().max(f64::MIN_POSITIVE),
-        direct_seconds: 0.0,
-        direct_estimated: 0,
-        direct_beyond_cap: 0,
-        shooting_seconds: 0.0,
-        remeshes: 0,
-        gathered: 0,
-        gather_seconds: 0.0,
-        hierarchy: None,
-        photon_map: None,
+/// The energy account of a solution, each term from what the solution itself sends where: the
+/// power absorbed, ∫ (1 − ρ) H, and the power sent out of the scene, ∫ B (1 − T) with T each
+/// vertex's total (the share of its view that fronts of surfaces cover: one inside a room, what
+/// the final gather's form factors sum to elsewhere). Nothing is a difference of other terms, so
+/// emitted − absorbed − escaped − unshot measures the solution's own error.
+struct Account<'a> {
+    scene: &'a Scene,
+    disc: &'a Discretization,
+    irradiance: &'a [Rgb],
+    totals: &'a [f64],
+    enclosed: &'a [bool],
+}
+
+impl Account<'_> {
+    fn stats(&self, unshot: Rgb, stats: &HierarchyStats) -> SolveStats {
+        let (scene, disc) = (self.scene, self.disc);
+        let emitted = scene.emitted_power();
+        let absorbed = disc.integrate(self.irradiance, |e| {
+            Rgb::splat(1.0) - scene.surfaces[e.surface].reflectance
+        });
+        let radiosity: Vec<Rgb> = (0..disc.receiver_count())
+            .map(|v| disc.emission[v] + disc.reflectance[v].mul_rgb(self.irradiance[v]))
+            .collect();
+        let open = self.open_shares();
+        let escaped = disc.integrate_product(&radiosity, &open);
+        SolveStats {
+            patches: stats.leaves,
+            receivers: disc.receiver_count(),
+            rays_cast: stats.link_rays + stats.gather_rays,
+            emitted,
+            absorbed,
+            unshot,
+            escaped,
+            unshot_fraction: unshot.mean().abs() / emitted.mean().max(f64::MIN_POSITIVE),
+            closed: Some(self.enclosed.iter().all(|&e| e)),
+            ..SolveStats::default()
+        }
+    }
+
+    /// Each vertex's 1 − T: the share of its view that no front covers.
+    fn open_shares(&self) -> Vec<f64> {
+        self.totals
+            .iter()
+            .zip(self.enclosed)
+            .map(|(&t, &enclosed)| if enclosed { 0.0 } else { 1.0 - t })
+            .collect()
     }
 }
 
@@ -614,8 +741,13 @@ fn refine_pair(
 }
 
 /// The links judged again with the radiosities of `field`: each link carrying more light wrongly
-/// than the tolerance is refined; `None` when none is.
-fn relink(refiner: &Refiner, system: &System, field: &Field) -> Option<(Vec<Link>, RefineCounts)> {
+/// than the tolerance is refined; `None` when none is. With the links, what finding them counted
+/// and the receivers whose links changed.
+fn relink(
+    refiner: &Refiner,
+    system: &System,
+    field: &Field,
+) -> Option<(Vec<Link>, RefineCounts, Vec<u32>)> {
     let state = system.radiosities(field);
     let h = system.hierarchy;
     let splittable = |l: &Link| !(h.node(l.receiver).is_leaf() && h.node(l.source).is_leaf());
@@ -637,6 +769,11 @@ fn relink(refiner: &Refiner, system: &System, field: &Field) -> Option<(Vec<Link
             refine_pair(refiner, l.receiver, l.source, &state)
         })
         .collect();
+    let mut changed: Vec<u32> = condemned
+        .iter()
+        .map(|&i| system.links[i].receiver)
+        .collect();
+    changed.dedup();
     let added: usize = parts.iter().map(|p| p.0.len()).sum();
     let mut links = Vec::with_capacity(system.links.len() - condemned.len() + added);
     let mut counts = RefineCounts::default();
@@ -650,7 +787,7 @@ fn relink(refiner: &Refiner, system: &System, field: &Field) -> Option<(Vec<Link
             None => links.push(*l),
         }
     }
-    Some((links, counts))
+    Some((links, counts, changed))
 }
 
 /// For each vertex, the leaf of the first element (in the discretization's order) that holds it;
@@ -675,9 +812,39 @@ fn vertex_leaves(disc: &Discretization, hierarchy: &Hierarchy) -> Vec<u32> {
 /// the Cornell box one pass gets nearest the path-traced reference; a second overshoots).
 pub const LINEAR_PASSES: usize = 1;
 
+/// What a final gather found at its points.
+#[derive(Debug, Default)]
+struct PointLight {
+    /// The reflected irradiance at each point, scaled to its total.
+    reflected: Vec<Rgb>,
+    /// Each point's total: the share of its view that surfaces cover.
+    totals: Vec<f64>,
+    rays: u64,
+    /// The reflected radiosity at every point, for later gathers (empty for those).
+    first_b: Vec<Rgb>,
+}
+
+impl PointLight {
+    /// Adds an ambient irradiance of `gain` times each point's total (points of `disc`, on
+    /// surfaces that reflect).
+    fn add_ambient(&mut self, disc: &Discretization, points: &[usize], gain: Rgb) {
+        for (k, &v) in points.iter().enumerate() {
+            if disc.reflectance[v].max_channel() <= 0.0 {
+                continue;
+            }
+            let lift = gain * self.totals[k];
+            self.reflected[k] += lift;
+            if let Some(b) = self.first_b.get_mut(k) {
+                *b += disc.reflectance[v].mul_rgb(lift);
+            }
+        }
+    }
+}
+
 /// The final gather at `points` of `disc` (the `leaves` they lie in, their `direct`
-/// irradiance), in parallel and in order, with a progress bar: their reflected irradiance, the
-/// rays cast, and the reflected radiosity at every vertex, for later gathers. Near leaves are
+/// irradiance, whether each is `enclosed` by a closed solid), in parallel and in order, with a
+/// progress bar. Each point's light is scaled so that the form factors it gathered along sum to
+/// its total: one where it is enclosed; elsewhere their own sum, at most one. Near leaves are
 /// gathered again with linear radiosities from `linear` (the reflected radiosity at the first
 /// mesh's vertices), or, when `None` (the points are all of the first mesh's vertices), from
 /// this gather. `None` if the run must stop first.
@@ -687,15 +854,16 @@ fn final_gather_at(
     points: &[usize],
     leaves: &[u32],
     direct: &[Rgb],
+    enclosed: &[bool],
     gather: &FinalGather,
     linear: Option<&[Rgb]>,
     options: &SolverOptions,
     progress: &dyn Progress,
-) -> Option<(Vec<Rgb>, u64, Vec<Rgb>)> {
+) -> Option<PointLight> {
     let gather_at = |stage: &str, linear: Option<(&[Rgb], &[Gathered])>| {
         each_point(points, stage, options, progress, |k| {
             let v = points[k];
-            if leaves[k] == NONE || disc.reflectance[v].max_channel() <= 0.0 {
+            if leaves[k] == NONE {
                 return Gathered::default();
             }
             let x = &disc.receivers[v];
@@ -704,6 +872,19 @@ fn final_gather_at(
         })
     };
     let mut values = gather_at("final gather", None)?;
+    let totals: Vec<f64> = values
+        .iter()
+        .zip(enclosed)
+        .map(|(g, &enclosed)| if enclosed { 1.0 } else { g.unit.min(1.0) })
+        .collect();
+    let scaled = |g: &Gathered, total: f64| {
+        let sum = g.near + g.far;
+        if g.unit > 0.0 {
+            sum * (total / g.unit)
+        } else {
+            sum
+        }
+    };
     let mut rays: u64 = values.iter().map(|g| g.rays).sum();
     let own: Vec<Rgb>;
     let vertex_b = match linear {
@@ -711,9 +892,9 @@ fn final_gather_at(
         None => {
             own = points
                 .iter()
-                .zip(&values)
+                .zip(values.iter().zip(&totals))
                 .zip(direct)
-                .map(|((&v, g), &d)| disc.reflectance[v].mul_rgb(d + g.near + g.far))
+                .map(|((&v, (g, &t)), &d)| disc.reflectance[v].mul_rgb(d + scaled(g, t)))
                 .collect();
             &own
         }
@@ -725,7 +906,11 @@ fn final_gather_at(
             rays += n.rays;
         }
     }
-    let reflected: Vec<Rgb> = values.iter().map(|g| g.near + g.far).collect();
+    let reflected: Vec<Rgb> = values
+        .iter()
+        .zip(&totals)
+        .map(|(g, &t)| scaled(g, t))
+        .collect();
     let first_b = match linear {
         Some(_) => Vec::new(),
         None => points
@@ -735,7 +920,12 @@ fn final_gather_at(
             .map(|((&v, &r), &d)| disc.reflectance[v].mul_rgb(d + r))
             .collect(),
     };
-    Some((reflected, rays, first_b))
+    Some(PointLight {
+        reflected,
+        totals,
+        rays,
+        first_b,
+    })
 }
 
 /// `f` of each index into `points`, in parallel and in order, with a progress bar; `None` if the
@@ -791,7 +981,13 @@ mod tests {
             direct_irradiance(&scene, &disc, &vis, &options, &NoProgress).expect("direct light");
         let hierarchy = Hierarchy::build(&disc, |s| scene.surfaces[s].reflectance);
         let shafts = Shafts::new(&scene, &vis);
-        let mut system = System::new(&hierarchy, leaf_direct(&scene, &disc, &hierarchy, &direct));
+        let open = vec![false; hierarchy.nodes.len()];
+        let mut system = System::new(
+            &hierarchy,
+            leaf_direct(&scene, &disc, &hierarchy, &direct),
+            open,
+            vis.contact_distance(),
+        );
         let refiner = Refiner {
             hierarchy: &hierarchy,
             shafts: &shafts,
@@ -866,7 +1062,8 @@ mod tests {
             .filter(|&i| hierarchy.node(i).is_leaf())
             .collect();
         let e = leaf_direct(&scene, &disc, &hierarchy, &direct);
-        let system = System::new(&hierarchy, e.clone());
+        let open = vec![false; hierarchy.nodes.len()];
+        let system = System::new(&hierarchy, e.clone(), open.clone(), vis.contact_distance());
         let field = system.initial_field();
         let whole = refiner(f64::INFINITY);
         let rows: Vec<Vec<(usize, f64)>> = leaves
@@ -910,7 +1107,8 @@ mod tests {
             / area;
         let mut previous = f64::INFINITY;
         for tol in [1e-3, 1e-4, 1e-5, 1e-6, 1e-7] {
-            let mut system = System::new(&hierarchy, e.clone());
+            let mut system =
+                System::new(&hierarchy, e.clone(), open.clone(), vis.contact_distance());
             let mut stats = HierarchyStats::default();
             let emitted = scene.emitted_power().mean();
             let solved = link_and_sweep(

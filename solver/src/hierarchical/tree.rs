@@ -56,6 +56,11 @@ impl Node {
     pub(super) fn is_leaf(&self) -> bool {
         self.children.is_none()
     }
+
+    /// Whether the node reflects any light (a cluster: some surface in it does).
+    pub(super) fn reflects(&self) -> bool {
+        self.reflectance.max_channel() > 0.0
+    }
 }
 
 /// One mesh triangle in the hierarchy's order.
@@ -77,20 +82,21 @@ pub(crate) struct Hierarchy {
     pub triangles: Vec<Triangle>,
     /// Area of the triangles before each one and including it, for sampling by area.
     pub cumulative_area: Vec<f64>,
-    /// The leaf of each element of the discretization (`NONE` on surfaces that reflect nothing).
+    /// The leaf of each element of the discretization (`NONE` for elements without area).
     pub leaf_of_element: Vec<u32>,
 }
 
 impl Hierarchy {
-    /// The hierarchy over the elements of `disc` on surfaces that reflect some light (the others
-    /// still block it, but neither send nor receive reflected light).
+    /// The hierarchy over the elements of `disc`. Surfaces that reflect nothing are in it too:
+    /// they send no reflected light, but what they receive counts in each receiver's total and
+    /// in the energy account (light that meets a black wall is absorbed, not lost).
     pub(super) fn build(
         disc: &Discretization,
         reflectance: impl Fn(SurfaceId) -> Rgb,
     ) -> Hierarchy {
         let mut by_surface: Vec<Vec<u32>> = vec![Vec::new(); disc.offsets.len()];
         for (i, e) in disc.elements.iter().enumerate() {
-            if e.area > 0.0 && reflectance(e.surface).max_channel() > 0.0 {
+            if e.area > 0.0 {
                 by_surface[e.surface].push(i as u32);
             }
         }

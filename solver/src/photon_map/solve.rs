@@ -60,6 +60,7 @@ pub fn solve_photon_map(
     map.stats.estimate_seconds = estimating.elapsed().as_secs_f64();
     let irradiance: Vec<Rgb> = direct.iter().zip(&indirect).map(|(&d, &i)| d + i).collect();
     let mut stats = energy_stats(scene, &disc, &irradiance);
+    stats.closed = Some(crate::solids::closed_scene(scene, visibility, &disc));
     stats.stop = stop.unwrap_or(StopReason::Converged);
     stats.gathered = gathered;
     stats.direct_seconds = direct_seconds;
