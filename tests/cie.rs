@@ -311,23 +311,20 @@ fn cie_5_8_inter_reflection() {
     assert!(previous < 1e-2, "{previous}");
 }
 
-/// 5.8 with the hierarchical solver: the six face means of the reflected illuminance (its
-/// total less the exact direct light, vertex by vertex) within 2 % of the flux balance (the
-/// dense solve above: 0.5 %). Measured: 0.61, 0.92, 0.87, 0.05 and 1.77 % at ρ = 0.05 to 0.95,
-/// low but for 0.8 and 0.95. A coarse receiver reads its mean form factor, which a leaf in a
-/// face's bright middle exceeds toward the walls beside it; at ρ = 0.95 the light bounces twenty
-/// times, and that small excess of the brightest leaves with it.
+/// 5.8 with the hierarchical solver at its default tolerances: the six face means of the
+/// reflected illuminance (its total less the exact direct light, vertex by vertex) within 0.5 %
+/// of the flux balance, at every reflectance up to 0.99, where the light bounces a hundred
+/// times. A link that delivers a little less of a bright source's light than it sends loses
+/// that at every bounce; the solver gives the light its links lose back as ambient light
+/// (measured: within 0.12 % at ρ = 0.05 and 0.5, 0.16 % at 0.95; before, 0.6 to 1.8 %).
 #[test]
 fn cie_5_8_inter_reflection_hierarchical() {
     let area = 6.0 * cie::CUBE_SIDE * cie::CUBE_SIDE;
-    for rho in [0.05, 0.2, 0.5, 0.8, 0.95] {
+    for rho in [0.05, 0.2, 0.5, 0.8, 0.95, 0.99] {
         let scene = cie::reflecting_cube(rho);
         let visibility = Visibility::build(&scene);
         let mesh = mesh_scene_uniform(&scene, 6000).expect("meshes");
-        let options = SolverOptions {
-            epsilon: 1e-6,
-            ..SolverOptions::default()
-        };
+        let options = SolverOptions::default();
         let full =
             solve_hierarchical(&scene, &mesh, &visibility, &options, &NoProgress).expect("solves");
         let direct_only = SolverOptions {
@@ -344,6 +341,6 @@ fn cie_5_8_inter_reflection_hierarchical() {
             .map(|(f, d)| f.iter().zip(d).map(|(&f, &d)| (f - d).mean()).collect())
             .collect();
         let case = format!("5.8 hierarchical, rho {rho}, face means");
-        check_face_means(&case, &scene, &mesh, &reflected, reference, 2e-2);
+        check_face_means(&case, &scene, &mesh, &reflected, reference, 5e-3);
     }
 }

@@ -7,7 +7,7 @@ use crate::model::{Camera, Scene, Surface};
 use crate::polygon;
 
 /// Names and one-line descriptions of the built-in scenes.
-pub const NAMES: [(&str, &str); 9] = [
+pub const NAMES: [(&str, &str); 11] = [
     (
         "cornell",
         "the measured Cornell box (mm): red and green walls, two white blocks, ceiling light",
@@ -19,6 +19,14 @@ pub const NAMES: [(&str, &str); 9] = [
     (
         "furnace",
         "closed unit cube, every face emitting (E = 1) and reflecting (rho = 0.5): B = E / (1 - rho)",
+    ),
+    (
+        "furnace-l",
+        "closed L-shaped room, 2 x 2 x 1 less a quarter, every face emitting (E = 1) and reflecting (rho = 0.5): B = E / (1 - rho), with occlusion",
+    ),
+    (
+        "furnace-long",
+        "closed 8 x 1 x 1 box, every face emitting (E = 1) and reflecting (rho = 0.5): B = E / (1 - rho)",
     ),
     (
         "boxworld",
@@ -52,6 +60,8 @@ pub fn builtin(name: &str) -> Option<Scene> {
         "cornell" => Some(cornell()),
         "textbook" => Some(textbook()),
         "furnace" => Some(furnace(1.0, 0.5)),
+        "furnace-l" => Some(l_room_furnace(1.0, 0.5)),
+        "furnace-long" => Some(long_furnace(1.0, 0.5)),
         "boxworld" => Some(boxworld(100, 1)),
         "bars" => Some(crossed_bars()),
         "cie-5.3" => Some(crate::cie::area_source()),
@@ -301,6 +311,69 @@ pub fn furnace(emission: f64, reflectance: f64) -> Scene {
         fov_deg: 100.0,
     });
     scene
+}
+
+/// A closed 8 x 1 x 1 box whose six inward faces all emit `emission` and reflect `reflectance`:
+/// the exact radiosity is `emission / (1 - reflectance)` everywhere, though most of each long
+/// face sees the box's far end at grazing angles.
+pub fn long_furnace(emission: f64, reflectance: f64) -> Scene {
+    let mut scene = closed_box(v(8.0, 1.0, 1.0), emission, reflectance);
+    scene.name = "furnace-long".into();
+    scene.camera = Some(Camera {
+        eye: v(0.05, 0.5, 0.5),
+        target: v(8.0, 0.5, 0.5),
+        up: v(0.0, 0.0, 1.0),
+        fov_deg: 70.0,
+    });
+    scene
+}
+
+/// A closed L-shaped room (the 2 x 2 x 1 box less its quarter x, y > 1) whose eight inward
+/// faces all emit `emission` and reflect `reflectance`: the exact radiosity is `emission / (1 -
+/// reflectance)` everywhere, though the room's inner corner hides part of it from most points.
+/// The floor and ceiling are L-shaped hexagons; the walls meet them and each other edge to edge.
+pub fn l_room_furnace(emission: f64, reflectance: f64) -> Scene {
+    let outline = [
+        v(0.0, 0.0, 0.0),
+        v(2.0, 0.0, 0.0),
+        v(2.0, 1.0, 0.0),
+        v(1.0, 1.0, 0.0),
+        v(1.0, 2.0, 0.0),
+        v(0.0, 2.0, 0.0),
+    ];
+    let up = v(0.0, 0.0, 1.0);
+    let inside = v(0.5, 0.5, 0.5);
+    let mut faces = vec![
+        ("floor".to_owned(), facing(outline.to_vec(), inside, false)),
+        (
+            "ceiling".to_owned(),
+            facing(outline.iter().map(|&p| p + up).collect(), inside, false),
+        ),
+    ];
+    for (i, &a) in outline.iter().enumerate() {
+        let b = outline[(i + 1) % outline.len()];
+        // The room lies to the left of each edge of the counter-clockwise outline.
+        let left = up.cross(b - a).normalize();
+        let wall = vec![a, b, b + up, a + up];
+        let point = (a + b) / 2.0 + up * 0.5 + left * 0.1;
+        faces.push((format!("wall{i}"), facing(wall, point, false)));
+    }
+    Scene {
+        name: "furnace-l".into(),
+        camera: Some(Camera {
+            eye: v(1.9, 0.1, 0.5),
+            target: v(0.3, 1.7, 0.5),
+            up,
+            fov_deg: 90.0,
+        }),
+        surfaces: faces
+            .into_iter()
+            .map(|(name, polygon)| {
+                Surface::new(name, polygon, Rgb::splat(reflectance))
+                    .with_emission(Rgb::splat(emission))
+            })
+            .collect(),
+    }
 }
 
 /// A closed box `[0, size.x] x [0, size.y] x [0, size.z]` whose six faces face inward, each
