@@ -254,6 +254,14 @@ impl Visibility {
         self.contact
     }
 
+    /// Distance within which a point where surfaces meet counts as lying on the other's plane:
+    /// polygons are planar only to [`PLANARITY_TOLERANCE`](crate::PLANARITY_TOLERANCE) of their
+    /// size, and files rounded to six decimals put walls that meet that far apart (CornellBox-
+    /// Sphere's back wall ends 5·10⁻⁷ behind the plane of the side wall it meets).
+    pub fn meeting_distance(&self) -> f64 {
+        self.contact * (crate::PLANARITY_TOLERANCE / CONTACT_TOLERANCE)
+    }
+
     /// Distance by which ray origins at junctions move into their surface ([`JUNCTION_OFFSET`]).
     pub fn junction_offset(&self) -> f64 {
         self.contact * (JUNCTION_OFFSET / CONTACT_TOLERANCE)

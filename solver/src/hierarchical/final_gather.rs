@@ -11,6 +11,12 @@
 //! overstates it. Near leaves are therefore gathered again with their radiosity linear over them,
 //! from their vertices' values of the gather before.
 //!
+//! A point where surfaces meet takes the one-sided limit of each form factor from inside its own
+//! surface when a source's plane passes within the meeting distance of it
+//! (`Visibility::meeting_distance`), on either side: walls read from files meet only to the
+//! files' rounding, and a vertex a hair behind the wall it meets would otherwise see nothing of
+//! it.
+//!
 //! Each point also sums the form factors it gathers along (`unit`, the irradiance a radiosity of
 //! one everywhere would give), so that its light can be scaled to its total as the leaves' are
 //! ([`super::totals`]): to one inside a closed solid, and never above one.
@@ -168,8 +174,7 @@ impl FinalGather<'_> {
                 (la + lb, fa + fb)
             }
             _ => {
-                let tol = self.visibility.contact_distance();
-                let factor = point_factor(h, x, s, tol);
+                let factor = point_factor(h, x, s, self.visibility.meeting_distance());
                 (self.field.b[s as usize] * factor, factor)
             }
         }
@@ -183,7 +188,7 @@ impl FinalGather<'_> {
         let h = self.system.hierarchy;
         let triangle = &h.triangles[h.node(s).first as usize];
         let t = triangle.points;
-        let tol = self.visibility.contact_distance();
+        let tol = self.visibility.meeting_distance();
         if !x.in_front_of(t[0], triangle.normal, tol) {
             return (Rgb::ZERO, 0.0);
         }
