@@ -48,7 +48,12 @@ fn worst_vertex(scene: Scene, rho: f64, budget: ElementBudget) -> (f64, usize, E
         .flat_map(|b| b.to_array())
         .map(|b| (b / exact - 1.0).abs())
         .fold(0.0, f64::max);
-    let triangles = result.mesh.surfaces.iter().map(|m| m.triangle_count()).sum();
+    let triangles = result
+        .mesh
+        .surfaces
+        .iter()
+        .map(|m| m.triangle_count())
+        .sum();
     (worst, triangles, EnergyBalance::of(stats))
 }
 

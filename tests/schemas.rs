@@ -306,6 +306,18 @@ fn hierarchical_solutions_match_the_schemas() {
     assert_eq!(report["method"]["solver"], "hierarchical");
     assert!(report["solver"]["hierarchy"].is_object());
     assert!(report.get("refinement").is_none());
+    assert_eq!(report["energy"]["closed"], false);
+    // A closed room: the report says so, lets nothing escape and balances.
+    let furnace = dir.path().join("furnace");
+    run("furnace-l", &furnace, &["--max-elements", "800"]);
+    let report = check_outputs(&furnace);
+    let energy = &report["energy"];
+    assert_eq!(energy["closed"], true);
+    assert_eq!(report["solver"]["closed"], true);
+    let escaped = energy["escaped_fraction"].as_f64().expect("fraction");
+    assert!(escaped.abs() < 1e-3, "{energy}");
+    assert_eq!(energy["balanced"], true, "{energy}");
+    assert_eq!(report["warnings"], serde_json::json!([]));
 }
 
 #[test]

@@ -200,4 +200,57 @@ mod tests {
                 .all(Option::is_none)
         );
     }
+
+    /// A point on a receiver, facing `normal`, inside its surface.
+    fn at(point: DVec3, normal: DVec3) -> ReceivingPoint {
+        ReceivingPoint::interior(point, normal)
+    }
+
+    #[test]
+    fn a_room_encloses_what_is_in_it_and_an_open_or_mixed_one_does_not() {
+        let room = |open: bool, lone: bool| {
+            let mut scene = penumbra_scenes::builtin::closed_box(DVec3::splat(4.0), 0.0, 0.5);
+            if open {
+                scene.surfaces.pop();
+            }
+            // A closed block in the room, faces out.
+            for (i, mut f) in cube(false).into_iter().enumerate() {
+                f.polygon = f.polygon.iter().map(|&p| p + DVec3::splat(1.0)).collect();
+                f.name = format!("block{i}");
+                scene.surfaces.push(f);
+            }
+            if lone {
+                let c = |x: f64, y: f64| DVec3::new(x, y, 3.0);
+                scene.surfaces.push(Surface::new(
+                    "lamp",
+                    vec![c(3.0, 3.0), c(3.5, 3.0), c(3.5, 3.5), c(3.0, 3.5)],
+                    Rgb::ZERO,
+                ));
+            }
+            scene
+        };
+        let floor_point = at(DVec3::new(3.0, 0.5, 0.0), DVec3::Z);
+        let block_top = at(DVec3::new(1.5, 1.5, 2.0), DVec3::Z);
+        let ids = |scene: &Scene| {
+            let id = |name: &str| scene.surface_id(name).expect("surface");
+            (id("floor"), id("block1"))
+        };
+        let closed = room(false, false);
+        let (floor, top) = ids(&closed);
+        let vis = Visibility::build(&closed);
+        let enclosures = Enclosures::new(&closed, &vis);
+        assert!(enclosures.encloses(&floor_point, floor));
+        assert!(enclosures.encloses(&block_top, top));
+        // Inside the block, looking at its backs: not in a room of its own.
+        let inside_block = at(DVec3::new(1.5, 1.5, 1.0), DVec3::Z);
+        assert!(!enclosures.encloses(&inside_block, floor));
+        // A face taken away opens the room; a lone polygon in it may show its black back.
+        for scene in [room(true, false), room(false, true)] {
+            let (floor, top) = ids(&scene);
+            let vis = Visibility::build(&scene);
+            let enclosures = Enclosures::new(&scene, &vis);
+            assert!(!enclosures.encloses(&floor_point, floor));
+            assert!(!enclosures.encloses(&block_top, top));
+        }
+    }
 }

@@ -31,11 +31,14 @@ fn face_means(mesh: &SceneMesh, field: &[Vec<Rgb>]) -> Vec<f64> {
         .collect()
 }
 
-/// The closed furnace: B = E / (1 − ρ) everywhere. With the default link tolerance every face's
-/// mean is within 0.5 %; with a tighter one every vertex is (corner vertices are the last).
+/// The closed furnace: B = E / (1 − ρ) everywhere. Every leaf's form factors sum to one (it lies
+/// in a room), so every vertex is exact to rounding at any link tolerance (before, with the
+/// default tolerance only the face means were within 0.5 %, and ρ = 0.999 diverged). The field's
+/// error is uniform, which the coarse correction after each sweep removes at once: a few sweeps
+/// per pass at any reflectance, where Jacobi sweeps alone would need thousands at 0.999.
 #[test]
 fn furnace_gives_e_over_one_minus_rho() {
-    for rho in [0.5, 0.9, 0.99] {
+    for rho in [0.5, 0.9, 0.99, 0.999] {
         let scene = builtin::furnace(1.0, rho);
         let mesh = mesh_scene_uniform(&scene, 1200).expect("cube meshes");
         let expected = 1.0 / (1.0 - rho);
@@ -54,21 +57,13 @@ fn furnace_gives_e_over_one_minus_rho() {
                 .flat_map(|b| b.to_array())
                 .map(|c| (c / expected - 1.0).abs())
                 .fold(0.0, f64::max);
-            let means = face_means(&mesh, &solution.radiosity);
-            let worst_mean = means
-                .iter()
-                .map(|m| (m / expected - 1.0).abs())
-                .fold(0.0, f64::max);
+            let h = solution.stats.hierarchy.as_ref().expect("figures");
             eprintln!(
-                "rho {rho}, link tol {link_tol}: vertices within {worst:.5}, faces {worst_mean:.5}"
+                "rho {rho}, link tol {link_tol}: vertices within {worst:.1e}, {} sweeps in {} passes",
+                h.sweeps, h.refinement_passes
             );
-            assert!(
-                worst_mean < 5e-3,
-                "rho {rho}: a face mean is {worst_mean} off"
-            );
-            if link_tol < 1e-5 {
-                assert!(worst < 5e-3, "rho {rho}: a vertex is {worst} off");
-            }
+            assert!(worst < 1e-9, "rho {rho}: a vertex is {worst} off");
+            assert!(h.sweeps <= 4 * h.refinement_passes, "{h:?}");
         }
     }
 }

@@ -1032,6 +1032,65 @@ mod tests {
         assert!(worst < 1e-3, "{worst}");
     }
 
+    /// On the Cornell box (open, so each leaf's total is its own links' sum), the balanced
+    /// solution's leaves receive along their links what they send toward surfaces that reflect,
+    /// to rounding, though the links alone lose some of it; and every leaf's form factors sum to
+    /// its total after scaling.
+    #[test]
+    fn the_balanced_leaves_receive_what_they_send() {
+        let scene = builtin::cornell();
+        let vis = Visibility::build(&scene);
+        let mesh = mesh_scene_uniform(&scene, 3000).expect("meshes");
+        let options = SolverOptions::default();
+        let disc = Discretization::new(&scene, &mesh, options.elements_per_patch);
+        let (direct, _) =
+            direct_irradiance(&scene, &disc, &vis, &options, &NoProgress).expect("direct light");
+        let hierarchy = Hierarchy::build(&disc, |s| scene.surfaces[s].reflectance);
+        let open = vec![false; hierarchy.nodes.len()];
+        let mut system = System::new(
+            &hierarchy,
+            leaf_direct(&scene, &disc, &hierarchy, &direct),
+            open,
+            vis.contact_distance(),
+        );
+        let shafts = Shafts::new(&scene, &vis);
+        let refiner = Refiner {
+            hierarchy: &hierarchy,
+            shafts: &shafts,
+            tolerance: options.link_tol * reflected_power(&system),
+            rays: options.visibility_rays,
+            seed: options.seed,
+            tol: vis.contact_distance(),
+            stop: None,
+        };
+        let mut stats = HierarchyStats::default();
+        let solved = link_and_sweep(
+            &mut system,
+            &refiner,
+            &options,
+            &mut stats,
+            &|| 0.0,
+            &NoProgress,
+        );
+        let (sent, received) = system.transport(&solved.field);
+        eprintln!(
+            "links lost {:.3e} before the balance; sent {sent:?}, received {received:?}",
+            stats.links_lost
+        );
+        assert!(stats.links_lost.abs() > 1e-5, "{}", stats.links_lost);
+        for (s, r) in sent.to_array().into_iter().zip(received.to_array()) {
+            assert!((s - r).abs() <= 1e-9 * s, "{s} sent, {r} received");
+        }
+        let sums = system.row_sums();
+        for (i, n) in hierarchy.nodes.iter().enumerate() {
+            if n.is_leaf() && !n.is_cluster() && sums[i] > 0.0 {
+                let total = sums[i] * system.scale[i];
+                assert!((total - system.totals[i]).abs() <= 1e-12, "{total}");
+                assert!(system.totals[i] <= 1.0);
+            }
+        }
+    }
+
     /// As the link tolerance shrinks, the leaves' radiosities approach those of the dense
     /// system the hierarchy stands for: every pair of leaves linked, with the same form factors
     /// and visibility, solved to rounding.
