@@ -70,10 +70,15 @@ const LINK_GROWTH: f64 = 0.7;
 /// sorting them by receiver takes a buffer (7.9 million links of 512 MiB peaked at 1.7 GiB).
 const LINK_PEAK: f64 = 3.0;
 
+/// Fields of light held at once per node: the solution, the next sweep's, the response that
+/// balances the energy, and the two fields of unit radiosity.
+const FIELDS: usize = 5;
+
 /// Bytes the hierarchy and its links take at their peak for a mesh of `triangles` at
-/// `link_tol`: two nodes per triangle, their light, and the links.
+/// `link_tol`: two nodes per triangle, their light (fields of five colours a node, and four
+/// numbers: scale, totals, sums), and the links.
 pub fn estimated_bytes(triangles: u64, link_tol: f64) -> u64 {
-    let node = (size_of::<tree::Node>() + 4 * size_of::<Rgb>() + 8) as f64;
+    let node = (size_of::<tree::Node>() + FIELDS * 5 * size_of::<Rgb>() + 4 * 8) as f64;
     let ratio = DEFAULT_LINK_TOL / link_tol.max(f64::MIN_POSITIVE);
     let links = LINKS_PER_TRIANGLE * ratio.max(1.0).powf(LINK_GROWTH);
     let per_triangle = 2.0 * node + LINK_PEAK * links * size_of::<Link>() as f64;
