@@ -8,7 +8,8 @@
 //! reflected light per bounce, which twenty bounces at ρ = 0.95 make 0.8 %.
 //!
 //! Reciprocity says what the solution must carry: what the leaves send toward fronts of
-//! surfaces, Σ A b T, is what they receive, Σ A H. The converged field B is corrected by what is
+//! surfaces that reflect, Σ A b T (T the part of each leaf's total those cover), is what they
+//! receive, Σ A H. The converged field B is corrected by what is
 //! missing, received as ambient light: every leaf gets γ T more irradiance, which it reflects
 //! and the links carry on. That response R is a solve of the same system, with the ambient
 //! light reflected in place of the direct light; γ per channel then makes B + γ R balance
@@ -23,8 +24,8 @@ use crate::elements::Discretization;
 impl System<'_> {
     /// What the leaves of `field` send toward fronts of surfaces that reflect (radiosity × area
     /// × the reflecting part of the total) and what those receive along the links (irradiance ×
-    /// area), per channel. Black surfaces are left out: what they receive the oracle does not
-    /// refine (it reflects nothing), and they send nothing.
+    /// area), per channel. Black surfaces are left out: they send nothing, and what they
+    /// receive is absorbed, not carried on.
     pub(super) fn transport(&self, field: &Field) -> (Rgb, Rgb) {
         let (mut sent, mut received) = (Rgb::ZERO, Rgb::ZERO);
         for i in self.reflecting_leaves() {
