@@ -94,6 +94,8 @@ pub(crate) struct System<'a> {
     /// Per node: the sum of the form factors along its links and its ancestors', unscaled
     /// (empty before the links are set).
     sums: Vec<f64>,
+    /// Per node: whether a leaf's links changed since its total was found.
+    stale: Vec<bool>,
     /// Per node: whether a leaf lies inside a closed solid (its total is then one).
     pub enclosed: Vec<bool>,
     /// Distance under which a point counts as lying on a plane.
@@ -134,6 +136,7 @@ impl<'a> System<'a> {
             totals: Vec::new(),
             reflecting: Vec::new(),
             sums: Vec::new(),
+            stale: vec![true; n],
             enclosed,
             tol,
             unit: Field::new(0, 0),
@@ -187,24 +190,36 @@ impl<'a> System<'a> {
 
     /// Each leaf's gathered light scaled so that its form factors sum to its total
     /// ([`super::totals`]), for the links as they are.
-    fn set_totals(&mut self, changed: Option<&[u32]>) {
-        let (totals, reflecting) = self.leaf_totals(changed);
+    fn rescale(&mut self) {
         let sums = self.row_sums();
         for (i, n) in self.hierarchy.nodes.iter().enumerate() {
             self.scale[i] = if n.is_leaf() && !n.is_cluster() && sums[i] > 0.0 {
-                totals[i] / sums[i]
+                self.totals[i] / sums[i]
             } else {
                 1.0
             };
         }
-        self.totals = totals;
-        self.reflecting = reflecting;
         self.sums = sums;
     }
 
+    /// Finds again the totals of the leaves whose links changed since theirs were found, and
+    /// scales them; false if none had.
+    pub(super) fn settle_totals(&mut self) -> bool {
+        if !self.stale.iter().any(|&s| s) {
+            return false;
+        }
+        (self.totals, self.reflecting) = self.leaf_totals(&self.stale);
+        self.stale.fill(false);
+        self.rescale();
+        true
+    }
+
     /// Replaces the links (in any order; sorted here by receiver, stably), and scales the
-    /// leaves to their totals along them. `changed` lists the receivers whose links were
-    /// replaced, when only theirs were (the totals of leaves below no other node stay).
+    /// leaves along them. `changed` lists the receivers whose links were replaced, when only
+    /// theirs were: the leaves below them keep the totals they had until
+    /// [`Self::settle_totals`]. A total is the share of a leaf's view that surfaces cover, so
+    /// links refined from coarser ones change it little, while finding it costs as much as the
+    /// links it is found along: it is found once, along the final links.
     pub(super) fn set_links(&mut self, mut links: Vec<Link>, changed: Option<&[u32]>) {
         links.sort_by_key(|l| l.receiver);
         self.first_link.iter_mut().for_each(|f| *f = 0);
@@ -215,7 +230,31 @@ impl<'a> System<'a> {
             self.first_link[i] += self.first_link[i - 1];
         }
         self.links = links;
-        self.set_totals(changed);
+        match changed {
+            // Until totals are found, a leaf's is its sum, at most one (one inside a closed
+            // solid): the sweeps are a contraction all the same.
+            None => {
+                let sums = self.row_sums();
+                self.totals = (sums.iter().zip(&self.enclosed))
+                    .map(|(&sum, &enclosed)| if enclosed { 1.0 } else { sum.min(1.0) })
+                    .collect();
+                self.reflecting.clone_from(&self.totals);
+                self.stale.fill(true);
+            }
+            Some(changed) => self.mark_stale(changed),
+        }
+        self.rescale();
+    }
+
+    /// Marks the leaves below each of `receivers`.
+    fn mark_stale(&mut self, receivers: &[u32]) {
+        let h = self.hierarchy;
+        for &r in receivers {
+            let n = h.node(r);
+            for t in &h.triangles[n.first as usize..n.end as usize] {
+                self.stale[h.leaf_of_element[t.element as usize] as usize] = true;
+            }
+        }
     }
 
     /// The links `id` receives along.

@@ -536,34 +536,51 @@ fn link_and_sweep(
     system.set_links(links, None);
     stats.link_seconds += t.elapsed().as_secs_f64();
     loop {
-        let t = Instant::now();
-        let stop = sweep_until(
-            system,
-            &mut solved,
-            options,
-            &mut stats.sweeps,
-            clock,
-            progress,
-        );
-        stats.sweep_seconds += t.elapsed().as_secs_f64();
+        let stop = timed_sweeps(system, &mut solved, options, stats, clock, progress);
         stats.refinement_passes += 1;
-        if stop.is_some() || stats.refinement_passes >= MAX_PASSES {
-            solved.stop = stop.unwrap_or(StopReason::Converged);
-            if stop.is_none() {
-                balance_energy(system, &mut solved, options, stats, clock, progress);
-            }
+        if let Some(stop) = stop {
+            solved.stop = stop;
             return solved;
         }
         let t = Instant::now();
-        let relinked = relink(refiner, system, &solved.field);
+        let relinked = (stats.refinement_passes < MAX_PASSES)
+            .then(|| relink(refiner, system, &solved.field))
+            .flatten();
+        if let Some((links, counts, changed)) = relinked {
+            add_counts(stats, counts);
+            system.set_links(links, Some(&changed));
+            stats.link_seconds += t.elapsed().as_secs_f64();
+            continue;
+        }
+        // The links are final: the totals of the leaves whose links changed are found along
+        // them, and the sweeps go on to the solution with those.
+        let settled = system.settle_totals();
         stats.link_seconds += t.elapsed().as_secs_f64();
-        let Some((links, counts, changed)) = relinked else {
-            balance_energy(system, &mut solved, options, stats, clock, progress);
+        let stop = settled
+            .then(|| timed_sweeps(system, &mut solved, options, stats, clock, progress))
+            .flatten();
+        if let Some(stop) = stop {
+            solved.stop = stop;
             return solved;
-        };
-        add_counts(stats, counts);
-        system.set_links(links, Some(&changed));
+        }
+        balance_energy(system, &mut solved, options, stats, clock, progress);
+        return solved;
     }
+}
+
+/// [`sweep_until`], counting the sweeps and their time in `stats`.
+fn timed_sweeps(
+    system: &System,
+    solved: &mut Solved,
+    options: &SolverOptions,
+    stats: &mut HierarchyStats,
+    clock: &dyn Fn() -> f64,
+    progress: &dyn Progress,
+) -> Option<StopReason> {
+    let t = Instant::now();
+    let stop = sweep_until(system, solved, options, &mut stats.sweeps, clock, progress);
+    stats.sweep_seconds += t.elapsed().as_secs_f64();
+    stop
 }
 
 /// Corrects a converged solution by the light its links lose, received as ambient light

@@ -6,7 +6,7 @@
 //! ancestors' sum to its total only on average over the surface: on the closed furnace, leaves of
 //! a 24,000-triangle mesh summed to between 0.87 and 1.25. In a closed scene such a sum is
 //! amplified by ρ / (1 − ρ), and above one the sweeps diverge. So every leaf's gathered light is
-//! scaled to its total ([`super::iterate::System::set_totals`]):
+//! scaled to its total ([`super::iterate::System::settle_totals`]):
 //!
 //! - inside a closed solid (a room whose faces meet edge to edge), the total is exactly one,
 //!   whatever the occlusion inside ([`crate::solids::Enclosures`]);
@@ -51,17 +51,10 @@ impl System<'_> {
     /// Every leaf's total (by node; one elsewhere) and the part of it that surfaces which
     /// reflect cover: the total is one inside a closed solid, else the sum of the leaf's links'
     /// form factors at its centroid, at most one; its reflecting part is the share of that sum
-    /// along links to surfaces that reflect. Only leaves below a `changed` node are found
-    /// again, when given; the others keep theirs.
-    pub(super) fn leaf_totals(&self, changed: Option<&[u32]>) -> (Vec<f64>, Vec<f64>) {
+    /// along links to surfaces that reflect. Only `stale` leaves are found again once totals
+    /// are set; the others keep theirs.
+    pub(super) fn leaf_totals(&self, stale: &[bool]) -> (Vec<f64>, Vec<f64>) {
         let h = self.hierarchy;
-        let mut dirty = vec![changed.is_none(); h.nodes.len()];
-        for &r in changed.unwrap_or_default() {
-            let n = h.node(r);
-            for t in &h.triangles[n.first as usize..n.end as usize] {
-                dirty[h.leaf_of_element[t.element as usize] as usize] = true;
-            }
-        }
         (0..h.nodes.len() as u32)
             .into_par_iter()
             .map(|i| {
@@ -70,7 +63,7 @@ impl System<'_> {
                     return (1.0, 1.0);
                 }
                 let i = i as usize;
-                if !dirty[i] && !self.totals.is_empty() {
+                if !stale[i] && !self.totals.is_empty() {
                     return (self.totals[i], self.reflecting[i]);
                 }
                 let (all, reflecting) = self.own_sums(i as u32);
