@@ -1,10 +1,13 @@
 //! The scenes of `penumbra_scenes::extremes`, each held to the behaviour it must show. Every
 //! solve here is also checked for NaN, infinities and negative radiosity.
 
+mod common;
+
+use common::in_process;
 use glam::DVec3;
-use penumbra::{RunOptions, RunResult, run};
-use penumbra_scenes::{LoadedScene, Scene, Visibility, extremes};
-use penumbra_solver::{DirectLight, NoProgress, ReceivingPoint, SolverOptions};
+use penumbra::{RunOptions, RunResult};
+use penumbra_scenes::{Scene, Visibility, extremes};
+use penumbra_solver::{DirectLight, ReceivingPoint, SolverOptions};
 
 fn solve(scene: Scene, direct_only: bool) -> RunResult {
     let options = RunOptions {
@@ -13,19 +16,9 @@ fn solve(scene: Scene, direct_only: bool) -> RunResult {
             direct_only,
             ..SolverOptions::default()
         },
-        render: penumbra_viz::RenderOptions {
-            width: 16,
-            height: 16,
-            ..Default::default()
-        },
         ..RunOptions::default()
     };
-    let loaded = LoadedScene {
-        scene,
-        source: "test".into(),
-        warnings: Vec::new(),
-    };
-    let result = run(loaded, &options, &NoProgress).expect("solves");
+    let result = in_process::run_scene(scene, options);
     assert_physical(&result);
     result
 }

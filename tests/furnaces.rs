@@ -4,11 +4,14 @@
 //! sum off by δ is amplified ρ / (1 − ρ) = 999 times; and the energy account must show that
 //! nothing escapes.
 
+mod common;
+
+use common::in_process;
 use penumbra::energy::EnergyBalance;
-use penumbra::{RunOptions, default_budget, run};
+use penumbra::{RunOptions, default_budget};
 use penumbra_meshing::ElementBudget;
-use penumbra_scenes::{LoadedScene, Scene, builtin};
-use penumbra_solver::{NoProgress, SolverMethod, StopReason};
+use penumbra_scenes::{Scene, builtin};
+use penumbra_solver::{SolverMethod, StopReason};
 
 /// The budgets of the table: about 600 and 3,000 triangles, and the default.
 fn budgets() -> [ElementBudget; 3] {
@@ -24,19 +27,9 @@ fn budgets() -> [ElementBudget; 3] {
 fn worst_vertex(scene: Scene, rho: f64, budget: ElementBudget) -> (f64, usize, EnergyBalance) {
     let options = RunOptions {
         max_elements: budget,
-        render: penumbra_viz::RenderOptions {
-            width: 1,
-            height: 1,
-            ..Default::default()
-        },
         ..RunOptions::default()
     };
-    let loaded = LoadedScene {
-        scene,
-        source: "test".into(),
-        warnings: Vec::new(),
-    };
-    let result = run(loaded, &options, &NoProgress).expect("solves");
+    let result = in_process::run_scene(scene, options);
     let stats = &result.solution.stats;
     assert_eq!(stats.stop, StopReason::Converged, "rho {rho}");
     let exact = 1.0 / (1.0 - rho);

@@ -1,6 +1,8 @@
-//! What the command-line tests share: running the binary, and reading what it says and writes.
-//! Each test file uses its own part of it.
+//! What the tests share: running the binary, reading what it says and writes, and running a
+//! scene in this process ([`in_process`]). Each test file uses its own part of it.
 #![allow(dead_code)]
+
+pub mod in_process;
 
 use std::path::Path;
 use std::process::{Command, Output};

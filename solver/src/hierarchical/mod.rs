@@ -987,6 +987,76 @@ mod tests {
     use penumbra_meshing::mesh_scene_uniform;
     use penumbra_scenes::builtin;
 
+    /// A scene meshed uniformly, with what a hierarchical solve of it starts from.
+    struct Setup {
+        scene: Scene,
+        vis: Visibility,
+        disc: Discretization,
+        direct: Vec<Rgb>,
+        hierarchy: Hierarchy,
+        options: SolverOptions,
+    }
+
+    impl Setup {
+        fn new(scene: Scene, triangles: usize, options: SolverOptions) -> Setup {
+            let vis = Visibility::build(&scene);
+            let mesh = mesh_scene_uniform(&scene, triangles).expect("meshes");
+            let disc = Discretization::new(&scene, &mesh, options.elements_per_patch);
+            let (direct, _) = direct_irradiance(&scene, &disc, &vis, &options, &NoProgress)
+                .expect("direct light");
+            let hierarchy = Hierarchy::build(&disc, |s| scene.surfaces[s].reflectance);
+            Setup {
+                scene,
+                vis,
+                disc,
+                direct,
+                hierarchy,
+                options,
+            }
+        }
+
+        /// The system with no leaf taken for enclosed.
+        fn system(&self) -> System<'_> {
+            System::new(
+                &self.hierarchy,
+                self.leaf_direct(),
+                vec![false; self.hierarchy.nodes.len()],
+                self.vis.contact_distance(),
+            )
+        }
+
+        fn leaf_direct(&self) -> Vec<Rgb> {
+            leaf_direct(&self.scene, &self.disc, &self.hierarchy, &self.direct)
+        }
+
+        /// Links `system` at `tolerance` (power) and sweeps it, as a run does.
+        fn solve(&self, system: &mut System, tolerance: f64) -> (Solved, HierarchyStats) {
+            let shafts = Shafts::new(&self.scene, &self.vis);
+            let mut stats = HierarchyStats::default();
+            let solved = link_and_sweep(
+                system,
+                &self.refiner(&shafts, tolerance),
+                &self.options,
+                &mut stats,
+                &|| 0.0,
+                &NoProgress,
+            );
+            (solved, stats)
+        }
+
+        fn refiner<'r>(&'r self, shafts: &'r Shafts, tolerance: f64) -> Refiner<'r> {
+            Refiner {
+                hierarchy: &self.hierarchy,
+                shafts,
+                tolerance,
+                rays: self.options.visibility_rays,
+                seed: self.options.seed,
+                tol: self.vis.contact_distance(),
+                stop: None,
+            }
+        }
+    }
+
     /// The links between two faces of the unit cube carry its face-to-face form factors
     /// (`docs/closed-forms.md`, "Two rectangles"): Σ area × form factor over the links from one
     /// face's elements to the other's, over the first face's area.
@@ -994,40 +1064,10 @@ mod tests {
     fn links_carry_the_unit_cubes_face_factors() {
         const OPPOSITE: f64 = 0.199_824_895_698_387;
         const ADJACENT: f64 = 0.200_043_776_075_403;
-        let scene = builtin::furnace(1.0, 0.5);
-        let vis = Visibility::build(&scene);
-        let mesh = mesh_scene_uniform(&scene, 1200).expect("meshes");
-        let options = SolverOptions::default();
-        let disc = Discretization::new(&scene, &mesh, options.elements_per_patch);
-        let (direct, _) =
-            direct_irradiance(&scene, &disc, &vis, &options, &NoProgress).expect("direct light");
-        let hierarchy = Hierarchy::build(&disc, |s| scene.surfaces[s].reflectance);
-        let shafts = Shafts::new(&scene, &vis);
-        let open = vec![false; hierarchy.nodes.len()];
-        let mut system = System::new(
-            &hierarchy,
-            leaf_direct(&scene, &disc, &hierarchy, &direct),
-            open,
-            vis.contact_distance(),
-        );
-        let refiner = Refiner {
-            hierarchy: &hierarchy,
-            shafts: &shafts,
-            tolerance: 1e-6 * scene.emitted_power().mean(),
-            rays: options.visibility_rays,
-            seed: options.seed,
-            tol: vis.contact_distance(),
-            stop: None,
-        };
-        let mut stats = HierarchyStats::default();
-        link_and_sweep(
-            &mut system,
-            &refiner,
-            &options,
-            &mut stats,
-            &|| 0.0,
-            &NoProgress,
-        );
+        let setup = Setup::new(builtin::furnace(1.0, 0.5), 1200, SolverOptions::default());
+        let mut system = setup.system();
+        setup.solve(&mut system, 1e-6 * setup.scene.emitted_power().mean());
+        let (scene, hierarchy) = (&setup.scene, &setup.hierarchy);
         let n = scene.surfaces.len();
         let mut factors = vec![vec![0.0; n]; n];
         for l in &system.links {
@@ -1060,40 +1100,11 @@ mod tests {
     /// its total after scaling.
     #[test]
     fn the_balanced_leaves_receive_what_they_send() {
-        let scene = builtin::cornell();
-        let vis = Visibility::build(&scene);
-        let mesh = mesh_scene_uniform(&scene, 3000).expect("meshes");
-        let options = SolverOptions::default();
-        let disc = Discretization::new(&scene, &mesh, options.elements_per_patch);
-        let (direct, _) =
-            direct_irradiance(&scene, &disc, &vis, &options, &NoProgress).expect("direct light");
-        let hierarchy = Hierarchy::build(&disc, |s| scene.surfaces[s].reflectance);
-        let open = vec![false; hierarchy.nodes.len()];
-        let mut system = System::new(
-            &hierarchy,
-            leaf_direct(&scene, &disc, &hierarchy, &direct),
-            open,
-            vis.contact_distance(),
-        );
-        let shafts = Shafts::new(&scene, &vis);
-        let refiner = Refiner {
-            hierarchy: &hierarchy,
-            shafts: &shafts,
-            tolerance: options.link_tol * reflected_power(&system),
-            rays: options.visibility_rays,
-            seed: options.seed,
-            tol: vis.contact_distance(),
-            stop: None,
-        };
-        let mut stats = HierarchyStats::default();
-        let solved = link_and_sweep(
-            &mut system,
-            &refiner,
-            &options,
-            &mut stats,
-            &|| 0.0,
-            &NoProgress,
-        );
+        let setup = Setup::new(builtin::cornell(), 3000, SolverOptions::default());
+        let mut system = setup.system();
+        let tolerance = setup.options.link_tol * reflected_power(&system);
+        let (solved, stats) = setup.solve(&mut system, tolerance);
+        let hierarchy = &setup.hierarchy;
         let (sent, received) = system.transport(&solved.field);
         eprintln!(
             "links lost {:.3e} before the balance; sent {sent:?}, received {received:?}",
@@ -1118,35 +1129,20 @@ mod tests {
     /// and visibility, solved to rounding.
     #[test]
     fn shrinking_link_tolerance_approaches_the_dense_leaf_system() {
-        let scene = builtin::cornell();
-        let vis = Visibility::build(&scene);
-        let mesh = mesh_scene_uniform(&scene, 400).expect("meshes");
         let options = SolverOptions {
             epsilon: 1e-9,
             ..SolverOptions::default()
         };
-        let disc = Discretization::new(&scene, &mesh, options.elements_per_patch);
-        let (direct, _) =
-            direct_irradiance(&scene, &disc, &vis, &options, &NoProgress).expect("direct light");
-        let hierarchy = Hierarchy::build(&disc, |s| scene.surfaces[s].reflectance);
-        let shafts = Shafts::new(&scene, &vis);
-        let refiner = |tolerance: f64| Refiner {
-            hierarchy: &hierarchy,
-            shafts: &shafts,
-            tolerance,
-            rays: options.visibility_rays,
-            seed: options.seed,
-            tol: vis.contact_distance(),
-            stop: None,
-        };
+        let setup = Setup::new(builtin::cornell(), 400, options);
+        let (scene, hierarchy) = (&setup.scene, &setup.hierarchy);
+        let shafts = Shafts::new(scene, &setup.vis);
         let leaves: Vec<u32> = (0..hierarchy.nodes.len() as u32)
             .filter(|&i| hierarchy.node(i).is_leaf())
             .collect();
-        let e = leaf_direct(&scene, &disc, &hierarchy, &direct);
-        let open = vec![false; hierarchy.nodes.len()];
-        let system = System::new(&hierarchy, e.clone(), open.clone(), vis.contact_distance());
+        let e = setup.leaf_direct();
+        let system = setup.system();
         let field = system.initial_field();
-        let whole = refiner(f64::INFINITY);
+        let whole = setup.refiner(&shafts, f64::INFINITY);
         let rows: Vec<Vec<(usize, f64)>> = leaves
             .iter()
             .map(|&r| {
@@ -1188,18 +1184,8 @@ mod tests {
             / area;
         let mut previous = f64::INFINITY;
         for tol in [1e-3, 1e-4, 1e-5, 1e-6, 1e-7] {
-            let mut system =
-                System::new(&hierarchy, e.clone(), open.clone(), vis.contact_distance());
-            let mut stats = HierarchyStats::default();
-            let emitted = scene.emitted_power().mean();
-            let solved = link_and_sweep(
-                &mut system,
-                &refiner(tol * emitted),
-                &options,
-                &mut stats,
-                &|| 0.0,
-                &NoProgress,
-            );
+            let mut system = setup.system();
+            let (solved, _) = setup.solve(&mut system, tol * scene.emitted_power().mean());
             let rms = (leaves
                 .iter()
                 .zip(&b)
