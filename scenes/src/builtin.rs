@@ -100,6 +100,16 @@ fn v(x: f64, y: f64, z: f64) -> DVec3 {
     DVec3::new(x, y, z)
 }
 
+/// A camera at `eye` looking at `target`, z up, with a vertical field of view of `fov_deg`.
+fn upright(eye: DVec3, target: DVec3, fov_deg: f64) -> Option<Camera> {
+    Some(Camera {
+        eye,
+        target,
+        up: DVec3::Z,
+        fov_deg,
+    })
+}
+
 /// Reverses `polygon` if needed so that its front faces `toward` (or away, if `outward`).
 fn facing(mut polygon: Vec<DVec3>, point: DVec3, outward: bool) -> Vec<DVec3> {
     let n = polygon::newell_normal(&polygon);
@@ -248,12 +258,7 @@ pub fn textbook() -> Scene {
     light.reverse(); // facing down
     Scene {
         name: "textbook".into(),
-        camera: Some(Camera {
-            eye: v(0.0, -6.5, 4.5),
-            target: v(0.0, 0.0, 0.4),
-            up: v(0.0, 0.0, 1.0),
-            fov_deg: 45.0,
-        }),
+        camera: upright(v(0.0, -6.5, 4.5), v(0.0, 0.0, 0.4), 45.0),
         surfaces: vec![
             Surface::new("light", light, Rgb::ZERO).with_emission(Rgb::splat(1.0)),
             Surface::new("blocker", square(1.0, 0.5), Rgb::splat(0.5)),
@@ -284,12 +289,7 @@ pub fn crossed_bars() -> Scene {
     light.reverse(); // facing down
     Scene {
         name: "bars".into(),
-        camera: Some(Camera {
-            eye: v(0.0, -7.5, 5.5),
-            target: v(0.0, 0.0, 0.6),
-            up: v(0.0, 0.0, 1.0),
-            fov_deg: 45.0,
-        }),
+        camera: upright(v(0.0, -7.5, 5.5), v(0.0, 0.0, 0.6), 45.0),
         surfaces: vec![
             Surface::new("light", light, Rgb::ZERO).with_emission(Rgb::splat(1.0)),
             Surface::new("upper", bar(2.0, 20.0), Rgb::splat(0.5)),
@@ -302,30 +302,22 @@ pub fn crossed_bars() -> Scene {
 /// A closed unit cube whose six inward faces all emit `emission` and reflect `reflectance`: the
 /// exact radiosity is `emission / (1 - reflectance)` everywhere.
 pub fn furnace(emission: f64, reflectance: f64) -> Scene {
-    let mut scene = closed_box(DVec3::ONE, emission, reflectance);
-    scene.name = "furnace".into();
-    scene.camera = Some(Camera {
-        eye: v(0.5, 0.02, 0.5),
-        target: v(0.5, 1.0, 0.5),
-        up: v(0.0, 0.0, 1.0),
-        fov_deg: 100.0,
-    });
-    scene
+    Scene {
+        name: "furnace".into(),
+        camera: upright(v(0.5, 0.02, 0.5), v(0.5, 1.0, 0.5), 100.0),
+        ..closed_box(DVec3::ONE, emission, reflectance)
+    }
 }
 
 /// A closed 8 x 1 x 1 box whose six inward faces all emit `emission` and reflect `reflectance`:
 /// the exact radiosity is `emission / (1 - reflectance)` everywhere, though most of each long
 /// face sees the box's far end at grazing angles.
 pub fn long_furnace(emission: f64, reflectance: f64) -> Scene {
-    let mut scene = closed_box(v(8.0, 1.0, 1.0), emission, reflectance);
-    scene.name = "furnace-long".into();
-    scene.camera = Some(Camera {
-        eye: v(0.05, 0.5, 0.5),
-        target: v(8.0, 0.5, 0.5),
-        up: v(0.0, 0.0, 1.0),
-        fov_deg: 70.0,
-    });
-    scene
+    Scene {
+        name: "furnace-long".into(),
+        camera: upright(v(0.05, 0.5, 0.5), v(8.0, 0.5, 0.5), 70.0),
+        ..closed_box(v(8.0, 1.0, 1.0), emission, reflectance)
+    }
 }
 
 /// A closed L-shaped room (the 2 x 2 x 1 box less its quarter x, y > 1) whose eight inward
@@ -360,12 +352,7 @@ pub fn l_room_furnace(emission: f64, reflectance: f64) -> Scene {
     }
     Scene {
         name: "furnace-l".into(),
-        camera: Some(Camera {
-            eye: v(1.9, 0.1, 0.5),
-            target: v(0.3, 1.7, 0.5),
-            up,
-            fov_deg: 90.0,
-        }),
+        camera: upright(v(1.9, 0.1, 0.5), v(0.3, 1.7, 0.5), 90.0),
         surfaces: faces
             .into_iter()
             .map(|(name, polygon)| {
@@ -523,12 +510,11 @@ pub fn boxworld(count: usize, seed: u64) -> Scene {
     }
     Scene {
         name: format!("boxworld-{count}"),
-        camera: Some(Camera {
-            eye: v(center, -0.6 * side, 0.9 * height),
-            target: v(center, 0.45 * side, 0.0),
-            up: v(0.0, 0.0, 1.0),
-            fov_deg: 50.0,
-        }),
+        camera: upright(
+            v(center, -0.6 * side, 0.9 * height),
+            v(center, 0.45 * side, 0.0),
+            50.0,
+        ),
         surfaces,
     }
 }

@@ -180,35 +180,12 @@ impl Discretization {
         self.receivers.len()
     }
 
-    /// Per-receiver fields of `old` carried over to this discretization where receivers match
-    /// ([`Self::matching_receivers`]; zero elsewhere), and the receivers that match none.
-    pub fn carried<T: Copy + Default, const N: usize>(
-        &self,
-        old: &Discretization,
-        fields: [&[T]; N],
-    ) -> ([Vec<T>; N], Vec<usize>) {
-        let n = self.receiver_count();
-        let mut out = std::array::from_fn(|_| vec![T::default(); n]);
-        let mut fresh = Vec::new();
-        for (v, same) in self.matching_receivers(old).into_iter().enumerate() {
-            match same {
-                Some(o) => {
-                    for (field, values) in out.iter_mut().zip(fields) {
-                        field[v] = values[o];
-                    }
-                }
-                None => fresh.push(v),
-            }
-        }
-        (out, fresh)
-    }
-
     /// For each receiver, the receiver of `old` (a coarser discretization of the same scene)
     /// that stands for it, if any: the same point of the same surface. Where a position repeats
     /// (the sides of a contact line, the corners of a block standing on the surface) each copy's
     /// value is a one-sided limit from its own triangles, so a copy matches only an old one that
     /// looked from the same direction; elsewhere the light is continuous.
-    pub fn matching_receivers(&self, old: &Discretization) -> Vec<Option<usize>> {
+    pub fn matching_receivers(&self, old: &Discretization) -> Matching {
         let positions = |d: &Discretization| {
             let mut at: HashMap<(SurfaceId, [u64; 3]), Vec<usize>> = HashMap::new();
             for (v, x) in d.receivers.iter().enumerate() {
@@ -219,7 +196,7 @@ impl Discretization {
             at
         };
         let (old_at, new_at) = (positions(old), positions(self));
-        (0..self.receiver_count())
+        let matching = (0..self.receiver_count())
             .map(|v| {
                 let x = &self.receivers[v];
                 let key = (
@@ -232,7 +209,8 @@ impl Discretization {
                     .copied()
                     .find(|&o| unique || old.receivers[o].inward.dot(x.inward) >= 1.0 - 1e-9)
             })
-            .collect()
+            .collect();
+        Matching(matching)
     }
 
     /// Splits a per-receiver vector into per-surface vectors.
@@ -275,6 +253,27 @@ impl Discretization {
                 mean.mul_rgb(weight(e)) * e.area
             })
             .sum()
+    }
+}
+
+/// For each receiver of a discretization, the receiver of an older, coarser one that stands for
+/// it, if any ([`Discretization::matching_receivers`]).
+#[derive(Debug)]
+pub struct Matching(Vec<Option<usize>>);
+
+impl Matching {
+    /// Per-receiver values of the older discretization carried over where receivers match (the
+    /// default elsewhere).
+    pub fn carry<T: Copy + Default>(&self, values: &[T]) -> Vec<T> {
+        self.0
+            .iter()
+            .map(|m| m.map_or_else(T::default, |o| values[o]))
+            .collect()
+    }
+
+    /// The receivers that match none.
+    pub fn fresh(&self) -> Vec<usize> {
+        (0..self.0.len()).filter(|&v| self.0[v].is_none()).collect()
     }
 }
 

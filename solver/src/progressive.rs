@@ -882,8 +882,12 @@ impl<'a> ProgressiveSolver<'a> {
             .collect();
 
         // Vertices that were there before keep their values.
-        let ([mut direct, mut irradiance], fresh) =
-            disc.carried(&self.disc, [&self.direct_irradiance, &self.irradiance]);
+        let matching = disc.matching_receivers(&self.disc);
+        let (mut direct, mut irradiance, fresh) = (
+            matching.carry(&self.direct_irradiance),
+            matching.carry(&self.irradiance),
+            matching.fresh(),
+        );
         let t = Instant::now();
         let new_direct = direct_at_new(&self.direct, &disc, &fresh, &self.options, progress)?;
         self.direct_seconds += t.elapsed().as_secs_f64();

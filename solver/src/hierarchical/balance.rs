@@ -86,9 +86,10 @@ pub(super) fn ambient_gain(system: &System, solved: &Field, response: &Field) ->
 
 /// The ambient irradiance per unit of total that the final gather's points on surfaces that
 /// reflect need besides what they gathered (`reflected` and `totals` at every vertex of
-/// `disc`), so that the display receives in all what the balanced leaves receive: the gather carries light from the leaves
-/// with each point's own form factors, and loses a little of it too, once (light it makes up is
-/// left, as in [`ambient_gain`]). With the share of the leaves' light it lost (channel means).
+/// `disc`), so that the display receives in all what the balanced leaves receive: the gather
+/// carries light from the leaves with each point's own form factors, and loses a little of it
+/// too, once (light it makes up is left, as in [`ambient_gain`]). With the share of the leaves'
+/// light it lost (channel means).
 pub(super) fn display_gain(
     system: &System,
     field: &Field,

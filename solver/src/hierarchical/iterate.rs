@@ -236,7 +236,7 @@ impl<'a> System<'a> {
             None => {
                 let sums = self.row_sums();
                 self.totals = (sums.iter().zip(&self.enclosed))
-                    .map(|(&sum, &enclosed)| if enclosed { 1.0 } else { sum.min(1.0) })
+                    .map(|(&sum, &enclosed)| super::totals::bounded(sum, enclosed))
                     .collect();
                 self.reflecting.clone_from(&self.totals);
                 self.stale.fill(true);
@@ -475,8 +475,7 @@ impl<'a> System<'a> {
     /// uniform, α per channel, with α the residual's area mean over that of (1 − ρT) (the
     /// residual a uniform field of one leaves, T the reflecting part of each leaf's total);
     /// `after` becomes the sweep from `before` + α, which adds α ρ T to each leaf's radiosity.
-    /// Returns α.
-    pub(super) fn correct(&self, before: &Field, after: &mut Field) -> Rgb {
+    pub(super) fn correct(&self, before: &Field, after: &mut Field) {
         let h = self.hierarchy;
         let (mut residual, mut weight) = (Rgb::ZERO, Rgb::ZERO);
         for (i, n) in h.nodes.iter().enumerate() {
@@ -505,7 +504,6 @@ impl<'a> System<'a> {
         if let Some(root) = h.root {
             self.pull(root, after);
         }
-        alpha
     }
 
     /// Σ area × |change of radiosity| over the leaves, relative to Σ area × reflected direct

@@ -191,6 +191,7 @@ pub fn solve_hierarchical_refining(
         hierarchy.nodes.len(),
         &enclosures,
     );
+    let closed = enclosed.iter().all(|&e| e);
     let tol = visibility.contact_distance();
     let mut system = System::new(
         &hierarchy,
@@ -233,7 +234,7 @@ pub fn solve_hierarchical_refining(
     let all: Vec<usize> = (0..first.receiver_count()).collect();
     let leaves = vertex_leaves(&first, &hierarchy);
     let mut stop = solved.stop;
-    let light = final_gather_at(
+    let mut light = final_gather_at(
         &first, &all, &leaves, &direct, &enclosed, &gather, None, options, progress,
     )
     .unwrap_or_else(|| {
@@ -254,7 +255,6 @@ pub fn solve_hierarchical_refining(
         stats.gather_lost = lost;
         gain
     };
-    let mut light = light;
     light.add_ambient(&first, &all, display_gain);
     let first_b = light.first_b;
     let mut gather_seconds = t.elapsed().as_secs_f64();
@@ -264,7 +264,6 @@ pub fn solve_hierarchical_refining(
         direct,
         reflected: light.reflected,
         totals: light.totals,
-        enclosed,
     };
 
     // Rounds of refinement: new vertices gather through the links of the first mesh's leaves.
@@ -275,10 +274,11 @@ pub fn solve_hierarchical_refining(
         while let Some(next) = refine(&current.round(&exact))? {
             check_mesh(scene, &next)?;
             let disc = Discretization::new(scene, &next, options.elements_per_patch);
-            let ([mut direct, mut reflected], fresh) =
-                disc.carried(&current.disc, [&current.direct, &current.reflected]);
-            let ([mut totals], _) = disc.carried(&current.disc, [&current.totals]);
-            let ([mut enclosed], _) = disc.carried(&current.disc, [&current.enclosed]);
+            let matching = disc.matching_receivers(&current.disc);
+            let fresh = matching.fresh();
+            let mut direct = matching.carry(&current.direct);
+            let mut reflected = matching.carry(&current.reflected);
+            let mut totals = matching.carry(&current.totals);
             let t = Instant::now();
             let new_direct = direct_at_new(&exact, &disc, &fresh, options, progress)?;
             direct_seconds += t.elapsed().as_secs_f64();
@@ -293,7 +293,7 @@ pub fn solve_hierarchical_refining(
                 interrupt: None,
                 ..options.clone()
             };
-            let light = final_gather_at(
+            let mut light = final_gather_at(
                 &disc,
                 &fresh,
                 &leaves,
@@ -305,7 +305,6 @@ pub fn solve_hierarchical_refining(
                 progress,
             )
             .unwrap_or_default();
-            let mut light = light;
             light.add_ambient(&disc, &fresh, display_gain);
             stats.gather_rays += light.rays;
             gather_seconds += t.elapsed().as_secs_f64();
@@ -313,7 +312,6 @@ pub fn solve_hierarchical_refining(
                 direct[v] = new_direct[k];
                 reflected[v] = light.reflected[k];
                 totals[v] = light.totals[k];
-                enclosed[v] = new_enclosed[k];
             }
             gathered += fresh.len();
             remeshes += 1;
@@ -323,7 +321,6 @@ pub fn solve_hierarchical_refining(
                 direct,
                 reflected,
                 totals,
-                enclosed,
             };
         }
     }
@@ -340,7 +337,7 @@ pub fn solve_hierarchical_refining(
         disc,
         irradiance: &irradiance,
         totals: &current.totals,
-        enclosed: &current.enclosed,
+        closed,
     };
     let solve_stats = SolveStats {
         stop,
@@ -372,15 +369,13 @@ pub fn solve_hierarchical_refining(
     Ok((current.mesh, solution))
 }
 
-/// The display mesh of the latest round and the light at its vertices, with each vertex's total
-/// and whether a closed solid encloses it.
+/// The display mesh of the latest round and the light at its vertices, with each vertex's total.
 struct Current {
     mesh: SceneMesh,
     disc: Discretization,
     direct: Vec<Rgb>,
     reflected: Vec<Rgb>,
     totals: Vec<f64>,
-    enclosed: Vec<bool>,
 }
 
 impl Current {
@@ -501,6 +496,19 @@ struct Solved {
     history: Vec<ConvergencePoint>,
 }
 
+impl Solved {
+    /// `field` before any sweep, with no history yet.
+    fn new(field: Field) -> Solved {
+        Solved {
+            field,
+            stop: StopReason::Converged,
+            residual: 0.0,
+            unshot: Rgb::ZERO,
+            history: Vec::new(),
+        }
+    }
+}
+
 /// Links the hierarchy from its root, sweeps until the residual is below `epsilon`, judges the
 /// links again with the new radiosities and refines those that carry too much light wrongly,
 /// and sweeps again, until no link changes (or [`MAX_PASSES`], the sweep cap, the deadline or an
@@ -514,17 +522,12 @@ fn link_and_sweep(
     progress: &dyn Progress,
 ) -> Solved {
     // Before the first sweep none of the reflected light is gathered: a residual of one.
-    let mut solved = Solved {
-        field: system.initial_field(),
-        stop: StopReason::Converged,
-        residual: 0.0,
-        unshot: Rgb::ZERO,
-        history: vec![ConvergencePoint {
-            iteration: 0,
-            residual: 1.0,
-            seconds: clock(),
-        }],
-    };
+    let mut solved = Solved::new(system.initial_field());
+    solved.history.push(ConvergencePoint {
+        iteration: 0,
+        residual: 1.0,
+        seconds: clock(),
+    });
     let Some(root) = system.hierarchy.root else {
         return solved;
     };
@@ -596,13 +599,7 @@ fn balance_energy(
 ) {
     let t = Instant::now();
     let direct = system.set_direct(system.ambient_source());
-    let mut response = Solved {
-        field: system.initial_field(),
-        stop: StopReason::Converged,
-        residual: 0.0,
-        unshot: Rgb::ZERO,
-        history: Vec::new(),
-    };
+    let mut response = Solved::new(system.initial_field());
     let stop = sweep_until(
         system,
         &mut response,
@@ -674,13 +671,14 @@ fn sweep_until(
 /// power absorbed, ∫ (1 − ρ) H, and the power sent out of the scene, ∫ B (1 − T) with T each
 /// vertex's total (the share of its view that fronts of surfaces cover: one inside a room, what
 /// the final gather's form factors sum to elsewhere). Nothing is a difference of other terms, so
-/// emitted − absorbed − escaped − unshot measures the solution's own error.
+/// emitted − absorbed − escaped − unshot measures the solution's own error. `closed` says
+/// whether every vertex of the first mesh lies inside a room.
 struct Account<'a> {
     scene: &'a Scene,
     disc: &'a Discretization,
     irradiance: &'a [Rgb],
     totals: &'a [f64],
-    enclosed: &'a [bool],
+    closed: bool,
 }
 
 impl Account<'_> {
@@ -693,7 +691,7 @@ impl Account<'_> {
         let radiosity: Vec<Rgb> = (0..disc.receiver_count())
             .map(|v| disc.emission[v] + disc.reflectance[v].mul_rgb(self.irradiance[v]))
             .collect();
-        let open = self.open_shares();
+        let open: Vec<f64> = self.totals.iter().map(|&t| 1.0 - t).collect();
         let escaped = disc.integrate_product(&radiosity, &open);
         SolveStats {
             patches: stats.leaves,
@@ -704,18 +702,9 @@ impl Account<'_> {
             unshot,
             escaped,
             unshot_fraction: unshot.mean().abs() / emitted.mean().max(f64::MIN_POSITIVE),
-            closed: Some(self.enclosed.iter().all(|&e| e)),
+            closed: Some(self.closed),
             ..SolveStats::default()
         }
-    }
-
-    /// Each vertex's 1 − T: the share of its view that no front covers.
-    fn open_shares(&self) -> Vec<f64> {
-        self.totals
-            .iter()
-            .zip(self.enclosed)
-            .map(|(&t, &enclosed)| if enclosed { 0.0 } else { 1.0 - t })
-            .collect()
     }
 }
 
@@ -897,7 +886,7 @@ fn final_gather_at(
     let totals: Vec<f64> = values
         .iter()
         .zip(enclosed)
-        .map(|(g, &enclosed)| if enclosed { 1.0 } else { g.unit.min(1.0) })
+        .map(|(g, &enclosed)| totals::bounded(g.unit, enclosed))
         .collect();
     let scaled = |g: &Gathered, total: f64| {
         let sum = g.near + g.far;

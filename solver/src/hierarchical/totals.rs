@@ -27,6 +27,12 @@ use crate::elements::Discretization;
 use crate::lambert::ReceivingPoint;
 use crate::solids::Enclosures;
 
+/// A receiver's total from the form factors found for it: one inside a closed solid, else their
+/// sum, at most one.
+pub(super) fn bounded(sum: f64, enclosed: bool) -> f64 {
+    if enclosed { 1.0 } else { sum.min(1.0) }
+}
+
 /// Per node: whether a leaf lies inside a closed solid (all its vertices do).
 pub(super) fn enclosed_leaves(
     disc: &Discretization,
@@ -67,7 +73,7 @@ impl System<'_> {
                     return (self.totals[i], self.reflecting[i]);
                 }
                 let (all, reflecting) = self.own_sums(i as u32);
-                let total = if self.enclosed[i] { 1.0 } else { all.min(1.0) };
+                let total = bounded(all, self.enclosed[i]);
                 let share = if all > 0.0 { reflecting / all } else { 1.0 };
                 (total, total * share)
             })
