@@ -31,7 +31,7 @@ pub const ENERGY_BALANCE_TOLERANCE: f64 = 1e-3;
 /// How far, relative to the emitted power (channel mean), emitted − absorbed − escaped − unshot
 /// may be from zero: the accuracy the defaults aim at. Where each term is measured on its own
 /// (the hierarchical solver), the gap is the solution's own error of transport: on the Cornell
-/// box about 4·10⁻³.
+/// box about 2·10⁻³.
 pub const CLOSURE_TOLERANCE: f64 = 1e-2;
 
 /// Where the emitted power went, per channel and as fractions of the emitted power (channel

@@ -10,9 +10,9 @@ use penumbra_solver::{NoProgress, SolverMethod};
 
 /// At seeded random points over the box's surfaces (inside the triangles, as a user reads the
 /// solution), the default hierarchical run is within 0.7 % RMS of path tracing, with the
-/// reference's own noise taken out (its standard errors, in quadrature). Measured: 0.53 %
+/// reference's own noise taken out (its standard errors, in quadrature). Measured: 0.54 %
 /// (0.71 % before the solver balanced its energy). Over the 1,000 points of `penumbra sweep`
-/// it is 0.81 %: most of what is left is the mesh's linear interpolation where the light bends
+/// it is 0.82 %: most of what is left is the mesh's linear interpolation where the light bends
 /// fastest, at the blocks' feet and along concave junctions, not the vertex values.
 #[test]
 fn cornell_box_within_0_7_percent_of_path_tracing() {
