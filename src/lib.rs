@@ -113,6 +113,7 @@
 
 pub mod adaptive;
 pub mod energy;
+pub mod error_mesh;
 pub mod experiments;
 pub mod export;
 #[doc(hidden)] // Support for the fuzz targets and their tests, not an API.

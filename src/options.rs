@@ -20,8 +20,12 @@ pub enum MeshMethod {
     Uniform,
     /// The same, with the discontinuities of the direct light as constraint edges.
     Discontinuity,
-    /// Discontinuity meshing if the scene casts shadows, else uniform: the discontinuity search
-    /// is made, and a scene where it finds no segment (and skips no emitter–receiver pair) is
+    /// Error-driven: a mesh along the discontinuities that carry a real jump (contact lines,
+    /// umbra and outer penumbra boundaries), refined where its interpolation of the exact
+    /// direct light is measured worst ([`crate::error_mesh`]), up to the budget or
+    /// [`RunOptions::tolerance`]. With adaptive refinement (`refine`) or shards it is the
+    /// discontinuity mesh if the scene casts shadows, else uniform: the discontinuity search is
+    /// made, and a scene where it finds no segment (and skips no emitter–receiver pair) is
     /// meshed uniformly.
     Auto,
 }
@@ -101,6 +105,10 @@ pub struct RunOptions {
     pub discontinuity: DiscontinuityOptions,
     /// Adaptive refinement from a coarser mesh up to `max_elements`, if asked for.
     pub refine: Option<RefineOptions>,
+    /// Error-driven meshes ([`MeshMethod::Auto`]): the error a check point of the direct light
+    /// may have, relative to the scene's mean reflected direct light;
+    /// [`crate::error_mesh::DEFAULT_TOLERANCE`] by default.
+    pub tolerance: f64,
     /// Seconds from the run's start after which the discontinuity search, adaptive refinement
     /// and the solver stop, and the best so far is kept (`None`: no limit); `report.json` then
     /// marks the run `partial`.
@@ -126,6 +134,7 @@ impl Default for RunOptions {
             penumbra_density: DEFAULT_PENUMBRA_DENSITY,
             discontinuity: DiscontinuityOptions::default(),
             refine: None,
+            tolerance: crate::error_mesh::DEFAULT_TOLERANCE,
             time_budget: None,
             solver: SolverOptions::default(),
             method,
@@ -167,6 +176,12 @@ impl From<SolveError> for InvalidOption {
 }
 
 impl RunOptions {
+    /// Whether the mesh is error-driven ([`MeshMethod::Auto`] without adaptive refinement or a
+    /// shard).
+    pub fn error_driven(&self) -> bool {
+        self.mesh == MeshMethod::Auto && self.refine.is_none() && self.shard.is_none()
+    }
+
     /// Checks every option's range and that the options go together. [`crate::run`] calls it
     /// first; front ends call it to refuse bad input before loading a scene.
     pub fn validate(&self) -> Result<(), InvalidOption> {
@@ -183,6 +198,15 @@ impl RunOptions {
                 format!(
                     "must be between 1 and {MAX_PENUMBRA_DENSITY:e}, not {}",
                     self.penumbra_density
+                ),
+            ));
+        }
+        if !(self.tolerance >= 0.0 && self.tolerance <= 1.0) {
+            return Err(InvalidOption::new(
+                "tolerance",
+                format!(
+                    "must be a fraction in [0, 1] of the mean reflected direct light, not {}",
+                    self.tolerance
                 ),
             ));
         }

@@ -175,6 +175,11 @@ struct Report<'a> {
     /// Adaptive refinement: rounds, residuals and why it stopped (absent when not asked for).
     #[serde(skip_serializing_if = "Option::is_none")]
     refinement: Option<&'a crate::adaptive::RefineReport>,
+    /// Error-driven meshes: the interpolation error of the direct light measured at every
+    /// triangle's check points, per surface and for the scene, and why refinement stopped
+    /// (absent for other meshes).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    mesh_error: Option<&'a crate::error_mesh::MeshErrorReport>,
     times_seconds: &'a StageTimes,
     /// Estimated need, the limit it was checked against, and the peak after each stage.
     memory: &'a crate::pipeline::MemoryReport,
@@ -216,6 +221,8 @@ struct Method {
     /// What was asked for: `"fit"` (the default: what the scene needs) or a number.
     max_elements_requested: BudgetRequested,
     penumbra_density: f64,
+    /// Error-driven meshes' tolerance, relative to the scene's mean reflected direct light.
+    tolerance: f64,
     eee: bool,
     /// Which EV and VE events: `complete` or `extremal`.
     events: penumbra_meshing::discontinuity::EventSet,
@@ -316,6 +323,36 @@ pub fn quality_warning(below: usize, triangles: usize, adaptive: bool) -> Option
     })
 }
 
+/// A warning naming the surfaces left above the tolerance when error-driven refinement stopped
+/// before meeting it (the budget or the time ran out).
+pub fn mesh_error_warning(report: &crate::error_mesh::MeshErrorReport) -> Option<String> {
+    let above = report.above_tolerance();
+    if report.stop == crate::error_mesh::ErrorStop::Tolerance || above.is_empty() {
+        return None;
+    }
+    const NAMED: usize = 5;
+    let mut names: Vec<String> = above
+        .iter()
+        .take(NAMED)
+        .map(|s| format!("{} ({:.2} % at worst)", s.surface, 100.0 * s.max))
+        .collect();
+    if above.len() > NAMED {
+        names.push(format!("and {} more", above.len() - NAMED));
+    }
+    let why = match report.stop {
+        crate::error_mesh::ErrorStop::Budget => "the element budget ran out (--max-elements)",
+        crate::error_mesh::ErrorStop::TimeBudget => "the time budget ran out",
+        _ => "the run was interrupted",
+    };
+    Some(format!(
+        "{why} before the direct light's interpolation error met the tolerance of {} on {} \
+         surface(s): {} (mesh_error.surfaces)",
+        report.tolerance,
+        above.len(),
+        names.join(", ")
+    ))
+}
+
 /// `report.json`, for a run whose SVGs are chosen by `svgs`: how the run was made, what it
 /// built, stage times, memory, the solver's figures, the energy balance, mesh quality and the
 /// warnings of the loader and the run (`docs/schemas/report.schema.json`).
@@ -328,11 +365,15 @@ pub fn report_json(result: &RunResult, svgs: &SvgSelection) -> String {
     warnings.extend(energy.warning());
     warnings.extend(estimated_direct_warning(stats));
     let mesh_quality = result.mesh.quality();
-    warnings.extend(quality_warning(
-        mesh_quality.triangles_below_min_angle,
-        mesh_quality.triangles,
-        result.refinement.is_some(),
-    ));
+    // Error-driven meshes choose their triangles' shapes by the error they measure.
+    if result.mesh_error.is_none() {
+        warnings.extend(quality_warning(
+            mesh_quality.triangles_below_min_angle,
+            mesh_quality.triangles,
+            result.refinement.is_some(),
+        ));
+    }
+    warnings.extend(result.mesh_error.as_ref().and_then(mesh_error_warning));
     let report = Report {
         format: REPORT_FORMAT,
         version: VERSION,
@@ -353,7 +394,9 @@ pub fn report_json(result: &RunResult, svgs: &SvgSelection) -> String {
         },
         warnings,
         method: Method {
-            mesh: if result.mesh.discontinuity_stats.is_some() {
+            mesh: if result.mesh_error.is_some() {
+                "error-driven"
+            } else if result.mesh.discontinuity_stats.is_some() {
                 "discontinuity"
             } else {
                 "uniform"
@@ -363,6 +406,7 @@ pub fn report_json(result: &RunResult, svgs: &SvgSelection) -> String {
             max_elements: result.budget,
             max_elements_requested: opts.max_elements.into(),
             penumbra_density: opts.penumbra_density,
+            tolerance: opts.tolerance,
             eee: opts.discontinuity.eee,
             events: opts.discontinuity.events,
             eee_tolerance: opts.discontinuity.eee_tolerance,
@@ -385,6 +429,7 @@ pub fn report_json(result: &RunResult, svgs: &SvgSelection) -> String {
         },
         discontinuities: result.mesh.discontinuity_stats.as_ref(),
         refinement: result.refinement.as_ref(),
+        mesh_error: result.mesh_error.as_ref(),
         times_seconds: &result.times,
         memory: &result.memory,
         solver: stats,

@@ -4,10 +4,13 @@
 use std::time::Instant;
 
 use crate::adaptive::{RefineReport, refine_adaptively, refine_hierarchically};
+use crate::error_mesh::{MeshErrorReport, StopWhen, refine_by_error};
 use crate::memory::{self, MeshCounts};
 use crate::options::{InvalidOption, MeshMethod, RunOptions};
 use crate::shard::ShardError;
-use penumbra_meshing::discontinuity::{DiscontinuityOptions, find_discontinuities_reporting};
+use penumbra_meshing::discontinuity::{
+    Boundary, DiscontinuityOptions, find_discontinuities_reporting,
+};
 use penumbra_meshing::{
     ElementBudget, MeshError, SceneMesh, mesh_scene_discontinuity_on, mesh_scene_uniform,
     polygon_minimum,
@@ -97,6 +100,9 @@ pub struct RunResult {
     pub mesh: SceneMesh,
     /// What adaptive refinement did, if it was asked for.
     pub refinement: Option<RefineReport>,
+    /// What error-driven refinement of the mesh did, and the error it measured, if the mesh is
+    /// error-driven ([`RunOptions::error_driven`]).
+    pub mesh_error: Option<MeshErrorReport>,
     /// The element budget used, in triangles for the whole scene, resolved: the mesh's, or the
     /// cap of adaptive refinement. The mesh may have fewer.
     pub budget: usize,
@@ -214,6 +220,17 @@ impl RunError {
     }
 }
 
+/// The share of the element budget an error-driven mesh starts from: the discontinuity mesh,
+/// refined evenly for the reflected light, which the exact direct light's error does not see.
+pub const BASE_SHARE: f64 = 0.25;
+
+/// The triangles a budget asks for at least: its cap, or its floor.
+fn budget_floor(budget: ElementBudget) -> usize {
+    match budget {
+        ElementBudget::AtMost(n) | ElementBudget::Fit { at_least: n, .. } => n,
+    }
+}
+
 /// The budget the mesh will have, as far as the polygons alone tell (at least one triangle).
 fn planned_budget(scene: &penumbra_scenes::Scene, options: &RunOptions) -> usize {
     let least = polygon_minimum(scene);
@@ -263,7 +280,19 @@ pub fn run(
     let at_least = polygon_minimum(scene);
     let surfaces = scene.surfaces.len();
     let planned_elements = options.max_elements.resolve(at_least, surfaces)?;
+    let error_driven = options.error_driven();
+    let base_share: f64 = std::env::var("PB_BASE")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(BASE_SHARE);
     let initial_budget = match (&options.refine, options.max_elements) {
+        // Error-driven meshes start from a share of the budget and spend the rest where the
+        // measured error is largest.
+        // (the least mesh when that is more: the final budget refuses what does not fit).
+        (None, budget) if error_driven => ElementBudget::Fit {
+            at_least: (budget_floor(budget) as f64 * base_share) as usize,
+            per_surface: 0,
+        },
         (None, budget) => budget,
         (Some(r), ElementBudget::AtMost(n)) => ElementBudget::AtMost(r.initial_elements.min(n)),
         // Refinement starts from the scene's least mesh when that is more than it asks for,
@@ -336,6 +365,16 @@ pub fn run(
             progress,
         )),
     };
+    // Error-driven meshes keep the lines that carry a real jump; refinement finds the rest.
+    let found = match found {
+        Some(mut found) if error_driven => {
+            for segments in &mut found.segments {
+                segments.retain(|g| g.boundary != Boundary::Inner);
+            }
+            Some(found)
+        }
+        found => found,
+    };
     times.discontinuities = t.elapsed().as_secs_f64();
     peaks.discontinuities = memory::peak_resident_bytes();
     interrupted()?;
@@ -345,6 +384,7 @@ pub fn run(
     let meshed = match found {
         Some(found)
             if options.mesh == MeshMethod::Discontinuity
+                || error_driven
                 || found.stats.segments > 0
                 || found.stats.pairs_skipped > 0 =>
         {
@@ -353,7 +393,11 @@ pub fn run(
                 &visibility,
                 found,
                 initial_budget,
-                options.penumbra_density,
+                if error_driven {
+                    1.0
+                } else {
+                    options.penumbra_density
+                },
                 shard_surfaces.as_deref(),
             )
         }
@@ -372,8 +416,8 @@ pub fn run(
     // Adaptive refinement grows the mesh up to the run's budget, resolved now that the scene's
     // least mesh is known.
     let budget = match options.refine {
-        None => mesh.budget,
-        Some(_) => options
+        None if !error_driven => mesh.budget,
+        _ => options
             .max_elements
             .resolve_for(
                 mesh.minimum_triangles,
@@ -383,6 +427,21 @@ pub fn run(
             .max(mesh.triangle_count()),
     };
     progress.finish();
+    let mesh_error = error_driven.then(|| {
+        let stop = StopWhen {
+            deadline: solver.deadline,
+            interrupt: options.solver.interrupt.clone(),
+        };
+        refine_by_error(
+            scene,
+            &visibility,
+            &mut mesh,
+            budget,
+            options.tolerance,
+            &stop,
+            progress,
+        )
+    });
     times.mesh = t.elapsed().as_secs_f64();
     peaks.mesh = memory::peak_resident_bytes();
     interrupted()?;
@@ -504,6 +563,7 @@ pub fn run(
         options: options.clone(),
         mesh,
         refinement,
+        mesh_error,
         budget,
         solution,
         render,

@@ -70,6 +70,7 @@
 
 #![warn(missing_docs)]
 
+mod bisection;
 mod budget;
 mod cdt;
 mod constrained;
@@ -86,6 +87,7 @@ mod scene_mesh;
 mod uniform;
 mod wedges;
 
+pub use bisection::{BisectionMesh, SHORTEST_SPLIT_EDGE, Split};
 pub use budget::{ElementBudget, FIT_TRIANGLES_PER_SURFACE, polygon_minimum};
 pub use constrained::{ConstrainedSurface, Constraint, RefinableSurface, SPLIT_MIN_ANGLE_DEG};
 pub use error::MeshError;

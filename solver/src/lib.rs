@@ -118,6 +118,6 @@ pub use lambert::{ReceivingPoint, form_factor};
 pub use measure::{InterpolationError, direct_interpolation_error};
 pub use progress::{Interrupt, NoProgress, Progress};
 pub use progressive::{
-    ConvergencePoint, DEFAULT_EPSILON, ProgressiveSolver, SHARED_POINT, Solution, SolveStats,
-    SolverOptions, StopReason, ambient_term, solve_direct_on, solve_progressive,
+    ConvergencePoint, DEFAULT_EPSILON, OVERLAY_CAP, ProgressiveSolver, SHARED_POINT, Solution,
+    SolveStats, SolverOptions, StopReason, ambient_term, solve_direct_on, solve_progressive,
 };

@@ -317,7 +317,7 @@ pub const SHARED_POINT: f64 = 1e-12;
 /// crossings of its edges, which the edges bound only by their square: a light seen through a
 /// lattice of beams and rods crosses each new batch of shadows with the many holes left so far
 /// (with 2^15 edges, one Sponza vertex took minutes and gigabytes in a single overlay).
-pub(crate) const OVERLAY_CAP: usize = 1 << 13;
+pub const OVERLAY_CAP: usize = 1 << 13;
 
 /// The exact direct irradiance at the `receivers` that `wanted` accepts (the others get zero),
 /// computed once per point for receivers that share one (faces of a mesh meeting at a vertex;

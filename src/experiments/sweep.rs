@@ -24,6 +24,8 @@ use crate::pipeline::{RunError, run};
 /// A way of meshing that a sweep compares.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SweepMethod {
+    /// Error-driven meshes (the default of a run, [`MeshMethod::Auto`]).
+    ErrorDriven,
     /// Uniform meshes of the budget.
     Uniform,
     /// Uniform meshes refined adaptively from a fraction of the budget up to it.
@@ -41,14 +43,14 @@ pub enum SweepMethod {
 
 impl SweepMethod {
     /// What a sweep runs unless told otherwise.
-    pub const DEFAULT: [SweepMethod; 4] = [
+    pub const DEFAULT: [SweepMethod; 3] = [
+        SweepMethod::ErrorDriven,
         SweepMethod::Uniform,
-        SweepMethod::UniformAdaptive,
         SweepMethod::Discontinuity,
-        SweepMethod::DiscontinuityAdaptive,
     ];
     /// Every method a sweep can run.
-    pub const ALL: [SweepMethod; 6] = [
+    pub const ALL: [SweepMethod; 7] = [
+        SweepMethod::ErrorDriven,
         SweepMethod::Uniform,
         SweepMethod::UniformAdaptive,
         SweepMethod::Discontinuity,
@@ -57,11 +59,12 @@ impl SweepMethod {
         SweepMethod::DiscontinuityExtremal,
     ];
 
-    /// The method's name in `--methods`, the CSV and the charts: `uniform`,
+    /// The method's name in `--methods`, the CSV and the charts: `error-driven`, `uniform`,
     /// `uniform+adaptive`, `discontinuity`, `discontinuity+adaptive`, `discontinuity-complete`
     /// or `discontinuity-extremal`.
     pub fn name(self) -> &'static str {
         match self {
+            SweepMethod::ErrorDriven => "error-driven",
             SweepMethod::Uniform => "uniform",
             SweepMethod::UniformAdaptive => "uniform+adaptive",
             SweepMethod::Discontinuity => "discontinuity",
@@ -81,6 +84,7 @@ impl SweepMethod {
 
     fn mesh(self) -> MeshMethod {
         match self {
+            SweepMethod::ErrorDriven => MeshMethod::Auto,
             SweepMethod::Uniform | SweepMethod::UniformAdaptive => MeshMethod::Uniform,
             _ => MeshMethod::Discontinuity,
         }

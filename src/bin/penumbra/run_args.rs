@@ -25,6 +25,11 @@ fn default_export() -> String {
     DEFAULT_EXPORT.to_owned()
 }
 
+// Reports written before error-driven meshes replay with their default tolerance.
+fn default_tol() -> f64 {
+    penumbra::error_mesh::DEFAULT_TOLERANCE
+}
+
 // Reports written before photon mapping replay with its defaults.
 fn default_photons() -> usize {
     penumbra_solver::photon_map::DEFAULT_PHOTONS
@@ -139,10 +144,18 @@ pub(crate) struct RunArgs {
     /// material are merged where the union is a simple polygon).
     #[arg(help_heading = INPUT, long)]
     pub(crate) no_merge: bool,
-    /// How surfaces are meshed (default: discontinuity where the scene casts shadows, else
-    /// uniform).
+    /// How surfaces are meshed (default: error-driven, along the umbra and penumbra boundaries
+    /// and contact lines, refined where the interpolation of the exact direct light is
+    /// measured worst, up to --max-elements or --tol; with --refine-tol or --shard,
+    /// discontinuity where the scene casts shadows, else uniform).
     #[arg(help_heading = MESH, long, value_enum)]
     pub(crate) mesh: Option<MeshArg>,
+    /// Error-driven meshes (the default): split triangles until no check point (edge midpoints
+    /// and centroids) misses the exact direct light by more than this fraction of the scene's
+    /// mean reflected direct light, or --max-elements is reached.
+    #[arg(help_heading = MESH, long, default_value_t = penumbra::error_mesh::DEFAULT_TOLERANCE)]
+    #[serde(default = "default_tol")]
+    pub(crate) tol: f64,
     /// Cap on triangles for the whole scene, spread over the surfaces by area. Default: what the
     /// scene needs: 25,000 with the hierarchical solver (its cost grows about linearly with the
     /// vertices), 10,000 with the others or --direct-only, or, when that is too few, the least
@@ -332,6 +345,7 @@ impl RunArgs {
                     self.refine_tol.is_some(),
                 )),
             time_budget: self.time_budget,
+            tolerance: self.tol,
             refine: self
                 .refine_tol
                 .map(|tolerance| penumbra::adaptive::RefineOptions {

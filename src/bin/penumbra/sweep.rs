@@ -51,10 +51,11 @@ pub(crate) struct SweepArgs {
     /// not emit).
     #[arg(long, value_delimiter = ',')]
     surfaces: Vec<String>,
-    /// The methods to run (comma-separated; default: the first four). `discontinuity` meshes the
+    /// The methods to run (comma-separated; default: the first three): `error-driven` is a run's
+    /// default mesh, `discontinuity` the discontinuity mesh graded by area alone. `discontinuity` meshes the
     /// default events (complete); `discontinuity-complete` and `discontinuity-extremal` name
     /// them (`run --events complete|extremal`).
-    #[arg(long, value_delimiter = ',', value_parser = ["uniform", "uniform+adaptive", "discontinuity", "discontinuity+adaptive", "discontinuity-complete", "discontinuity-extremal"])]
+    #[arg(long, value_delimiter = ',', value_parser = ["error-driven", "uniform", "uniform+adaptive", "discontinuity", "discontinuity+adaptive", "discontinuity-complete", "discontinuity-extremal"])]
     methods: Vec<String>,
     /// The solvers to compare, comma-separated (default: progressive). Adaptive runs use
     /// progressive refinement or the hierarchical solver.

@@ -1,0 +1,646 @@
+//! Error-driven meshes: the exact direct light can be evaluated anywhere, so a mesh's
+//! interpolation error is measured, not guessed. Every triangle is checked at its edge midpoints
+//! and centroid against the linear interpolation of its vertices, and the triangles whose
+//! measured error carries the largest share of the squared error (error squared times area) are
+//! split first, over all surfaces at once through one priority queue, until the element budget
+//! or the tolerance is reached.
+//!
+//! A triangle is measured when it first comes to the top of the queue, which holds it until
+//! then by a bound on its error (its area times the brightest light its surface could
+//! reflect): the many small faces of a scanned statue, whose bound is below what the budget
+//! reaches, are never measured.
+//!
+//! Triangles are split by conforming longest-edge bisection ([`BisectionMesh`]): the new vertex
+//! is the midpoint of an edge that was checked, and takes that check's value, so no point is
+//! evaluated twice. Splits never cross a mesh edge, so the discontinuities built into the mesh
+//! stay edges, and thin triangles along them stay thin: they interpolate well.
+
+use std::cmp::Ordering;
+use std::collections::{BinaryHeap, HashMap, HashSet};
+use std::time::Instant;
+
+use glam::DVec3;
+use penumbra_meshing::{BisectionMesh, SceneMesh, Split, SurfaceMesh};
+use penumbra_scenes::{Rgb, Scene, SplitMix64, SurfaceId, Visibility};
+use penumbra_solver::{DirectLight, Interrupt, OVERLAY_CAP, Progress, ReceivingPoint};
+use rayon::prelude::*;
+use serde::Serialize;
+
+/// The error a run aims for by default, relative to the mean reflected direct light: a check
+/// point may miss the exact light by this much before its triangle stops being split. Small
+/// enough that the default budget, not the tolerance, ends refinement on the scenes measured in
+/// `docs/accuracy.md`.
+pub const DEFAULT_TOLERANCE: f64 = 2e-3;
+
+/// A batch of splits takes at most this fraction of the triangles the mesh has: the queue's order
+/// is kept to within a batch, and each batch's checks are evaluated in parallel.
+const BATCH_FRACTION: f64 = 1.0 / 16.0;
+
+/// A bound on a triangle's squared error over its area, in units of the square of the brightest
+/// light its surface can reflect, M: with every check point off by at most M, the estimate of
+/// [`Refined::squared_error`] is at most (4/45)·12 + (729/2520)·(7/3)² < 2.65.
+const SQUARED_ERROR_BOUND: f64 = 2.65;
+
+/// Points the scene's mean reflected direct light is sampled at (seeded, spread by area): the
+/// scale of the tolerance and of the report's relative errors.
+const MEAN_SAMPLES: usize = 1024;
+
+/// The seed of those points.
+const MEAN_SEED: u64 = 0x6d65_616e;
+
+/// Room kept below the budget: a split's propagation path adds a few triangles more than the
+/// two of the split itself.
+const SPLIT_MARGIN: usize = 32;
+
+/// Why error-driven refinement stopped (`mesh_error.stop` in `report.json`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ErrorStop {
+    /// Every check point is within the tolerance.
+    Tolerance,
+    /// The element budget is spent.
+    Budget,
+    /// The time budget ran out.
+    TimeBudget,
+    /// The run was interrupted.
+    Interrupted,
+}
+
+/// One surface's measured interpolation error of the direct light (an entry of
+/// `mesh_error.surfaces` in `report.json`).
+#[derive(Clone, Debug, Serialize)]
+pub struct SurfaceError {
+    /// The surface's name.
+    pub surface: String,
+    /// Its triangles.
+    pub triangles: usize,
+    /// Of those, how many were measured at their check points (the others' bound was below
+    /// every error refinement reached).
+    pub measured: usize,
+    /// Area-weighted mean of the reflected direct light (ρ·H, channel mean) at its vertices, in
+    /// W/m².
+    pub mean_reflected: f64,
+    /// Area-weighted RMS of the check points' errors, relative to `mean_reflected`.
+    pub rms: f64,
+    /// The largest check point error, relative to `mean_reflected`.
+    pub max: f64,
+}
+
+/// What error-driven refinement did and the error it measured (`mesh_error` in `report.json`).
+#[derive(Clone, Debug, Serialize)]
+pub struct MeshErrorReport {
+    /// The tolerance asked for, relative to the scene's mean reflected direct light.
+    pub tolerance: f64,
+    /// The scene's mean reflected direct light (channel mean) over the reflecting surfaces,
+    /// W/m², sampled at [`MEAN_SAMPLES`] points spread by area.
+    pub mean_reflected: f64,
+    /// Why refinement stopped.
+    pub stop: ErrorStop,
+    /// Triangles of the mesh refinement started from.
+    pub triangles_before: usize,
+    /// Triangles of the refined mesh.
+    pub triangles: usize,
+    /// Points where the exact direct light was evaluated (vertices and check points).
+    pub evaluations: usize,
+    /// Area-weighted RMS of the check points' errors over the measured triangles, relative to
+    /// `mean_reflected`.
+    pub rms: f64,
+    /// The share of the reflecting surfaces' area in triangles never measured.
+    pub unmeasured_area: f64,
+    /// The largest check point error, relative to `mean_reflected`.
+    pub max: f64,
+    /// Each reflecting surface with a measured triangle, in the scene's order.
+    pub surfaces: Vec<SurfaceError>,
+}
+
+impl MeshErrorReport {
+    /// The surfaces whose largest check point error is above the tolerance (relative to the
+    /// scene's mean): where the budget ran out before the tolerance was met.
+    pub fn above_tolerance(&self) -> Vec<&SurfaceError> {
+        let scene = self.mean_reflected.max(f64::MIN_POSITIVE);
+        self.surfaces
+            .iter()
+            .filter(|s| s.max * s.mean_reflected > self.tolerance * scene)
+            .collect()
+    }
+}
+
+/// When refinement must stop early.
+#[derive(Clone, Debug, Default)]
+pub struct StopWhen {
+    /// At this instant (a run's time budget).
+    pub deadline: Option<Instant>,
+    /// When this is set (Ctrl-C).
+    pub interrupt: Option<Interrupt>,
+}
+
+impl StopWhen {
+    fn now(&self) -> Option<ErrorStop> {
+        if self.interrupt.as_ref().is_some_and(Interrupt::is_set) {
+            Some(ErrorStop::Interrupted)
+        } else if self.deadline.is_some_and(|d| Instant::now() >= d) {
+            Some(ErrorStop::TimeBudget)
+        } else {
+            None
+        }
+    }
+}
+
+/// Refines `mesh` where its interpolation of the exact direct light is worst, up to `budget`
+/// triangles in all or until no check point misses by more than `tolerance` times the scene's
+/// mean reflected direct light. The refined mesh keeps no triangulations to refine further
+/// ([`SceneMesh::refinable`] is emptied).
+pub fn refine_by_error(
+    scene: &Scene,
+    visibility: &Visibility,
+    mesh: &mut SceneMesh,
+    budget: usize,
+    tolerance: f64,
+    stop: &StopWhen,
+    progress: &dyn Progress,
+) -> MeshErrorReport {
+    let direct = DirectLight::new(scene, visibility).with_overlay_cap(OVERLAY_CAP);
+    let triangles_before = mesh.triangle_count();
+    let mut refiner = Refiner::new(scene, mesh, &direct);
+    let mean = refiner.sampled_mean();
+    let threshold = tolerance * mean;
+    refiner.fill_queue(threshold);
+    progress.start("refining by error", budget as u64);
+    let reason = loop {
+        progress.set(refiner.triangles as u64);
+        if let Some(reason) = stop.now() {
+            break reason;
+        }
+        let room = budget.saturating_sub(refiner.triangles);
+        if room < SPLIT_MARGIN + 4 {
+            break ErrorStop::Budget;
+        }
+        let batch = ((refiner.triangles as f64 * BATCH_FRACTION) as usize).clamp(1, room / 4);
+        if !refiner.step(batch, budget - SPLIT_MARGIN, threshold) {
+            break ErrorStop::Tolerance;
+        }
+    };
+    progress.finish();
+    let report = refiner.report(scene, tolerance, mean, reason, triangles_before);
+    for s in refiner.surfaces {
+        mesh.surfaces[s.id] = s.mesh.into_mesh();
+    }
+    mesh.refinable = Vec::new();
+    report
+}
+
+/// A reflecting surface being refined, with the values measured on it: the reflected direct
+/// light (ρ·H, channel mean) at its vertices, edge midpoints and centroids.
+struct Refined {
+    id: SurfaceId,
+    mesh: BisectionMesh,
+    reflectance: Rgb,
+    /// The brightest light it can reflect: ρ times the brightest emitter (form factors to all
+    /// emitters sum to at most one).
+    brightest: f64,
+    /// NaN until measured.
+    vertex: Vec<f64>,
+    /// By the edge's vertices, smaller first: the two sides of a jump have their own.
+    midpoint: HashMap<(u32, u32), f64>,
+    centroid: Vec<f64>,
+    /// Whether each triangle was measured (or is being measured).
+    measured: Vec<bool>,
+    /// Each measured triangle's largest check point error, W/m².
+    error: Vec<f64>,
+    /// Bumped when a triangle changes, so that its old queue entries are passed over.
+    version: Vec<u32>,
+}
+
+/// A point to evaluate, on a surface being refined.
+#[derive(Clone, Copy, Debug)]
+enum Check {
+    /// A vertex, approached from inside the triangle whose centroid is given.
+    Vertex(u32, DVec3),
+    /// The midpoint of edge `[a, b]`, from the side of the corner `c` across it; for a vertex
+    /// made there, `Some(vertex)`.
+    Edge([u32; 3], Option<u32>),
+    /// A triangle's centroid.
+    Centroid(u32),
+}
+
+/// A queue entry: a triangle's share of the squared error, measured or bounded.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Entry {
+    priority: f64,
+    surface: u32,
+    triangle: u32,
+    version: u32,
+}
+
+impl Eq for Entry {}
+
+impl Ord for Entry {
+    fn cmp(&self, other: &Self) -> Ordering {
+        self.priority
+            .total_cmp(&other.priority)
+            .then((other.surface, other.triangle).cmp(&(self.surface, self.triangle)))
+    }
+}
+
+impl PartialOrd for Entry {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+struct Refiner<'a> {
+    direct: &'a DirectLight<'a>,
+    surfaces: Vec<Refined>,
+    queue: BinaryHeap<Entry>,
+    /// Triangles of the whole scene, reflecting or not.
+    triangles: usize,
+    evaluations: usize,
+}
+
+impl<'a> Refiner<'a> {
+    /// Takes the reflecting surfaces of `mesh`, none measured yet.
+    fn new(scene: &Scene, mesh: &SceneMesh, direct: &'a DirectLight<'a>) -> Refiner<'a> {
+        let brightest = scene
+            .emitters()
+            .map(|(_, e)| e.emission)
+            .fold(Rgb::ZERO, |a, e| {
+                Rgb::new(a.r.max(e.r), a.g.max(e.g), a.b.max(e.b))
+            });
+        let surfaces = mesh
+            .surfaces
+            .iter()
+            .filter(|m| {
+                scene.surfaces[m.surface].reflectance.mean() > 0.0 && m.triangle_count() > 0
+            })
+            .map(|m| {
+                let reflectance = scene.surfaces[m.surface].reflectance;
+                let n = m.triangle_count();
+                Refined {
+                    id: m.surface,
+                    reflectance,
+                    brightest: reflectance.mul_rgb(brightest).mean(),
+                    vertex: vec![f64::NAN; m.vertex_count()],
+                    midpoint: HashMap::new(),
+                    centroid: vec![f64::NAN; n],
+                    measured: vec![false; n],
+                    error: vec![0.0; n],
+                    version: vec![0; n],
+                    mesh: BisectionMesh::new(m.clone()),
+                }
+            })
+            .collect();
+        Refiner {
+            direct,
+            surfaces,
+            queue: BinaryHeap::new(),
+            triangles: mesh.triangle_count(),
+            evaluations: 0,
+        }
+    }
+
+    /// The mean reflected direct light over the reflecting surfaces, sampled at seeded points
+    /// spread by area.
+    fn sampled_mean(&mut self) -> f64 {
+        let mut cumulative = Vec::new();
+        let mut total = 0.0;
+        for (i, s) in self.surfaces.iter().enumerate() {
+            for t in 0..s.mesh().triangle_count() {
+                total += s.mesh().triangle_area(t);
+                cumulative.push((total, i, t));
+            }
+        }
+        if cumulative.is_empty() {
+            return 0.0;
+        }
+        let mut rng = SplitMix64::keyed(MEAN_SEED, &[]);
+        let points: Vec<(usize, ReceivingPoint)> = (0..MEAN_SAMPLES)
+            .map(|_| {
+                let u = rng.next_f64() * total;
+                let k = cumulative
+                    .partition_point(|c| c.0 < u)
+                    .min(cumulative.len() - 1);
+                let (_, i, t) = cumulative[k];
+                let (r1, r2) = (rng.next_f64().sqrt(), rng.next_f64());
+                let [a, b, c] = self.surfaces[i].mesh().triangle_points3(t);
+                let p = a * (1.0 - r1) + b * (r1 * (1.0 - r2)) + c * (r1 * r2);
+                let normal = self.surfaces[i].mesh().frame.normal;
+                (i, ReceivingPoint::interior(p, normal))
+            })
+            .collect();
+        let values: Vec<f64> = points
+            .par_iter()
+            .map(|(i, x)| self.surfaces[*i].value(self.direct.irradiance(x, self.surfaces[*i].id)))
+            .collect();
+        self.evaluations += values.len();
+        let finite: Vec<f64> = values.into_iter().filter(|v| v.is_finite()).collect();
+        finite.iter().sum::<f64>() / finite.len().max(1) as f64
+    }
+
+    /// Every triangle that may need splitting, by the bound on its error.
+    fn fill_queue(&mut self, threshold: f64) {
+        for (i, s) in self.surfaces.iter().enumerate() {
+            if s.brightest <= threshold {
+                continue;
+            }
+            for t in 0..s.mesh().triangle_count() {
+                self.queue.push(Entry {
+                    priority: SQUARED_ERROR_BOUND
+                        * s.brightest
+                        * s.brightest
+                        * s.mesh().triangle_area(t),
+                    surface: i as u32,
+                    triangle: t as u32,
+                    version: 0,
+                });
+            }
+        }
+    }
+
+    /// Takes the worst triangles off the queue: measures those not measured yet and splits
+    /// the others, up to `batch` of each (while the scene has fewer than `most` triangles);
+    /// then measures what changed and queues it again. Returns false when the queue is empty.
+    fn step(&mut self, batch: usize, most: usize, threshold: f64) -> bool {
+        // What the step changed or is to measure, on each surface.
+        let mut changed: Vec<Split> = vec![Split::default(); self.surfaces.len()];
+        let (mut splits, mut measures) = (0, 0);
+        while splits < batch && measures < batch && self.triangles < most {
+            let Some(e) = self.queue.pop() else { break };
+            let (i, t) = (e.surface as usize, e.triangle as usize);
+            let s = &mut self.surfaces[i];
+            if s.version[t] != e.version {
+                continue;
+            }
+            if !s.measured[t] {
+                s.measured[t] = true;
+                changed[i].triangles.push(t as u32);
+                measures += 1;
+                continue;
+            }
+            if s.mesh.too_small(t) {
+                continue;
+            }
+            let mut split = Split::default();
+            s.mesh.split(t, &mut split);
+            s.grow(&split);
+            // Each half replaces or joins a triangle.
+            self.triangles += split.triangles.len() / 2;
+            splits += 1;
+            changed[i].triangles.extend(split.triangles);
+            changed[i].vertices.extend(split.vertices);
+        }
+        if splits + measures == 0 {
+            return false;
+        }
+        let mut checks = Vec::new();
+        for (i, split) in changed.iter().enumerate() {
+            checks.extend(
+                self.surfaces[i]
+                    .checks_missing(split)
+                    .into_iter()
+                    .map(|c| (i, c)),
+            );
+        }
+        self.evaluate(&checks);
+        for (i, split) in changed.into_iter().enumerate() {
+            let s = &mut self.surfaces[i];
+            let mut triangles = split.triangles;
+            triangles.sort_unstable();
+            triangles.dedup();
+            for &t in &triangles {
+                let t = t as usize;
+                s.measured[t] = true;
+                s.error[t] = s.triangle_error(t);
+                if s.error[t] > threshold {
+                    self.queue.push(Entry {
+                        priority: s.squared_error(t),
+                        surface: i as u32,
+                        triangle: t as u32,
+                        version: s.version[t],
+                    });
+                }
+            }
+        }
+        true
+    }
+
+    /// Evaluates the exact light at `checks` (in parallel) and stores the values.
+    fn evaluate(&mut self, checks: &[(usize, Check)]) {
+        let values: Vec<f64> = checks
+            .par_iter()
+            .map(|&(i, c)| {
+                let s = &self.surfaces[i];
+                s.value(self.direct.irradiance(&s.point(c), s.id))
+            })
+            .collect();
+        self.evaluations += checks.len();
+        for (&(i, c), value) in checks.iter().zip(values) {
+            self.surfaces[i].store(c, value);
+        }
+    }
+
+    fn report(
+        &self,
+        scene: &Scene,
+        tolerance: f64,
+        mean: f64,
+        stop: ErrorStop,
+        triangles_before: usize,
+    ) -> MeshErrorReport {
+        let surfaces: Vec<SurfaceError> = self
+            .surfaces
+            .iter()
+            .filter(|s| s.measured.iter().any(|&m| m))
+            .map(|s| s.summary(&scene.surfaces[s.id].name))
+            .collect();
+        let (mut area, mut measured, mut sum2, mut max) = (0.0, 0.0, 0.0, 0.0f64);
+        for s in &self.surfaces {
+            let m = s.mesh();
+            for t in 0..m.triangle_count() {
+                let a = m.triangle_area(t);
+                area += a;
+                if s.measured[t] {
+                    measured += a;
+                    sum2 += a * s.error[t] * s.error[t];
+                    max = max.max(s.error[t]);
+                }
+            }
+        }
+        let relative = |e: f64| if mean > 0.0 { e / mean } else { 0.0 };
+        MeshErrorReport {
+            tolerance,
+            mean_reflected: mean,
+            stop,
+            triangles_before,
+            triangles: self.triangles,
+            evaluations: self.evaluations,
+            rms: relative((sum2 / measured.max(f64::MIN_POSITIVE)).sqrt()),
+            unmeasured_area: if area > 0.0 {
+                1.0 - measured / area
+            } else {
+                0.0
+            },
+            max: relative(max),
+            surfaces,
+        }
+    }
+}
+
+impl Refined {
+    fn mesh(&self) -> &SurfaceMesh {
+        self.mesh.mesh()
+    }
+
+    /// The reflected light (channel mean) of irradiance `h`.
+    fn value(&self, h: Rgb) -> f64 {
+        self.reflectance.mul_rgb(h).mean()
+    }
+
+    /// The checks not measured yet of the triangles `changed` lists and of the vertices it
+    /// made (which take their edges' values when those were measured): each triangle's
+    /// centroid, its vertices and its edges' midpoints, each once.
+    fn checks_missing(&self, changed: &Split) -> Vec<Check> {
+        let m = self.mesh();
+        let mut checks = Vec::new();
+        let mut vertices = HashSet::new();
+        for &(v, edge) in &changed.vertices {
+            if self.vertex[v as usize].is_nan() && vertices.insert(v) {
+                checks.push(Check::Edge(edge, Some(v)));
+            }
+        }
+        let (mut triangles, mut edges) = (HashSet::new(), HashSet::new());
+        for &t in &changed.triangles {
+            if !triangles.insert(t) {
+                continue;
+            }
+            checks.push(Check::Centroid(t));
+            let p = m.triangle_points3(t as usize);
+            let centroid = (p[0] + p[1] + p[2]) / 3.0;
+            for k in 0..3 {
+                let [a, b] = self.mesh.edge(t as usize, k);
+                if self.vertex[a as usize].is_nan() && vertices.insert(a) {
+                    checks.push(Check::Vertex(a, centroid));
+                }
+                let key = (a.min(b), a.max(b));
+                if !self.midpoint.contains_key(&key) && edges.insert(key) {
+                    checks.push(Check::Edge([a, b, self.mesh.opposite(t, k)], None));
+                }
+            }
+        }
+        checks
+    }
+
+    /// Room for the triangles and vertices `split` made; the vertices take their edges' values.
+    fn grow(&mut self, split: &Split) {
+        let m = self.mesh.mesh();
+        self.vertex.resize(m.vertex_count(), f64::NAN);
+        self.centroid.resize(m.triangle_count(), f64::NAN);
+        self.measured.resize(m.triangle_count(), false);
+        self.error.resize(m.triangle_count(), 0.0);
+        self.version.resize(m.triangle_count(), 0);
+        for &t in &split.triangles {
+            self.version[t as usize] += 1;
+        }
+        for &(v, [a, b, _]) in &split.vertices {
+            if let Some(&value) = self.midpoint.get(&(a.min(b), a.max(b))) {
+                self.vertex[v as usize] = value;
+            }
+        }
+    }
+
+    /// Where check `c` is, approached from the side it belongs to.
+    fn point(&self, c: Check) -> ReceivingPoint {
+        let m = self.mesh();
+        let normal = m.frame.normal;
+        let towards = |p: DVec3, q: DVec3| ReceivingPoint {
+            point: p,
+            normal,
+            inward: (q - p).normalize_or_zero(),
+        };
+        match c {
+            Check::Vertex(v, centroid) => towards(m.points3[v as usize], centroid),
+            Check::Edge([a, b, c], _) => towards(
+                (m.points3[a as usize] + m.points3[b as usize]) * 0.5,
+                m.points3[c as usize],
+            ),
+            Check::Centroid(t) => {
+                let p = m.triangle_points3(t as usize);
+                ReceivingPoint::interior((p[0] + p[1] + p[2]) / 3.0, normal)
+            }
+        }
+    }
+
+    fn store(&mut self, c: Check, value: f64) {
+        match c {
+            Check::Vertex(v, _) | Check::Edge(_, Some(v)) => self.vertex[v as usize] = value,
+            Check::Edge([a, b, _], None) => {
+                self.midpoint.insert((a.min(b), a.max(b)), value);
+            }
+            Check::Centroid(t) => self.centroid[t as usize] = value,
+        }
+    }
+
+    /// Triangle `t`'s check point errors: its edge midpoints' (in its edges' order) and its
+    /// centroid's, each the exact value less the interpolated one. A value the evaluator could
+    /// not give (a view beyond its overlay cap) counts as no error.
+    fn deviations(&self, t: usize) -> [f64; 4] {
+        let tri = self.mesh().triangles[t];
+        let v = |k: usize| self.vertex[tri[k] as usize];
+        let mut d = [0.0; 4];
+        for (k, dk) in d.iter_mut().enumerate().take(3) {
+            let [a, b] = self.mesh.edge(t, k);
+            if let Some(&m) = self.midpoint.get(&(a.min(b), a.max(b))) {
+                *dk = m - (self.vertex[a as usize] + self.vertex[b as usize]) * 0.5;
+            }
+        }
+        d[3] = self.centroid[t] - (v(0) + v(1) + v(2)) / 3.0;
+        d.map(|x| if x.is_finite() { x } else { 0.0 })
+    }
+
+    /// Triangle `t`'s largest check point error.
+    fn triangle_error(&self, t: usize) -> f64 {
+        self.deviations(t).iter().fold(0.0, |e, d| e.max(d.abs()))
+    }
+
+    /// Triangle `t`'s squared interpolation error integrated over it, estimated from its check
+    /// points: the light as the linear interpolant plus a quadratic bubble on each edge (the
+    /// midpoint's deviation d_e) and a cubic one for what the centroid adds beyond them, whose
+    /// integrals of products over a triangle of area A are (4A/45)((Σd)² + Σd²) and
+    /// (729/2520)A r².
+    fn squared_error(&self, t: usize) -> f64 {
+        let d = self.deviations(t);
+        let (sum, sum2) = (d[0] + d[1] + d[2], d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        let r = d[3] - 4.0 / 9.0 * sum;
+        let area = self.mesh().triangle_area(t);
+        area * (4.0 / 45.0 * (sum * sum + sum2) + 729.0 / 2520.0 * r * r)
+    }
+
+    fn summary(&self, name: &str) -> SurfaceError {
+        let m = self.mesh();
+        let (mut area, mut sum, mut sum2, mut max) = (0.0, 0.0, 0.0, 0.0f64);
+        let mut measured = 0;
+        for t in (0..m.triangle_count()).filter(|&t| self.measured[t]) {
+            let a = m.triangle_area(t);
+            let mean: f64 = m.triangles[t]
+                .iter()
+                .map(|&v| self.vertex[v as usize])
+                .sum::<f64>()
+                / 3.0;
+            area += a;
+            sum += a * mean;
+            sum2 += a * self.error[t] * self.error[t];
+            max = max.max(self.error[t]);
+            measured += 1;
+        }
+        let area = area.max(f64::MIN_POSITIVE);
+        let mean = sum / area;
+        let relative = |e: f64| if mean > 0.0 { e / mean } else { 0.0 };
+        SurfaceError {
+            surface: name.to_string(),
+            triangles: m.triangle_count(),
+            measured,
+            mean_reflected: mean,
+            rms: relative((sum2 / area).sqrt()),
+            max: relative(max),
+        }
+    }
+}
