@@ -1,14 +1,16 @@
 //! Error-driven meshes: the exact direct light can be evaluated anywhere, so a mesh's
 //! interpolation error is measured, not guessed. Every triangle is checked at its edge midpoints
-//! and centroid against the linear interpolation of its vertices, and the triangles whose
-//! measured error carries the largest share of the squared error (error squared times area) are
-//! split first, over all surfaces at once through one priority queue, until the element budget
-//! or the tolerance is reached.
+//! against the linear interpolation of its vertices; the deviations give the quadratic that
+//! the linear interpolation misses, and so the triangle's squared error integrated over it. The
+//! triangles with the largest squared error are split first, over all surfaces at once through
+//! one priority queue, until every surface's RMS error is within the tolerance of its mean
+//! reflected direct light, or the element budget is spent.
 //!
 //! A triangle is measured when it first comes to the top of the queue, which holds it until
-//! then by a bound on its error (its area times the brightest light its surface could
-//! reflect): the many small faces of a scanned statue, whose bound is below what the budget
-//! reaches, are never measured.
+//! then by a prior on its error: a tenth of the light it would reflect unoccluded for a
+//! triangle of the budget's typical size, and less in proportion to area for smaller ones
+//! (interpolation error goes as the square of the size). The many small faces of a scanned
+//! statue, whose prior is below what the budget reaches, are never measured.
 //!
 //! Triangles are split by conforming longest-edge bisection ([`BisectionMesh`]): the new vertex
 //! is the midpoint of an edge that was checked, and takes that check's value, so no point is
@@ -22,7 +24,7 @@ use std::time::Instant;
 use glam::DVec3;
 use penumbra_meshing::{BisectionMesh, SceneMesh, Split, SurfaceMesh};
 use penumbra_scenes::{Rgb, Scene, SplitMix64, SurfaceId, Visibility};
-use penumbra_solver::{DirectLight, Interrupt, OVERLAY_CAP, Progress, ReceivingPoint};
+use penumbra_solver::{DirectLight, Interrupt, OVERLAY_CAP, Progress, ReceivingPoint, form_factor};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -30,20 +32,43 @@ use serde::Serialize;
 /// point may miss the exact light by this much before its triangle stops being split. Small
 /// enough that the default budget, not the tolerance, ends refinement on the scenes measured in
 /// `docs/accuracy.md`.
-pub const DEFAULT_TOLERANCE: f64 = 2e-3;
+pub const DEFAULT_TOLERANCE: f64 = 5e-3;
 
 /// A batch of splits takes at most this fraction of the triangles the mesh has: the queue's order
 /// is kept to within a batch, and each batch's checks are evaluated in parallel.
-const BATCH_FRACTION: f64 = 1.0 / 16.0;
+const BATCH_FRACTION: f64 = 1.0 / 64.0;
 
-/// A bound on a triangle's squared error over its area, in units of the square of the brightest
-/// light its surface can reflect, M: with every check point off by at most M, the estimate of
-/// [`Refined::squared_error`] is at most (4/45)·12 + (729/2520)·(7/3)² < 2.65.
-const SQUARED_ERROR_BOUND: f64 = 2.65;
+/// A triangle's squared error over its area, before it is measured, in units of the square of
+/// its prior error (below): the estimate of [`Refined::squared_error`] when every check point
+/// is off by it, (4/45)·(9 + 3).
+const PRIOR_SQUARED_ERROR: f64 = 48.0 / 45.0;
+
+/// A triangle of the budget's typical size is presumed off by this fraction of the light it
+/// would reflect unoccluded until it is measured.
+const PRIOR_RELATIVE_ERROR: f64 = 0.1;
+
+/// Surfaces smaller than this many of the budget's typical elements keep their least mesh.
+const REFINED_ELEMENTS: f64 = 8.0;
+
+/// Triangles smaller than this share of the budget's typical element are not split: a jump
+/// across a triangle (a value discontinuity the mesh does not follow) keeps its error however
+/// small the triangle, and would take the whole budget down to rounding.
+const SMALLEST_SHARE: f64 = 1.0 / 64.0;
+
+/// A surface darker than this share of the scene's mean reflected direct light is held to the
+/// tolerance of one that bright: the relative error of a surface in shadow is not worth a budget.
+const DARK_SHARE: f64 = 0.1;
+
+/// Points closer than this fraction of the scene's diagonal to an emitter's edge or plane
+/// count as on it, for the unoccluded light of a triangle's prior.
+const UNOCCLUDED_TOLERANCE: f64 = 1e-9;
 
 /// Points the scene's mean reflected direct light is sampled at (seeded, spread by area): the
 /// scale of the tolerance and of the report's relative errors.
-const MEAN_SAMPLES: usize = 1024;
+const MEAN_SAMPLES: usize = 2048;
+
+/// A surface with this many of those points takes their mean as its own.
+const MIN_SURFACE_SAMPLES: usize = 64;
 
 /// The seed of those points.
 const MEAN_SEED: u64 = 0x6d65_616e;
@@ -77,13 +102,17 @@ pub struct SurfaceError {
     /// Of those, how many were measured at their check points (the others' bound was below
     /// every error refinement reached).
     pub measured: usize,
-    /// Area-weighted mean of the reflected direct light (ρ·H, channel mean) at its vertices, in
-    /// W/m².
+    /// Its mean reflected direct light (ρ·H, channel mean), W/m²: from the scene's samples on
+    /// it when it has enough of them, else from its vertices.
     pub mean_reflected: f64,
-    /// Area-weighted RMS of the check points' errors, relative to `mean_reflected`.
+    /// Its estimated RMS interpolation error (of the measured triangles, from their check
+    /// points, and of the others, from their priors), relative to `mean_reflected`.
     pub rms: f64,
     /// The largest check point error, relative to `mean_reflected`.
     pub max: f64,
+    /// Whether its estimated RMS error (of its measured triangles and the priors of the others)
+    /// is within the tolerance of its mean (or of a tenth of the scene's, if darker).
+    pub within_tolerance: bool,
 }
 
 /// What error-driven refinement did and the error it measured (`mesh_error` in `report.json`).
@@ -114,13 +143,11 @@ pub struct MeshErrorReport {
 }
 
 impl MeshErrorReport {
-    /// The surfaces whose largest check point error is above the tolerance (relative to the
-    /// scene's mean): where the budget ran out before the tolerance was met.
+    /// The surfaces left above the tolerance: where the budget or the time ran out first.
     pub fn above_tolerance(&self) -> Vec<&SurfaceError> {
-        let scene = self.mean_reflected.max(f64::MIN_POSITIVE);
         self.surfaces
             .iter()
-            .filter(|s| s.max * s.mean_reflected > self.tolerance * scene)
+            .filter(|s| !s.within_tolerance)
             .collect()
     }
 }
@@ -162,9 +189,12 @@ pub fn refine_by_error(
     let direct = DirectLight::new(scene, visibility).with_overlay_cap(OVERLAY_CAP);
     let triangles_before = mesh.triangle_count();
     let mut refiner = Refiner::new(scene, mesh, &direct);
+    // Out of time before it starts: the mesh stays as it is, measured nowhere.
+    if let Some(reason) = stop.now() {
+        return refiner.report(scene, tolerance, 0.0, reason, triangles_before);
+    }
     let mean = refiner.sampled_mean();
-    let threshold = tolerance * mean;
-    refiner.fill_queue(threshold);
+    refiner.start(scene, budget, tolerance, mean);
     progress.start("refining by error", budget as u64);
     let reason = loop {
         progress.set(refiner.triangles as u64);
@@ -176,13 +206,24 @@ pub fn refine_by_error(
             break ErrorStop::Budget;
         }
         let batch = ((refiner.triangles as f64 * BATCH_FRACTION) as usize).clamp(1, room / 4);
-        if !refiner.step(batch, budget - SPLIT_MARGIN, threshold) {
+        if !refiner.step(batch, budget - SPLIT_MARGIN) {
             break ErrorStop::Tolerance;
         }
     };
     progress.finish();
     let report = refiner.report(scene, tolerance, mean, reason, triangles_before);
+    mesh.measured_direct = vec![Vec::new(); mesh.surfaces.len()];
     for s in refiner.surfaces {
+        // Vertices on a hovering face's contact line are lifted off it by the solvers; they
+        // measure those surfaces themselves.
+        if mesh.hovering[s.id].is_empty() {
+            mesh.measured_direct[s.id] = s
+                .vertex
+                .iter()
+                .zip(&s.irradiance)
+                .map(|(v, &h)| v.is_finite().then_some(h))
+                .collect();
+        }
         mesh.surfaces[s.id] = s.mesh.into_mesh();
     }
     mesh.refinable = Vec::new();
@@ -190,23 +231,34 @@ pub fn refine_by_error(
 }
 
 /// A reflecting surface being refined, with the values measured on it: the reflected direct
-/// light (ρ·H, channel mean) at its vertices, edge midpoints and centroids.
+/// light (ρ·H, channel mean) at its vertices and edge midpoints.
 struct Refined {
     id: SurfaceId,
     mesh: BisectionMesh,
     reflectance: Rgb,
-    /// The brightest light it can reflect: ρ times the brightest emitter (form factors to all
-    /// emitters sum to at most one).
-    brightest: f64,
     /// NaN until measured.
     vertex: Vec<f64>,
-    /// By the edge's vertices, smaller first: the two sides of a jump have their own.
-    midpoint: HashMap<(u32, u32), f64>,
-    centroid: Vec<f64>,
+    /// The exact direct irradiance at the measured vertices (what solvers take).
+    irradiance: Vec<Rgb>,
+    /// By the edge's vertices, smaller first: the two sides of a jump have their own. The
+    /// irradiance, and the reflected light.
+    midpoint: HashMap<(u32, u32), (Rgb, f64)>,
     /// Whether each triangle was measured (or is being measured).
     measured: Vec<bool>,
     /// Each measured triangle's largest check point error, W/m².
     error: Vec<f64>,
+    /// Each triangle's squared error integrated over it: measured ([`Self::squared_error`]),
+    /// or its prior.
+    squared: Vec<f64>,
+    /// Whether the surface is refined: faces smaller than the budget's typical element keep
+    /// their least mesh.
+    refined: bool,
+    /// The sum and count of the scene's samples of the mean on it.
+    samples: (f64, usize),
+    /// The RMS error it may keep, W/m²: the tolerance times its mean reflected direct light.
+    target: f64,
+    /// Whether its estimated RMS error is within `target`.
+    done: bool,
     /// Bumped when a triangle changes, so that its old queue entries are passed over.
     version: Vec<u32>,
 }
@@ -219,8 +271,6 @@ enum Check {
     /// The midpoint of edge `[a, b]`, from the side of the corner `c` across it; for a vertex
     /// made there, `Some(vertex)`.
     Edge([u32; 3], Option<u32>),
-    /// A triangle's centroid.
-    Centroid(u32),
 }
 
 /// A queue entry: a triangle's share of the squared error, measured or bounded.
@@ -250,6 +300,8 @@ impl PartialOrd for Entry {
 
 struct Refiner<'a> {
     direct: &'a DirectLight<'a>,
+    /// No triangle smaller than this (in the scene's units) is split.
+    smallest: f64,
     surfaces: Vec<Refined>,
     queue: BinaryHeap<Entry>,
     /// Triangles of the whole scene, reflecting or not.
@@ -260,12 +312,6 @@ struct Refiner<'a> {
 impl<'a> Refiner<'a> {
     /// Takes the reflecting surfaces of `mesh`, none measured yet.
     fn new(scene: &Scene, mesh: &SceneMesh, direct: &'a DirectLight<'a>) -> Refiner<'a> {
-        let brightest = scene
-            .emitters()
-            .map(|(_, e)| e.emission)
-            .fold(Rgb::ZERO, |a, e| {
-                Rgb::new(a.r.max(e.r), a.g.max(e.g), a.b.max(e.b))
-            });
         let surfaces = mesh
             .surfaces
             .iter()
@@ -278,12 +324,16 @@ impl<'a> Refiner<'a> {
                 Refined {
                     id: m.surface,
                     reflectance,
-                    brightest: reflectance.mul_rgb(brightest).mean(),
                     vertex: vec![f64::NAN; m.vertex_count()],
+                    irradiance: vec![Rgb::ZERO; m.vertex_count()],
                     midpoint: HashMap::new(),
-                    centroid: vec![f64::NAN; n],
                     measured: vec![false; n],
                     error: vec![0.0; n],
+                    squared: vec![0.0; n],
+                    refined: false,
+                    target: 0.0,
+                    samples: (0.0, 0),
+                    done: false,
                     version: vec![0; n],
                     mesh: BisectionMesh::new(m.clone()),
                 }
@@ -291,6 +341,7 @@ impl<'a> Refiner<'a> {
             .collect();
         Refiner {
             direct,
+            smallest: 0.0,
             surfaces,
             queue: BinaryHeap::new(),
             triangles: mesh.triangle_count(),
@@ -332,34 +383,66 @@ impl<'a> Refiner<'a> {
             .map(|(i, x)| self.surfaces[*i].value(self.direct.irradiance(x, self.surfaces[*i].id)))
             .collect();
         self.evaluations += values.len();
-        let finite: Vec<f64> = values.into_iter().filter(|v| v.is_finite()).collect();
-        finite.iter().sum::<f64>() / finite.len().max(1) as f64
+        let (mut sum, mut count) = (0.0, 0usize);
+        for (&(i, _), v) in points.iter().zip(values) {
+            if v.is_finite() {
+                let s = &mut self.surfaces[i];
+                s.samples.0 += v;
+                s.samples.1 += 1;
+                sum += v;
+                count += 1;
+            }
+        }
+        sum / count.max(1) as f64
     }
 
-    /// Every triangle that may need splitting, by the bound on its error.
-    fn fill_queue(&mut self, threshold: f64) {
-        for (i, s) in self.surfaces.iter().enumerate() {
-            if s.brightest <= threshold {
+    /// Measures the vertices of the surfaces to refine, sets each one's target, and queues
+    /// every triangle that may need splitting by the prior on its error.
+    fn start(&mut self, scene: &Scene, budget: usize, tolerance: f64, mean: f64) {
+        let area: f64 = self.surfaces.iter().map(|s| s.mesh().area()).sum();
+        let element = area / budget.max(1) as f64;
+        self.smallest = SMALLEST_SHARE * element;
+        for (i, s) in self.surfaces.iter_mut().enumerate() {
+            // A face the budget would give only a few triangles keeps its least mesh: the
+            // faces of a tessellated statue.
+            s.refined = s.mesh().area() >= REFINED_ELEMENTS * element;
+            if !s.refined {
                 continue;
             }
             for t in 0..s.mesh().triangle_count() {
-                self.queue.push(Entry {
-                    priority: SQUARED_ERROR_BOUND
-                        * s.brightest
-                        * s.brightest
-                        * s.mesh().triangle_area(t),
-                    surface: i as u32,
-                    triangle: t as u32,
-                    version: 0,
-                });
+                let a = s.mesh().triangle_area(t);
+                let e = PRIOR_RELATIVE_ERROR * s.unoccluded(scene, t) * (a / element).min(1.0);
+                s.squared[t] = PRIOR_SQUARED_ERROR * a * e * e;
+                if s.squared[t] > 0.0 {
+                    self.queue.push(Entry {
+                        priority: s.squared[t],
+                        surface: i as u32,
+                        triangle: t as u32,
+                        version: 0,
+                    });
+                }
             }
+        }
+        let mut checks = Vec::new();
+        for (i, s) in self.surfaces.iter().enumerate().filter(|(_, s)| s.refined) {
+            let inward = s.mesh().interior_directions();
+            checks.extend((0..s.mesh().vertex_count()).map(|v| {
+                let towards = s.mesh().points3[v] + inward[v];
+                (i, Check::Vertex(v as u32, towards))
+            }));
+        }
+        self.evaluate(&checks);
+        let dark = DARK_SHARE * mean;
+        for s in self.surfaces.iter_mut().filter(|s| s.refined) {
+            s.target = tolerance * s.mean().max(dark);
+            s.update_done();
         }
     }
 
     /// Takes the worst triangles off the queue: measures those not measured yet and splits
     /// the others, up to `batch` of each (while the scene has fewer than `most` triangles);
     /// then measures what changed and queues it again. Returns false when the queue is empty.
-    fn step(&mut self, batch: usize, most: usize, threshold: f64) -> bool {
+    fn step(&mut self, batch: usize, most: usize) -> bool {
         // What the step changed or is to measure, on each surface.
         let mut changed: Vec<Split> = vec![Split::default(); self.surfaces.len()];
         let (mut splits, mut measures) = (0, 0);
@@ -367,7 +450,7 @@ impl<'a> Refiner<'a> {
             let Some(e) = self.queue.pop() else { break };
             let (i, t) = (e.surface as usize, e.triangle as usize);
             let s = &mut self.surfaces[i];
-            if s.version[t] != e.version {
+            if s.version[t] != e.version || s.done {
                 continue;
             }
             if !s.measured[t] {
@@ -376,7 +459,7 @@ impl<'a> Refiner<'a> {
                 measures += 1;
                 continue;
             }
-            if s.mesh.too_small(t) {
+            if s.mesh.too_small(t) || s.mesh().triangle_area(t) < self.smallest {
                 continue;
             }
             let mut split = Split::default();
@@ -403,6 +486,9 @@ impl<'a> Refiner<'a> {
         self.evaluate(&checks);
         for (i, split) in changed.into_iter().enumerate() {
             let s = &mut self.surfaces[i];
+            if split.triangles.is_empty() {
+                continue;
+            }
             let mut triangles = split.triangles;
             triangles.sort_unstable();
             triangles.dedup();
@@ -410,26 +496,28 @@ impl<'a> Refiner<'a> {
                 let t = t as usize;
                 s.measured[t] = true;
                 s.error[t] = s.triangle_error(t);
-                if s.error[t] > threshold {
+                s.squared[t] = s.squared_error(t);
+                if s.squared[t] > 0.0 {
                     self.queue.push(Entry {
-                        priority: s.squared_error(t),
+                        priority: s.squared[t],
                         surface: i as u32,
                         triangle: t as u32,
                         version: s.version[t],
                     });
                 }
             }
+            s.update_done();
         }
         true
     }
 
     /// Evaluates the exact light at `checks` (in parallel) and stores the values.
     fn evaluate(&mut self, checks: &[(usize, Check)]) {
-        let values: Vec<f64> = checks
+        let values: Vec<Rgb> = checks
             .par_iter()
             .map(|&(i, c)| {
                 let s = &self.surfaces[i];
-                s.value(self.direct.irradiance(&s.point(c), s.id))
+                self.direct.irradiance(&s.point(c), s.id)
             })
             .collect();
         self.evaluations += checks.len();
@@ -449,7 +537,7 @@ impl<'a> Refiner<'a> {
         let surfaces: Vec<SurfaceError> = self
             .surfaces
             .iter()
-            .filter(|s| s.measured.iter().any(|&m| m))
+            .filter(|s| s.refined)
             .map(|s| s.summary(&scene.surfaces[s.id].name))
             .collect();
         let (mut area, mut measured, mut sum2, mut max) = (0.0, 0.0, 0.0, 0.0f64);
@@ -460,7 +548,7 @@ impl<'a> Refiner<'a> {
                 area += a;
                 if s.measured[t] {
                     measured += a;
-                    sum2 += a * s.error[t] * s.error[t];
+                    sum2 += s.squared[t];
                     max = max.max(s.error[t]);
                 }
             }
@@ -490,6 +578,44 @@ impl Refined {
         self.mesh.mesh()
     }
 
+    /// The light triangle `t` would reflect at its centroid if nothing stood between it and
+    /// the emitters.
+    fn unoccluded(&self, scene: &Scene, t: usize) -> f64 {
+        let p = self.mesh().triangle_points3(t);
+        let x = ReceivingPoint::interior((p[0] + p[1] + p[2]) / 3.0, self.mesh().frame.normal);
+        let tol = UNOCCLUDED_TOLERANCE * scene.diagonal();
+        let h: Rgb = scene
+            .emitters()
+            .filter(|(_, e)| e.normal().dot(x.point - e.polygon[0]) > 0.0)
+            .map(|(_, e)| e.emission * form_factor(&x, &e.polygon, tol))
+            .sum();
+        self.value(h)
+    }
+
+    /// The mean of the reflected direct light: its samples' when it has enough, else the
+    /// area-weighted mean of its vertex values (which a coarse mesh can miss by far).
+    fn mean(&self) -> f64 {
+        if self.samples.1 >= MIN_SURFACE_SAMPLES {
+            return self.samples.0 / self.samples.1 as f64;
+        }
+        let m = self.mesh();
+        let sum: f64 = (0..m.triangle_count())
+            .map(|t| {
+                // A value beyond the evaluator's cap counts as dark.
+                let v = m.triangles[t].map(|v| self.vertex[v as usize]);
+                let v = v.map(|x| if x.is_finite() { x } else { 0.0 });
+                m.triangle_area(t) * (v[0] + v[1] + v[2]) / 3.0
+            })
+            .sum();
+        sum / m.area().max(f64::MIN_POSITIVE)
+    }
+
+    /// Whether the estimated RMS error (measured, or prior) is within the target.
+    fn update_done(&mut self) {
+        let sum: f64 = self.squared.iter().sum();
+        self.done = sum <= self.target * self.target * self.mesh().area();
+    }
+
     /// The reflected light (channel mean) of irradiance `h`.
     fn value(&self, h: Rgb) -> f64 {
         self.reflectance.mul_rgb(h).mean()
@@ -497,7 +623,7 @@ impl Refined {
 
     /// The checks not measured yet of the triangles `changed` lists and of the vertices it
     /// made (which take their edges' values when those were measured): each triangle's
-    /// centroid, its vertices and its edges' midpoints, each once.
+    /// vertices and its edges' midpoints, each once.
     fn checks_missing(&self, changed: &Split) -> Vec<Check> {
         let m = self.mesh();
         let mut checks = Vec::new();
@@ -512,7 +638,6 @@ impl Refined {
             if !triangles.insert(t) {
                 continue;
             }
-            checks.push(Check::Centroid(t));
             let p = m.triangle_points3(t as usize);
             let centroid = (p[0] + p[1] + p[2]) / 3.0;
             for k in 0..3 {
@@ -533,15 +658,17 @@ impl Refined {
     fn grow(&mut self, split: &Split) {
         let m = self.mesh.mesh();
         self.vertex.resize(m.vertex_count(), f64::NAN);
-        self.centroid.resize(m.triangle_count(), f64::NAN);
+        self.irradiance.resize(m.vertex_count(), Rgb::ZERO);
         self.measured.resize(m.triangle_count(), false);
         self.error.resize(m.triangle_count(), 0.0);
+        self.squared.resize(m.triangle_count(), 0.0);
         self.version.resize(m.triangle_count(), 0);
         for &t in &split.triangles {
             self.version[t as usize] += 1;
         }
         for &(v, [a, b, _]) in &split.vertices {
-            if let Some(&value) = self.midpoint.get(&(a.min(b), a.max(b))) {
+            if let Some(&(h, value)) = self.midpoint.get(&(a.min(b), a.max(b))) {
+                self.irradiance[v as usize] = h;
                 self.vertex[v as usize] = value;
             }
         }
@@ -562,38 +689,35 @@ impl Refined {
                 (m.points3[a as usize] + m.points3[b as usize]) * 0.5,
                 m.points3[c as usize],
             ),
-            Check::Centroid(t) => {
-                let p = m.triangle_points3(t as usize);
-                ReceivingPoint::interior((p[0] + p[1] + p[2]) / 3.0, normal)
-            }
         }
     }
 
-    fn store(&mut self, c: Check, value: f64) {
+    fn store(&mut self, c: Check, h: Rgb) {
+        let value = self.value(h);
         match c {
-            Check::Vertex(v, _) | Check::Edge(_, Some(v)) => self.vertex[v as usize] = value,
-            Check::Edge([a, b, _], None) => {
-                self.midpoint.insert((a.min(b), a.max(b)), value);
+            Check::Vertex(v, _) | Check::Edge(_, Some(v)) => {
+                self.irradiance[v as usize] = h;
+                self.vertex[v as usize] = value;
             }
-            Check::Centroid(t) => self.centroid[t as usize] = value,
+            Check::Edge([a, b, _], None) => {
+                self.midpoint.insert((a.min(b), a.max(b)), (h, value));
+            }
         }
     }
 
-    /// Triangle `t`'s check point errors: its edge midpoints' (in its edges' order) and its
-    /// centroid's, each the exact value less the interpolated one. A value the evaluator could
-    /// not give (a view beyond its overlay cap) counts as no error.
-    fn deviations(&self, t: usize) -> [f64; 4] {
-        let tri = self.mesh().triangles[t];
-        let v = |k: usize| self.vertex[tri[k] as usize];
-        let mut d = [0.0; 4];
-        for (k, dk) in d.iter_mut().enumerate().take(3) {
+    /// Triangle `t`'s check point errors, at its edges' midpoints in its edges' order: the
+    /// exact value less the interpolated one. A value the evaluator could not give (a view
+    /// beyond its overlay cap) counts as no error.
+    fn deviations(&self, t: usize) -> [f64; 3] {
+        let mut d = [0.0; 3];
+        for (k, dk) in d.iter_mut().enumerate() {
             let [a, b] = self.mesh.edge(t, k);
-            if let Some(&m) = self.midpoint.get(&(a.min(b), a.max(b))) {
-                *dk = m - (self.vertex[a as usize] + self.vertex[b as usize]) * 0.5;
+            if let Some(&(_, m)) = self.midpoint.get(&(a.min(b), a.max(b))) {
+                let e = m - (self.vertex[a as usize] + self.vertex[b as usize]) * 0.5;
+                *dk = if e.is_finite() { e } else { 0.0 };
             }
         }
-        d[3] = self.centroid[t] - (v(0) + v(1) + v(2)) / 3.0;
-        d.map(|x| if x.is_finite() { x } else { 0.0 })
+        d
     }
 
     /// Triangle `t`'s largest check point error.
@@ -602,45 +726,28 @@ impl Refined {
     }
 
     /// Triangle `t`'s squared interpolation error integrated over it, estimated from its check
-    /// points: the light as the linear interpolant plus a quadratic bubble on each edge (the
-    /// midpoint's deviation d_e) and a cubic one for what the centroid adds beyond them, whose
-    /// integrals of products over a triangle of area A are (4A/45)((Σd)² + Σd²) and
-    /// (729/2520)A r².
+    /// points: the light as the linear interpolant plus a quadratic bubble 4·λi·λj on each
+    /// edge, weighted by the midpoint's deviation d_e, whose integral over a triangle of area A
+    /// is (4A/45)((Σd)² + Σd²).
     fn squared_error(&self, t: usize) -> f64 {
         let d = self.deviations(t);
         let (sum, sum2) = (d[0] + d[1] + d[2], d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-        let r = d[3] - 4.0 / 9.0 * sum;
-        let area = self.mesh().triangle_area(t);
-        area * (4.0 / 45.0 * (sum * sum + sum2) + 729.0 / 2520.0 * r * r)
+        self.mesh().triangle_area(t) * 4.0 / 45.0 * (sum * sum + sum2)
     }
 
     fn summary(&self, name: &str) -> SurfaceError {
         let m = self.mesh();
-        let (mut area, mut sum, mut sum2, mut max) = (0.0, 0.0, 0.0, 0.0f64);
-        let mut measured = 0;
-        for t in (0..m.triangle_count()).filter(|&t| self.measured[t]) {
-            let a = m.triangle_area(t);
-            let mean: f64 = m.triangles[t]
-                .iter()
-                .map(|&v| self.vertex[v as usize])
-                .sum::<f64>()
-                / 3.0;
-            area += a;
-            sum += a * mean;
-            sum2 += a * self.error[t] * self.error[t];
-            max = max.max(self.error[t]);
-            measured += 1;
-        }
-        let area = area.max(f64::MIN_POSITIVE);
-        let mean = sum / area;
+        let mean = self.mean();
         let relative = |e: f64| if mean > 0.0 { e / mean } else { 0.0 };
+        let squared: f64 = self.squared.iter().sum();
         SurfaceError {
             surface: name.to_string(),
             triangles: m.triangle_count(),
-            measured,
+            measured: self.measured.iter().filter(|&&m| m).count(),
             mean_reflected: mean,
-            rms: relative((sum2 / area).sqrt()),
-            max: relative(max),
+            rms: relative((squared / m.area().max(f64::MIN_POSITIVE)).sqrt()),
+            max: relative(self.error.iter().fold(0.0, |a, &b| a.max(b))),
+            within_tolerance: self.done,
         }
     }
 }

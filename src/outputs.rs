@@ -334,7 +334,7 @@ pub fn mesh_error_warning(report: &crate::error_mesh::MeshErrorReport) -> Option
     let mut names: Vec<String> = above
         .iter()
         .take(NAMED)
-        .map(|s| format!("{} ({:.2} % at worst)", s.surface, 100.0 * s.max))
+        .map(|s| format!("{} ({:.2} % RMS)", s.surface, 100.0 * s.rms))
         .collect();
     if above.len() > NAMED {
         names.push(format!("and {} more", above.len() - NAMED));
@@ -345,8 +345,8 @@ pub fn mesh_error_warning(report: &crate::error_mesh::MeshErrorReport) -> Option
         _ => "the run was interrupted",
     };
     Some(format!(
-        "{why} before the direct light's interpolation error met the tolerance of {} on {} \
-         surface(s): {} (mesh_error.surfaces)",
+        "{why} before the direct light's interpolation error met the tolerance of {} (RMS, \
+         relative to each surface's mean) on {} surface(s): {} (mesh_error.surfaces)",
         report.tolerance,
         above.len(),
         names.join(", ")

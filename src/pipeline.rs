@@ -220,9 +220,15 @@ impl RunError {
     }
 }
 
-/// The share of the element budget an error-driven mesh starts from: the discontinuity mesh,
-/// refined evenly for the reflected light, which the exact direct light's error does not see.
+/// The share of the element budget an error-driven mesh of a full solution starts from: the
+/// discontinuity mesh refined evenly, for the light reflected more than once, which the direct
+/// light's error does not see. Direct-only runs start from the least mesh.
 pub const BASE_SHARE: f64 = 0.25;
+
+/// [`BASE_SHARE`] for full solutions, nothing for direct-only runs.
+fn base_share(direct_only: bool) -> f64 {
+    if direct_only { 0.0 } else { BASE_SHARE }
+}
 
 /// The triangles a budget asks for at least: its cap, or its floor.
 fn budget_floor(budget: ElementBudget) -> usize {
@@ -281,10 +287,7 @@ pub fn run(
     let surfaces = scene.surfaces.len();
     let planned_elements = options.max_elements.resolve(at_least, surfaces)?;
     let error_driven = options.error_driven();
-    let base_share: f64 = std::env::var("PB_BASE")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(BASE_SHARE);
+    let base_share = base_share(options.solver.direct_only);
     let initial_budget = match (&options.refine, options.max_elements) {
         // Error-driven meshes start from a share of the budget and spend the rest where the
         // measured error is largest.
@@ -360,6 +363,7 @@ pub fn run(
                 deadline: solver.deadline,
                 interrupt: options.solver.interrupt.clone(),
                 receivers: shard_surfaces.as_deref().map(Into::into),
+                horizons_near_edges: error_driven,
                 ..options.discontinuity.clone()
             },
             progress,

@@ -886,6 +886,7 @@ fn joined_mesh(
         discontinuity_stats: None,
         budget: 0,
         minimum_triangles: 0,
+        measured_direct: Vec::new(),
     })
 }
 

@@ -49,7 +49,14 @@ fn run_writes_every_output() {
     let report = json(&out.join("report.json"));
     assert_eq!(report["format"], "penumbra-report/1");
     let triangles = report["counts"]["triangles"].as_u64().expect("count");
-    assert!(triangles > 1000 && triangles <= 1500, "{triangles}");
+    // The error-driven mesh stops at its tolerance or at the cap, whichever comes first.
+    assert!(triangles > 200 && triangles <= 1500, "{triangles}");
+    assert_eq!(report["method"]["mesh"], "error-driven");
+    assert!(
+        report["mesh_error"]["surfaces"]
+            .as_array()
+            .is_some_and(|s| !s.is_empty())
+    );
     assert_eq!(report["solver"]["stop"], "converged");
     assert!(
         report["energy"]["unshot_fraction"]
@@ -203,7 +210,15 @@ fn eee_events_are_reported_and_can_be_left_out() {
     let mut counts = Vec::new();
     for (name, extra) in [("with", None), ("without", Some("--no-eee"))] {
         let out = dir.path().join(name);
-        let mut args = vec!["--direct-only", "--max-elements", "3000"];
+        // A discontinuity mesh keeps every event; an error-driven one only those that bound an
+        // umbra or a penumbra.
+        let mut args = vec![
+            "--direct-only",
+            "--max-elements",
+            "3000",
+            "--mesh",
+            "discontinuity",
+        ];
         args.extend(extra);
         run_quietly("bars", &out, &args);
         let report = json(&out.join("report.json"));
@@ -329,7 +344,7 @@ fn adaptive_refinement_is_reported() {
     }
 }
 
-/// `penumbra sweep` runs the four methods per budget and writes a row for each, in CSV and JSON;
+/// `penumbra sweep` runs the three default methods per budget and writes a row for each, in CSV and JSON;
 /// without `--direct-only` it says what is missing and exits 2.
 #[test]
 fn sweep_writes_a_row_per_method_and_budget() {
@@ -349,10 +364,10 @@ fn sweep_writes_a_row_per_method_and_budget() {
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let csv = std::fs::read_to_string(out.join("sweep.csv")).expect("sweep.csv");
-    assert_eq!(csv.lines().count(), 1 + 2 * 4, "{csv}");
+    assert_eq!(csv.lines().count(), 1 + 2 * 3, "{csv}");
     let sweep = json(&out.join("sweep.json"));
     let rows = sweep["rows"].as_array().expect("rows");
-    assert_eq!(rows.len(), 8);
+    assert_eq!(rows.len(), 6);
     for r in rows {
         let rms = r["rms"].as_f64().expect("rms");
         assert!(rms.is_finite() && rms >= 0.0 && rms <= r["max"].as_f64().expect("max"));
@@ -380,8 +395,8 @@ fn sweep_writes_a_row_per_method_and_budget() {
     // Both charts, as SVG with a line per method and as PNG.
     for stem in ["error-vs-elements", "error-vs-time"] {
         let svg = std::fs::read_to_string(out.join(format!("{stem}.svg"))).expect("svg");
-        assert_eq!(svg.matches("<polyline").count(), 1 + 4, "frame and 4 lines");
-        for method in ["uniform+adaptive", "discontinuity+adaptive"] {
+        assert_eq!(svg.matches("<polyline").count(), 1 + 3, "frame and 3 lines");
+        for method in ["error-driven", "discontinuity"] {
             assert!(svg.contains(method));
         }
         let png = std::fs::read(out.join(format!("{stem}.png"))).expect("png");
@@ -419,7 +434,7 @@ fn full_sweeps_trace_their_reference_once() {
             .expect("error")
             .is_finite()
     );
-    assert_eq!(sweep["rows"].as_array().expect("rows").len(), 4);
+    assert_eq!(sweep["rows"].as_array().expect("rows").len(), 3);
     let first = std::fs::read(out.join("sweep.json")).expect("sweep.json");
     // A second run reads the reference back, and the same runs give the same bytes.
     let o = penumbra(&args);
@@ -581,7 +596,11 @@ fn hierarchical_runs_report_their_links() {
             .collect()
     };
     let out = dir.path().join("hierarchical");
+    // A mesh spread by area: the dense solve's patches group about as many elements each, and
+    // are coarse where an error-driven mesh is.
     let common = [
+        "--mesh",
+        "discontinuity",
         "--max-elements",
         "3000",
         "--epsilon",
@@ -1112,7 +1131,7 @@ fn the_default_budget_fits_the_scene() {
     let surfaces = n * n + 2;
     let polygons_need = n * n + 4;
     let out = dir.path().join("fit");
-    run_quietly(path, &out, &["--direct-only"]);
+    run_quietly(path, &out, &["--direct-only", "--mesh", "discontinuity"]);
     let report = json(&out.join("report.json"));
     assert_eq!(report["scene"]["surfaces"], surfaces);
     assert_eq!(report["method"]["max_elements_requested"], "fit");
@@ -1131,6 +1150,8 @@ fn the_default_budget_fits_the_scene() {
             "run",
             path,
             "--direct-only",
+            "--mesh",
+            "discontinuity",
             "--max-elements",
             &n.to_string(),
             "--out",

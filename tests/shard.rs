@@ -28,10 +28,14 @@ fn run(scene: &str, out: &Path, extra: &[&str]) {
         true => &[][..],
         false => CAP,
     };
+    // Shards mesh by discontinuities (an error-driven mesh spreads one queue over all the
+    // surfaces), so the whole run they are compared with does too.
     let mut args = vec![
         "run",
         scene,
         "--direct-only",
+        "--mesh",
+        "discontinuity",
         "--width",
         "96",
         "--height",

@@ -34,6 +34,10 @@ pub struct SceneMesh {
     /// The least number of triangles any mesh of the scene with these constraints has: each
     /// surface's constrained triangulation before refinement.
     pub minimum_triangles: usize,
+    /// The exact direct irradiance at the vertices where it was measured while the mesh was
+    /// made (error-driven meshes), per surface and vertex; empty, or `None`, where it was not.
+    /// Solvers take these values instead of evaluating them again.
+    pub measured_direct: Vec<Vec<Option<penumbra_scenes::Rgb>>>,
 }
 
 impl SceneMesh {
@@ -166,6 +170,7 @@ pub fn mesh_scene_uniform(
         discontinuity_stats: None,
         budget,
         minimum_triangles: minimum.iter().sum(),
+        measured_direct: Vec::new(),
     })
 }
 
@@ -321,6 +326,7 @@ pub fn mesh_scene_discontinuity_on(
         discontinuity_stats: Some(found.stats),
         budget,
         minimum_triangles,
+        measured_direct: Vec::new(),
     })
 }
 

@@ -53,6 +53,7 @@ def run(
     *,
     mesh: MeshMethod = "auto",
     max_elements: Optional[int] = None,
+    tol: Optional[float] = None,
     penumbra_density: Optional[float] = None,
     eee: bool = True,
     events: Literal["complete", "extremal"] = "complete",
@@ -87,8 +88,10 @@ def run(
     defaults (``penumbra run --help``, ``docs/cli.md``); the same options give the same
     ``solution.json``, to the bit.
 
-    The main options: ``mesh`` ``"auto"`` (discontinuity where the scene casts shadows, else
-    uniform), ``"uniform"`` or ``"discontinuity"``; ``max_elements`` caps the triangles for the
+    The main options: ``mesh`` ``"auto"`` (error-driven: the lines that bound umbrae and
+    penumbrae as mesh edges, refined where the exact direct light's measured interpolation
+    error is largest, until each surface's RMS error is within ``tol`` of its mean or the
+    budget is spent), ``"uniform"`` or ``"discontinuity"``; ``max_elements`` caps the triangles for the
     whole scene (default 25,000 with the hierarchical solver, 10,000 with the others and
     ``direct_only``, or what the scene needs if more); ``solver`` ``"hierarchical"``,
     ``"progressive"``, ``"jacobi"``, ``"gauss-seidel"``, ``"direct"`` or ``"photon-map"`` (with
@@ -120,6 +123,7 @@ def run(
     arguments = {
         "mesh": _checks.choice(mesh, "mesh", _MESHES),
         "max_elements": _checks.count(max_elements, "max_elements"),
+        "tol": _checks.number(tol, "tol"),
         "penumbra_density": _checks.number(penumbra_density, "penumbra_density"),
         "eee": _checks.flag(eee, "eee"),
         "events": _checks.choice(events, "events", ("complete", "extremal")),

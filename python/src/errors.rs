@@ -71,6 +71,7 @@ fn argument(option: &str) -> &str {
         "direct only" => "direct_only",
         "refine indirect" => "refine_indirect",
         "refine tolerance" => "refine_tol",
+        "tolerance" => "tol",
         "refine rounds" => "refine_rounds",
         "penumbra density" => "penumbra_density",
         "event tolerance" => "event_tol",

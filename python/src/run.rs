@@ -58,6 +58,7 @@ impl Interrupt {
 pub(crate) struct RunArguments {
     mesh: Option<String>,
     max_elements: Option<usize>,
+    tol: Option<f64>,
     penumbra_density: Option<f64>,
     eee: bool,
     events: Option<String>,
@@ -177,6 +178,7 @@ impl RunArguments {
                 ..DiscontinuityOptions::default()
             },
             refine,
+            tolerance: self.tol.unwrap_or(penumbra::error_mesh::DEFAULT_TOLERANCE),
             time_budget: self.time_budget,
             solver: self.solver_options(interrupt)?,
             method,

@@ -164,11 +164,63 @@ pub fn tessellated(n: usize) -> Scene {
     }
 }
 
-/// A statue-like blob: an icosahedron's faces split `levels` times into four, every corner
-/// pushed out from the centre by a smooth bumpy function of its direction (folds, dents and
-/// overhangs that shade the blob itself), centred at `center` with mean radius `radius`. The
-/// faces are welded (shared corners have the same bits) and turn outwards: a closed solid.
+/// A sphere's tessellation as a geodesic (icosahedral) mesh: an icosahedron's faces split
+/// `levels` times into four, every corner on the sphere of `radius` about `center`
+/// (20·4^levels triangles: 1,280 at 3). Welded and turned outwards: a closed solid.
+pub fn icosphere(center: DVec3, radius: f64, levels: usize) -> Vec<[DVec3; 3]> {
+    unit_icosphere(levels)
+        .into_iter()
+        .map(|t| t.map(|d| center + d * radius))
+        .collect()
+}
+
+/// A statue-like blob: [`icosphere`]'s corners pushed out from the centre by a smooth bumpy
+/// function of their direction (folds, dents and overhangs that shade the blob itself),
+/// centred at `center` with mean radius `radius`. Welded and turned outwards.
 pub fn bumpy_blob(center: DVec3, radius: f64, levels: usize) -> Vec<[DVec3; 3]> {
+    let bump = |d: DVec3| {
+        1.0 + 0.25 * (3.0 * d.x + 1.0).sin() * (2.0 * d.y).cos()
+            + 0.15 * (5.0 * d.z + 2.0 * d.x).sin()
+    };
+    unit_icosphere(levels)
+        .into_iter()
+        .map(|t| t.map(|d| center + d * (radius * bump(d))))
+        .collect()
+}
+
+/// A torus about the vertical axis through `center`: the tube of radius `minor` around the
+/// circle of radius `major`, as `around` × `across` quads split into triangles. Welded and
+/// turned outwards.
+pub fn torus(
+    center: DVec3,
+    major: f64,
+    minor: f64,
+    around: usize,
+    across: usize,
+) -> Vec<[DVec3; 3]> {
+    let (around, across) = (around.max(3), across.max(3));
+    let point = |i: usize, j: usize| {
+        let u = std::f64::consts::TAU * (i % around) as f64 / around as f64;
+        let v = std::f64::consts::TAU * (j % across) as f64 / across as f64;
+        let ring = major + minor * v.cos();
+        center + DVec3::new(ring * u.cos(), ring * u.sin(), minor * v.sin())
+    };
+    (0..around)
+        .flat_map(|i| (0..across).map(move |j| (i, j)))
+        .flat_map(|(i, j)| {
+            let (a, b, c, d) = (
+                point(i, j),
+                point(i + 1, j),
+                point(i + 1, j + 1),
+                point(i, j + 1),
+            );
+            [[a, b, c], [a, c, d]]
+        })
+        .collect()
+}
+
+/// [`icosphere`] of the unit sphere about the origin.
+fn unit_icosphere(levels: usize) -> Vec<[DVec3; 3]> {
     let t = (1.0 + 5f64.sqrt()) / 2.0;
     let v = [
         (-1.0, t, 0.0),
@@ -219,14 +271,7 @@ pub fn bumpy_blob(center: DVec3, radius: f64, levels: usize) -> Vec<[DVec3; 3]> 
             })
             .collect();
     }
-    let bump = |d: DVec3| {
-        1.0 + 0.25 * (3.0 * d.x + 1.0).sin() * (2.0 * d.y).cos()
-            + 0.15 * (5.0 * d.z + 2.0 * d.x).sin()
-    };
     triangles
-        .into_iter()
-        .map(|t| t.map(|d| center + d * (radius * bump(d))))
-        .collect()
 }
 
 #[cfg(test)]
@@ -271,13 +316,34 @@ mod tests {
         }
     }
 
+    /// The blob, the sphere and the torus are closed, welded, turned outwards, and hold about
+    /// the volume of what they tessellate.
     #[test]
-    fn the_blob_is_a_closed_welded_solid() {
-        let faces = bumpy_blob(DVec3::ZERO, 1.0, 2);
-        assert_eq!(faces.len(), 320);
+    fn the_solids_are_closed_and_welded() {
+        let sphere = std::f64::consts::PI * 4.0 / 3.0;
+        let torus_volume = 2.0 * std::f64::consts::PI.powi(2) * 0.25 * 0.25;
+        for (faces, count, (lo, hi)) in [
+            (bumpy_blob(DVec3::ZERO, 1.0, 2), 320, (2.0, 8.0)),
+            (
+                icosphere(DVec3::ZERO, 1.0, 3),
+                1280,
+                (0.99 * sphere, sphere),
+            ),
+            (
+                torus(DVec3::ZERO, 1.0, 0.25, 48, 16),
+                2 * 48 * 16,
+                (0.95 * torus_volume, torus_volume),
+            ),
+        ] {
+            assert_closed(&faces, count, lo, hi);
+        }
+    }
+
+    fn assert_closed(faces: &[[DVec3; 3]], count: usize, lo: f64, hi: f64) {
+        assert_eq!(faces.len(), count);
         let mut edges: HashMap<([u64; 3], [u64; 3]), usize> = HashMap::new();
         let mut volume = 0.0;
-        for f in &faces {
+        for f in faces {
             for i in 0..3 {
                 *edges.entry((key(f[i]), key(f[(i + 1) % 3]))).or_default() += 1;
             }
@@ -286,8 +352,8 @@ mod tests {
         for (&(a, b), &count) in &edges {
             assert_eq!((count, edges.get(&(b, a))), (1, Some(&1)));
         }
-        // Turned outwards: a positive volume, near the unit ball's.
-        assert!(volume > 2.0 && volume < 8.0, "{volume}");
+        // Turned outwards: a positive volume, near the solid's.
+        assert!(volume > lo && volume < hi, "{volume} not in {lo}..{hi}");
     }
 
     #[test]

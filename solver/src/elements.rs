@@ -71,6 +71,9 @@ pub struct Discretization {
     pub reflectance: Vec<Rgb>,
     /// The emission at each receiver (its surface's).
     pub emission: Vec<Rgb>,
+    /// The exact direct irradiance at each receiver, where the mesh measured it
+    /// ([`SceneMesh::measured_direct`]).
+    pub measured_direct: Vec<Option<Rgb>>,
 }
 
 impl Discretization {
@@ -164,6 +167,14 @@ impl Discretization {
             .iter()
             .map(|&s| scene.surfaces[s].emission)
             .collect();
+        let measured_direct = mesh
+            .surfaces
+            .iter()
+            .flat_map(|m| {
+                let known = mesh.measured_direct.get(m.surface);
+                (0..m.vertex_count()).map(move |v| known.and_then(|k| k.get(v).copied().flatten()))
+            })
+            .collect();
         Discretization {
             offsets,
             receivers,
@@ -172,6 +183,7 @@ impl Discretization {
             patches,
             reflectance,
             emission,
+            measured_direct,
         }
     }
 

@@ -288,13 +288,17 @@ fn direct_on(
     progress: &dyn Progress,
 ) -> Result<(Vec<Rgb>, Estimated), SolveError> {
     let all: Vec<usize> = (0..disc.receiver_count()).collect();
-    let wanted =
+    let lit =
         |v: usize| on.is_none_or(|on| on.get(disc.receiver_surface[v]).copied().unwrap_or(false));
+    // What the mesh measured is not evaluated again.
+    let wanted = |v: usize| lit(v) && disc.measured_direct[v].is_none();
     let (mut values, estimated) = direct_at(direct, disc, &all, &wanted, limits, progress)?;
     for (v, h) in values.iter_mut().enumerate() {
-        if !wanted(v) {
-            *h = Rgb::ZERO;
-        }
+        *h = match disc.measured_direct[v] {
+            _ if !lit(v) => Rgb::ZERO,
+            Some(known) => known,
+            None => *h,
+        };
     }
     Ok((values, estimated))
 }

@@ -113,6 +113,8 @@ pub struct SweepOptions {
     /// Tolerance of the adaptive runs at the first budget; it shrinks in proportion as the
     /// budget grows, so that larger budgets are spent.
     pub refine_tol: f64,
+    /// The error-driven runs' tolerance ([`RunOptions::tolerance`]).
+    pub tolerance: f64,
     /// Sample points the runs are scored at ([`sample_points`]).
     pub samples: usize,
     /// The seed of the sample points.
@@ -425,6 +427,7 @@ pub fn sweep(
                 indirect: Default::default(),
             }),
             solver,
+            tolerance: options.tolerance,
             render: penumbra_viz::RenderOptions {
                 width: 1,
                 height: 1,

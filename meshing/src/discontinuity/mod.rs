@@ -116,6 +116,10 @@ pub struct DiscontinuityOptions {
     /// [`MIN_RECEIVER_ELEMENTS`] such elements get no events, and blocker patches whose shadow
     /// is smaller than one element start none.
     pub element_area: Option<f64>,
+    /// Keep the lines where an emitter's plane cuts a receiver however close they come to its
+    /// edge (meshes refined by bisection, which keep the thin triangles of such a strip thin);
+    /// otherwise a line within an element of the edge is left out.
+    pub horizons_near_edges: bool,
     /// When to stop starting new emitter–receiver pairs (a run's time budget).
     pub deadline: Option<Instant>,
     /// Stops the search early when set (Ctrl-C).
@@ -161,6 +165,7 @@ impl Default for DiscontinuityOptions {
             eee_tolerance: 1e-4,
             event_tolerance: DEFAULT_EVENT_TOLERANCE,
             element_area: None,
+            horizons_near_edges: false,
             deadline: None,
             interrupt: None,
             receivers: None,

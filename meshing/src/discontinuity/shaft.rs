@@ -180,7 +180,11 @@ impl<'a> SearchContext<'a> {
         let (e, r) = (pair.emitter, pair.receiver);
         let (ef, rf) = (pair.emitter_frame, pair.receiver_frame);
         let receiver_polygon = &self.scene.surfaces[r].polygon;
-        if let Some(area) = self.options.element_area {
+        if let Some(area) = self
+            .options
+            .element_area
+            .filter(|_| !self.options.horizons_near_edges)
+        {
             // How far the receiver reaches behind the plane, measured in the receiver's plane.
             let sine = ef.normal.cross(rf.normal).length();
             let behind = receiver_polygon

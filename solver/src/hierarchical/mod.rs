@@ -326,11 +326,13 @@ pub fn solve_hierarchical_refining(
     }
 
     let disc = &current.disc;
+    // A vertex in the dark gathers what its links carry to rounding, which may leave it a
+    // few ulps below zero; no irradiance is negative.
     let irradiance: Vec<Rgb> = current
         .direct
         .iter()
         .zip(&current.reflected)
-        .map(|(&d, &r)| d + r)
+        .map(|(&d, &r)| (d + r).max(Rgb::ZERO))
         .collect();
     let account = Account {
         scene,

@@ -80,6 +80,7 @@ fn flag(option: &str, command: Command) -> Option<&'static str> {
         ("direct only", _) => "--direct-only",
         ("refine indirect", _) => "--refine-indirect",
         ("refine tolerance", _) => "--refine-tol",
+        ("tolerance", _) => "--tol",
         ("refine rounds", _) => "--refine-rounds",
         ("penumbra density", _) => "--penumbra-density",
         ("event tolerance", _) => "--event-tol",

@@ -33,6 +33,9 @@ pub(crate) struct SweepArgs {
     /// radiosity (as `run --refine-tol`); it shrinks in proportion as the budget grows, so that larger budgets are spent.
     #[arg(long, default_value_t = 1e-3)]
     refine_tol: f64,
+    /// Tolerance of the error-driven runs (as `run --tol`).
+    #[arg(long, default_value_t = penumbra::error_mesh::DEFAULT_TOLERANCE)]
+    tol: f64,
     /// Sample points the runs are scored at (default: 4000 with --direct-only, else 1000).
     #[arg(long)]
     samples: Option<usize>,
@@ -111,6 +114,7 @@ pub(crate) fn sweep(args: &SweepArgs) -> Result<(), Failure> {
         methods,
         surfaces: args.surfaces.clone(),
         refine_tol: args.refine_tol,
+        tolerance: args.tol,
         initial_fraction: args.initial_fraction,
         samples: sample_count,
         seed: args.seed,
