@@ -28,14 +28,10 @@ fn run(scene: &str, out: &Path, extra: &[&str]) {
         true => &[][..],
         false => CAP,
     };
-    // Shards mesh by discontinuities (an error-driven mesh spreads one queue over all the
-    // surfaces), so the whole run they are compared with does too.
     let mut args = vec![
         "run",
         scene,
         "--direct-only",
-        "--mesh",
-        "discontinuity",
         "--width",
         "96",
         "--height",
@@ -45,6 +41,11 @@ fn run(scene: &str, out: &Path, extra: &[&str]) {
         path(out),
     ];
     args.extend(budget);
+    // `--mesh auto` makes a shard's mesh by discontinuities (an error-driven mesh spreads one
+    // queue over all the surfaces), so a whole run compared with shards asks for that mesh.
+    if !extra.contains(&"--shard") && !extra.contains(&"--mesh") {
+        args.extend(["--mesh", "discontinuity"]);
+    }
     args.extend(extra.iter().filter(|&&a| a != "--fit"));
     succeeds(&args);
 }
