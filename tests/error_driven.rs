@@ -2,11 +2,14 @@
 //! sphere of 1,280 facets, a bumpy blob, a torus) and on the Cornell box: the RMS error of the
 //! direct light on the floor, against the exact evaluator at random points (not at vertices).
 
+mod common;
+
+use common::in_process::run_scene;
 use glam::DVec3;
-use penumbra::{MeshMethod, RunOptions, run};
+use penumbra::{MeshMethod, RunOptions};
 use penumbra_scenes::tessellated::{bumpy_blob, icosphere, torus};
-use penumbra_scenes::{LoadedScene, Rgb, Scene, Surface, Visibility, builtin};
-use penumbra_solver::{DirectLight, NoProgress, SolverOptions, direct_interpolation_error};
+use penumbra_scenes::{Rgb, Scene, Surface, Visibility, builtin};
+use penumbra_solver::{DirectLight, SolverOptions, direct_interpolation_error};
 
 /// A 4 × 4 floor under a 0.5 × 0.5 light 2 units up, with a tessellated solid between them.
 fn floor_scene(name: &str, solid: Vec<[DVec3; 3]>) -> Scene {
@@ -50,12 +53,7 @@ fn floor_error(scene: &Scene, mesh: MeshMethod, max_elements: usize) -> (f64, us
         },
         ..RunOptions::default()
     };
-    let loaded = LoadedScene {
-        scene: scene.clone(),
-        source: "test".into(),
-        warnings: Vec::new(),
-    };
-    let result = run(loaded, &options, &NoProgress).expect("runs");
+    let result = run_scene(scene.clone(), options);
     let visibility = Visibility::build(scene);
     let direct = DirectLight::new(scene, &visibility);
     let floor = scene.surface_id("floor").expect("a floor");

@@ -71,6 +71,7 @@
 
 #![warn(missing_docs)]
 
+mod area_sampler;
 pub mod builtin;
 pub mod cie;
 mod color;
@@ -91,6 +92,7 @@ mod validate;
 mod visibility;
 pub mod visibility_check;
 
+pub use area_sampler::AreaSampler;
 pub use color::Rgb;
 pub use error::SceneError;
 pub use frame::PlaneFrame;

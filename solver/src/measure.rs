@@ -3,7 +3,7 @@
 
 use glam::DVec3;
 use penumbra_meshing::SurfaceMesh;
-use penumbra_scenes::SplitMix64;
+use penumbra_scenes::{AreaSampler, SplitMix64};
 use penumbra_scenes::{Rgb, Scene};
 use serde::Serialize;
 
@@ -35,25 +35,13 @@ pub fn direct_interpolation_error(
     seed: u64,
 ) -> InterpolationError {
     let surface = &scene.surfaces[mesh.surface];
-    let areas: Vec<f64> = (0..mesh.triangle_count())
-        .map(|t| mesh.triangle_area(t))
-        .collect();
-    let total: f64 = areas.iter().sum();
-    let mut cumulative = Vec::with_capacity(areas.len());
-    let mut acc = 0.0;
-    for a in &areas {
-        acc += a;
-        cumulative.push(acc);
-    }
+    let sampler = AreaSampler::new((0..mesh.triangle_count()).map(|t| mesh.triangle_area(t)));
     let mut rng = SplitMix64::keyed(seed, &[mesh.surface as u64]);
     let (mut sum2, mut max, mut sum_exact) = (0.0f64, 0.0f64, 0.0);
     for _ in 0..samples {
-        let u = rng.next_f64() * total;
-        let t = cumulative
-            .partition_point(|&c| c < u)
-            .min(areas.len().saturating_sub(1));
-        let (r1, r2) = (rng.next_f64().sqrt(), rng.next_f64());
-        let w = [1.0 - r1, r1 * (1.0 - r2), r1 * r2];
+        let Some((t, w)) = sampler.pick(&mut rng) else {
+            break;
+        };
         let tri = mesh.triangles[t];
         let point: DVec3 = (0..3).map(|k| mesh.points3[tri[k] as usize] * w[k]).sum();
         let interpolated: Rgb = (0..3).map(|k| values[tri[k] as usize] * w[k]).sum();

@@ -10,7 +10,7 @@
 use glam::DVec3;
 use penumbra_meshing::discontinuity::{DiscontinuityOptions, EmitterProbe, EventSet};
 use penumbra_meshing::{DEFAULT_PENUMBRA_DENSITY, TriangleLocator};
-use penumbra_scenes::SplitMix64;
+use penumbra_scenes::{AreaSampler, SplitMix64};
 use penumbra_scenes::{LoadedScene, Scene, SurfaceId, Visibility};
 use penumbra_solver::path_trace::ReferenceValue;
 use penumbra_solver::{DirectLight, Progress, ReceivingPoint, SolverMethod, SolverOptions};
@@ -550,20 +550,11 @@ pub fn sample_points(
         .filter(|t| !scene.surfaces[t.surface].is_emitter())
         .filter(|t| surfaces.is_empty() || surfaces.contains(&t.surface))
         .collect();
-    let areas: Vec<f64> = triangles
-        .iter()
-        .map(|t| {
-            0.5 * (t.vertices[1] - t.vertices[0])
-                .cross(t.vertices[2] - t.vertices[0])
-                .length()
-        })
-        .collect();
-    let mut cumulative = Vec::with_capacity(areas.len());
-    let mut acc = 0.0;
-    for a in &areas {
-        acc += a;
-        cumulative.push(acc);
-    }
+    let sampler = AreaSampler::new(triangles.iter().map(|t| {
+        0.5 * (t.vertices[1] - t.vertices[0])
+            .cross(t.vertices[2] - t.vertices[0])
+            .length()
+    }));
     let direct = DirectLight::new(scene, visibility);
     let probes: Vec<EmitterProbe> = scene
         .emitters()
@@ -572,13 +563,8 @@ pub fn sample_points(
     let mut rng = SplitMix64::keyed(seed, &[]);
     (0..count)
         .filter_map(|_| {
-            let u = rng.next_f64() * acc;
-            let k = cumulative
-                .partition_point(|&c| c < u)
-                .min(areas.len().checked_sub(1)?);
+            let (k, w) = sampler.pick(&mut rng)?;
             let t = triangles[k];
-            let (r1, r2) = (rng.next_f64().sqrt(), rng.next_f64());
-            let w = [1.0 - r1, r1 * (1.0 - r2), r1 * r2];
             let point: DVec3 = (0..3).map(|j| t.vertices[j] * w[j]).sum();
             let surface = &scene.surfaces[t.surface];
             let normal = surface.normal();
