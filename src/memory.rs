@@ -123,9 +123,11 @@ pub fn estimate(scene: &Scene, options: &RunOptions, counts: MeshCounts) -> Memo
                 columns(p.min(3 * r * r))
             }
             (SolverMethod::Progressive, _) => 0,
-            (SolverMethod::Hierarchical, _) => {
-                penumbra_solver::hierarchical::estimated_bytes(counts.triangles, solver.link_tol)
-            }
+            (SolverMethod::Hierarchical, _) => penumbra_solver::hierarchical::estimated_bytes(
+                counts.triangles,
+                scene.surfaces.len() as u64,
+                solver.link_tol,
+            ),
             // About two landings per photon, each a position, a power and its tree's share, and
             // for a final gather an estimate made in advance at every fourth.
             (SolverMethod::PhotonMap, _) => {

@@ -109,6 +109,11 @@ pub struct RunOptions {
     /// may have, relative to the scene's mean reflected direct light;
     /// [`crate::error_mesh::DEFAULT_TOLERANCE`] by default.
     pub tolerance: f64,
+    /// Discontinuity and error-driven meshes: the smallest angle (degrees) quality refinement
+    /// aims for where the constraints do not force a smaller one; 0 for none (triangles are
+    /// then split only by size and by the error), at most
+    /// [`penumbra_meshing::MAX_MIN_ANGLE_DEG`]; [`DEFAULT_MIN_ANGLE_DEG`] by default.
+    pub min_angle: f64,
     /// Seconds from the run's start after which the discontinuity search, adaptive refinement
     /// and the solver stop, and the best so far is kept (`None`: no limit); `report.json` then
     /// marks the run `partial`.
@@ -125,6 +130,9 @@ pub struct RunOptions {
     pub shard: Option<Shard>,
 }
 
+/// The smallest angle discontinuity and error-driven meshes aim for by default, in degrees.
+pub const DEFAULT_MIN_ANGLE_DEG: f64 = penumbra_meshing::CONSTRAINED_MIN_ANGLE_DEG;
+
 impl Default for RunOptions {
     fn default() -> Self {
         let method = SolverMethod::Hierarchical;
@@ -135,6 +143,7 @@ impl Default for RunOptions {
             discontinuity: DiscontinuityOptions::default(),
             refine: None,
             tolerance: crate::error_mesh::DEFAULT_TOLERANCE,
+            min_angle: DEFAULT_MIN_ANGLE_DEG,
             time_budget: None,
             solver: SolverOptions::default(),
             method,
@@ -207,6 +216,16 @@ impl RunOptions {
                 format!(
                     "must be a fraction in [0, 1] of the mean reflected direct light, not {}",
                     self.tolerance
+                ),
+            ));
+        }
+        if !(0.0..=penumbra_meshing::MAX_MIN_ANGLE_DEG).contains(&self.min_angle) {
+            return Err(InvalidOption::new(
+                "min angle",
+                format!(
+                    "must be between 0 and {} degrees, not {}",
+                    penumbra_meshing::MAX_MIN_ANGLE_DEG,
+                    self.min_angle
                 ),
             ));
         }

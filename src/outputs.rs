@@ -223,6 +223,8 @@ struct Method {
     penumbra_density: f64,
     /// Error-driven meshes' tolerance, relative to the scene's mean reflected direct light.
     tolerance: f64,
+    /// The smallest angle discontinuity and error-driven meshes aimed for (0: none).
+    min_angle: f64,
     eee: bool,
     /// Which EV and VE events: `complete` or `extremal`.
     events: penumbra_meshing::discontinuity::EventSet,
@@ -407,6 +409,7 @@ pub fn report_json(result: &RunResult, svgs: &SvgSelection) -> String {
             max_elements_requested: opts.max_elements.into(),
             penumbra_density: opts.penumbra_density,
             tolerance: opts.tolerance,
+            min_angle: opts.min_angle,
             eee: opts.discontinuity.eee,
             events: opts.discontinuity.events,
             eee_tolerance: opts.discontinuity.eee_tolerance,

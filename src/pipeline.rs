@@ -402,6 +402,7 @@ pub fn run(
                 } else {
                     options.penumbra_density
                 },
+                options.min_angle,
                 shard_surfaces.as_deref(),
             )
         }

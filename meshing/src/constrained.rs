@@ -28,9 +28,13 @@ use spade::Triangulation as _;
 pub(crate) const MERGE_DISTANCE: f64 = 1.0 / (1u64 << 30) as f64;
 /// Margin of the frame around a constrained polygon, relative to its extent.
 const FRAME_MARGIN: f64 = 0.05;
-/// Smallest angle the refinement of constrained meshes aims for: constraints may meet at any
-/// angle, and 20 degrees keeps Ruppert's refinement from cascading around them.
-pub(crate) const CONSTRAINED_MIN_ANGLE_DEG: f64 = 20.0;
+/// Smallest angle the refinement of constrained meshes aims for by default: constraints may meet
+/// at any angle, and 20 degrees keeps Ruppert's refinement from cascading around them.
+pub const CONSTRAINED_MIN_ANGLE_DEG: f64 = 20.0;
+
+/// The largest smallest angle refinement can be asked for: Ruppert's refinement terminates up
+/// to about 20.7°, and spade's off-centre variant somewhat beyond; above 30° it may not.
+pub const MAX_MIN_ANGLE_DEG: f64 = 30.0;
 
 /// A segment to be a chain of mesh edges, in the surface's plane-frame coordinates.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -53,6 +57,9 @@ pub struct ConstrainedSurface {
     /// The least quality mesh, once looked for ([`Self::quality_triangles`]): `Some(None)` when
     /// it takes more triangles than were allowed.
     quality: Option<Option<SurfaceTriangulation>>,
+    /// The smallest angle refinement aims for where the constraints do not force a smaller one
+    /// (0: none; refinement then only splits by area).
+    min_angle_deg: f64,
 }
 
 /// Vertices beyond a target's triangle count that the search for a quality mesh may add: Ruppert's
@@ -188,7 +195,16 @@ impl ConstrainedSurface {
             triangulation: SurfaceTriangulation::new(coords, cdt, boundary_only),
             segments,
             quality: None,
+            min_angle_deg: CONSTRAINED_MIN_ANGLE_DEG,
         })
+    }
+
+    /// The same surface, refined to `min_angle_deg` (0 to [`MAX_MIN_ANGLE_DEG`]; 0: no quality
+    /// refinement) instead of [`CONSTRAINED_MIN_ANGLE_DEG`].
+    pub fn with_min_angle(mut self, min_angle_deg: f64) -> ConstrainedSurface {
+        self.min_angle_deg = min_angle_deg.clamp(0.0, MAX_MIN_ANGLE_DEG);
+        self.quality = None;
+        self
     }
 
     /// Triangles before refinement: the least this surface can have.
@@ -202,10 +218,13 @@ impl ConstrainedSurface {
     /// at most `target` triangles; meshes of this surface with at least as many then keep
     /// those angles ([`Self::into_refinable`]).
     pub fn quality_triangles(&mut self, target: usize) -> Option<usize> {
+        if self.min_angle_deg <= 0.0 {
+            return None;
+        }
         if self.quality.is_none() {
             self.quality = Some(
                 self.triangulation
-                    .quality_least(CONSTRAINED_MIN_ANGLE_DEG, target + QUALITY_SPARE_VERTICES)
+                    .quality_least(self.min_angle_deg, target + QUALITY_SPARE_VERTICES)
                     .filter(|q| q.count() <= target),
             );
         }
@@ -251,17 +270,18 @@ impl ConstrainedSurface {
             Some(Some(q)) if q.count() <= target => q,
             _ => self.triangulation,
         };
+        let angle = self.min_angle_deg;
         let triangulation = if self.segments.is_empty() || penumbra_density <= 1.0 {
-            base.refined(target, CONSTRAINED_MIN_ANGLE_DEG)
+            base.refined(target, angle)
         } else {
             let density = Density::probe(&base, target, penumbra_density, varies);
-            base.refined_graded(target, CONSTRAINED_MIN_ANGLE_DEG, &density)
+            base.refined_graded(target, angle, &density)
         };
         RefinableSurface {
             id: self.id,
             triangulation,
             segments: self.segments,
-            min_angle_deg: CONSTRAINED_MIN_ANGLE_DEG,
+            min_angle_deg: angle,
         }
     }
 }

@@ -89,7 +89,10 @@ mod wedges;
 
 pub use bisection::{BisectionMesh, SHORTEST_SPLIT_EDGE, Split};
 pub use budget::{ElementBudget, FIT_TRIANGLES_PER_SURFACE, polygon_minimum};
-pub use constrained::{ConstrainedSurface, Constraint, RefinableSurface, SPLIT_MIN_ANGLE_DEG};
+pub use constrained::{
+    CONSTRAINED_MIN_ANGLE_DEG, ConstrainedSurface, Constraint, MAX_MIN_ANGLE_DEG, RefinableSurface,
+    SPLIT_MIN_ANGLE_DEG,
+};
 pub use error::MeshError;
 pub use grading::DEFAULT_PENUMBRA_DENSITY;
 pub use locate::{TriangleLocator, transfer_density};

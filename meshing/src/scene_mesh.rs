@@ -8,7 +8,9 @@ use glam::DVec3;
 use penumbra_scenes::{PlaneFrame, Scene, SurfaceId, Visibility};
 
 use crate::budget::{ElementBudget, polygon_minimum, polygon_triangles};
-use crate::constrained::{ConstrainedSurface, Constraint, RefinableSurface};
+use crate::constrained::{
+    CONSTRAINED_MIN_ANGLE_DEG, ConstrainedSurface, Constraint, RefinableSurface,
+};
 use crate::discontinuity::{
     Discontinuities, DiscontinuitySegment, DiscontinuityStats, EmitterProbe, Event,
 };
@@ -185,7 +187,15 @@ pub fn mesh_scene_discontinuity(
     budget: impl Into<ElementBudget>,
     penumbra_density: f64,
 ) -> Result<SceneMesh, MeshError> {
-    mesh_scene_discontinuity_on(scene, visibility, found, budget, penumbra_density, None)
+    mesh_scene_discontinuity_on(
+        scene,
+        visibility,
+        found,
+        budget,
+        penumbra_density,
+        CONSTRAINED_MIN_ANGLE_DEG,
+        None,
+    )
 }
 
 /// Discontinuity segment ends within this many contact distances of another end or segment are
@@ -197,13 +207,16 @@ pub(crate) const JOIN_CONTACT_DISTANCES: f64 = 4.0;
 /// surface's share of the budget depends on it alone ([`ElementBudget::shared_extra`]): the
 /// others get an empty mesh, and the budget, counts and least mesh are those of the surfaces
 /// meshed. A budget spread over all surfaces needs every surface's least mesh, so then every
-/// surface is meshed. A surface's mesh is the same whichever others are meshed.
+/// surface is meshed. A surface's mesh is the same whichever others are meshed. Refinement aims
+/// for angles of at least `min_angle_deg` where the constraints allow (0: none; at most
+/// [`MAX_MIN_ANGLE_DEG`](crate::MAX_MIN_ANGLE_DEG)).
 pub fn mesh_scene_discontinuity_on(
     scene: &Scene,
     visibility: &Visibility,
     found: Discontinuities,
     budget: impl Into<ElementBudget>,
     penumbra_density: f64,
+    min_angle_deg: f64,
     on: Option<&[bool]>,
 ) -> Result<SceneMesh, MeshError> {
     let budget = budget.into();
@@ -236,7 +249,7 @@ pub fn mesh_scene_discontinuity_on(
             // spade's constraint insertion does not survive; those surfaces keep the ends apart.
             ConstrainedSurface::joining(id, s, &constraints, join)
                 .or_else(|_| ConstrainedSurface::new(id, s, &constraints))
-                .map(Some)
+                .map(|c| Some(c.with_min_angle(min_angle_deg)))
         })
         .collect::<Result<Vec<_>, _>>()?;
     let areas: Vec<f64> = scene

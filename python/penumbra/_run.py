@@ -54,6 +54,7 @@ def run(
     mesh: MeshMethod = "auto",
     max_elements: Optional[int] = None,
     tol: Optional[float] = None,
+    min_angle: Optional[float] = None,
     penumbra_density: Optional[float] = None,
     eee: bool = True,
     events: Literal["complete", "extremal"] = "complete",
@@ -91,7 +92,8 @@ def run(
     The main options: ``mesh`` ``"auto"`` (error-driven: the lines that bound umbrae and
     penumbrae as mesh edges, refined where the exact direct light's measured interpolation
     error is largest, until each surface's RMS error is within ``tol`` of its mean or the
-    budget is spent), ``"uniform"`` or ``"discontinuity"``; ``max_elements`` caps the triangles for the
+    budget is spent), ``"uniform"`` or ``"discontinuity"``; ``min_angle`` the smallest angle
+    (degrees) their quality refinement aims for (0: none); ``max_elements`` caps the triangles for the
     whole scene (default 25,000 with the hierarchical solver, 10,000 with the others and
     ``direct_only``, or what the scene needs if more); ``solver`` ``"hierarchical"``,
     ``"progressive"``, ``"jacobi"``, ``"gauss-seidel"``, ``"direct"`` or ``"photon-map"`` (with
@@ -124,6 +126,7 @@ def run(
         "mesh": _checks.choice(mesh, "mesh", _MESHES),
         "max_elements": _checks.count(max_elements, "max_elements"),
         "tol": _checks.number(tol, "tol"),
+        "min_angle": _checks.number(min_angle, "min_angle"),
         "penumbra_density": _checks.number(penumbra_density, "penumbra_density"),
         "eee": _checks.flag(eee, "eee"),
         "events": _checks.choice(events, "events", ("complete", "extremal")),

@@ -72,6 +72,7 @@ fn argument(option: &str) -> &str {
         "refine indirect" => "refine_indirect",
         "refine tolerance" => "refine_tol",
         "tolerance" => "tol",
+        "min angle" => "min_angle",
         "refine rounds" => "refine_rounds",
         "penumbra density" => "penumbra_density",
         "event tolerance" => "event_tol",

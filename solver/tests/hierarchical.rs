@@ -3,7 +3,8 @@
 
 use glam::DVec3;
 use penumbra_meshing::{SceneMesh, mesh_scene_uniform};
-use penumbra_scenes::{Rgb, Scene, Visibility, builtin};
+use penumbra_scenes::tessellated::icosphere;
+use penumbra_scenes::{Rgb, Scene, Surface, Visibility, builtin};
 use penumbra_solver::PatchSystem;
 use penumbra_solver::{
     NoProgress, Solution, SolverMethod, SolverOptions, StopReason, solve_hierarchical,
@@ -120,6 +121,125 @@ fn unit_cube_face_means_match_the_continuous_limit() {
                 "rho {rho} face {s}: {eh} against {ed}"
             );
         }
+    }
+}
+
+/// CornellBox-Sphere's room: a floor and three walls of pure red, green and blue, open at the
+/// top and the front, a 0.5 × 0.5 light just under the open top, and a sphere of 320 facets.
+fn open_room_with_sphere() -> Scene {
+    let p = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
+    let h = 0.25;
+    let mut surfaces = vec![
+        Surface::new(
+            "light",
+            vec![
+                p(-h, -h, 0.99),
+                p(-h, h, 0.99),
+                p(h, h, 0.99),
+                p(h, -h, 0.99),
+            ],
+            Rgb::ZERO,
+        )
+        .with_emission(Rgb::splat(10.0)),
+        Surface::new(
+            "floor",
+            vec![
+                p(-1., -1., -1.),
+                p(1., -1., -1.),
+                p(1., 1., -1.),
+                p(-1., 1., -1.),
+            ],
+            Rgb::new(0.64, 0.64, 0.62),
+        ),
+        Surface::new(
+            "back",
+            vec![
+                p(-1., 1., -1.),
+                p(1., 1., -1.),
+                p(1., 1., 1.),
+                p(-1., 1., 1.),
+            ],
+            Rgb::new(0.0, 0.8, 0.0),
+        ),
+        Surface::new(
+            "left",
+            vec![
+                p(-1., -1., -1.),
+                p(-1., 1., -1.),
+                p(-1., 1., 1.),
+                p(-1., -1., 1.),
+            ],
+            Rgb::new(0.8, 0.0, 0.0),
+        ),
+        Surface::new(
+            "right",
+            vec![
+                p(1., -1., -1.),
+                p(1., -1., 1.),
+                p(1., 1., 1.),
+                p(1., 1., -1.),
+            ],
+            Rgb::new(0.0, 0.0, 0.8),
+        ),
+    ];
+    surfaces.extend(
+        icosphere(DVec3::ZERO, 0.5, 2)
+            .into_iter()
+            .enumerate()
+            .map(|(i, t)| Surface::new(format!("sphere/{i}"), t.to_vec(), Rgb::splat(0.64))),
+    );
+    Scene {
+        name: "open room with a sphere".into(),
+        camera: None,
+        surfaces,
+    }
+}
+
+/// Light from clusters of curved surfaces goes where their facets face, and links between
+/// surfaces that reflect different colours are as fine as their geometry needs: on an open room
+/// of pure-coloured walls around a sphere of 320 facets, every room face's mean reflected light
+/// (B − E − ρ H_direct) is within 5 % of the dense solve of the same mesh (measured: 0.5 % on
+/// the floor, 3.4 % on the blue wall). Sent per axis direction, the sphere's lit top shone on
+/// the floor beside it (10 % too much), and the coloured walls kept links as coarse as the whole
+/// walls (their totals a third too high).
+#[test]
+fn a_tessellated_sphere_sends_its_light_where_its_facets_face() {
+    let scene = open_room_with_sphere();
+    let vis = Visibility::build(&scene);
+    let mesh = mesh_scene_uniform(&scene, 3000).expect("meshes");
+    let options = SolverOptions::default();
+    let hierarchical = solve(&scene, &mesh, &options);
+    let system =
+        PatchSystem::assemble(&scene, &mesh, &vis, &options, &NoProgress).expect("assembles");
+    let solved = system
+        .solve(SolverMethod::Direct, 1e-12, 1, &|| None)
+        .expect("solves");
+    let dense_h = system
+        .disc
+        .per_surface(&system.irradiance(&solved.patch_radiosity));
+    let reflected = |h: &[Vec<Rgb>]| -> Vec<Vec<Rgb>> {
+        (0..scene.surfaces.len())
+            .map(|s| {
+                let rho = scene.surfaces[s].reflectance;
+                h[s].iter()
+                    .zip(&hierarchical.direct_irradiance[s])
+                    .map(|(&h, &d)| rho.mul_rgb(h - d))
+                    .collect()
+            })
+            .collect()
+    };
+    let ours = face_means(&mesh, &reflected(&hierarchical.irradiance));
+    let dense = face_means(&mesh, &reflected(&dense_h));
+    for name in ["floor", "back", "left", "right"] {
+        let s = scene.surface_id(name).expect("a room face");
+        let off = ours[s] / dense[s] - 1.0;
+        eprintln!(
+            "{name}: hierarchical {:.5}, dense {:.5} ({:+.2} %)",
+            ours[s],
+            dense[s],
+            100.0 * off
+        );
+        assert!(off.abs() < 0.05, "{name}: {off:+.4}");
     }
 }
 

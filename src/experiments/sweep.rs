@@ -115,6 +115,8 @@ pub struct SweepOptions {
     pub refine_tol: f64,
     /// The error-driven runs' tolerance ([`RunOptions::tolerance`]).
     pub tolerance: f64,
+    /// The smallest angle of discontinuity and error-driven meshes ([`RunOptions::min_angle`]).
+    pub min_angle: f64,
     /// Sample points the runs are scored at ([`sample_points`]).
     pub samples: usize,
     /// The seed of the sample points.
@@ -428,6 +430,7 @@ pub fn sweep(
             }),
             solver,
             tolerance: options.tolerance,
+            min_angle: options.min_angle,
             render: penumbra_viz::RenderOptions {
                 width: 1,
                 height: 1,

@@ -15,6 +15,8 @@
 use penumbra_scenes::Rgb;
 use rayon::prelude::*;
 
+use super::directions::{self, Table};
+use super::links::EXACT_CLUSTER_SURFACES;
 use super::links::{Link, Radiosities, Transfer};
 use super::transfer::{Axes, axis_weights, irradiance_from_axes, power_shares};
 use super::tree::{Hierarchy, NONE};
@@ -26,6 +28,9 @@ pub(crate) struct Field {
     pub b: Vec<Rgb>,
     /// Per cluster slot: power per axis direction.
     pub q: Vec<Axes>,
+    /// Per table slot (clusters of more than [`EXACT_CLUSTER_SURFACES`] surfaces): intensity
+    /// per sample direction.
+    pub tables: Vec<Table>,
     /// Per node: an element's mean irradiance from reflected light, its ancestors' included.
     pub irradiance: Vec<Rgb>,
     /// Per node: the least and greatest radiosity of its leaves.
@@ -58,12 +63,18 @@ impl Field {
                 *a += b.mul_rgb(gamma);
             }
         }
+        for (mine, theirs) in self.tables.iter_mut().zip(&other.tables) {
+            for (a, b) in mine.iter_mut().zip(theirs) {
+                *a += b.mul_rgb(gamma);
+            }
+        }
     }
 
-    fn new(nodes: usize, clusters: usize) -> Field {
+    fn new(nodes: usize, clusters: usize, tables: usize) -> Field {
         Field {
             b: vec![Rgb::ZERO; nodes],
             q: vec![[Rgb::ZERO; 6]; clusters],
+            tables: vec![directions::DARK; tables],
             irradiance: vec![Rgb::ZERO; nodes],
             low: vec![Rgb::ZERO; nodes],
             high: vec![Rgb::ZERO; nodes],
@@ -79,6 +90,9 @@ pub(crate) struct System<'a> {
     /// Each node's slot among the clusters (`NONE` for elements).
     pub slot: Vec<u32>,
     pub clusters: usize,
+    /// Each node's slot among the clusters with a table of intensities (`NONE` for others).
+    pub table_slot: Vec<u32>,
+    pub tables: usize,
     /// Per node: the mean radiosity it reflects of the exact direct light.
     pub direct: Vec<Rgb>,
     /// Links sorted by receiver, and for each node the range of its own.
@@ -124,11 +138,21 @@ impl<'a> System<'a> {
                 clusters += 1;
             }
         }
+        let mut table_slot = vec![NONE; hierarchy.nodes.len()];
+        let mut tables = 0;
+        for (i, n) in hierarchy.nodes.iter().enumerate() {
+            if n.is_cluster() && n.surfaces > EXACT_CLUSTER_SURFACES {
+                table_slot[i] = tables;
+                tables += 1;
+            }
+        }
         let n = hierarchy.nodes.len();
         let mut system = System {
             hierarchy,
             slot,
             clusters: clusters as usize,
+            table_slot,
+            tables: tables as usize,
             direct: vec![Rgb::splat(1.0); n],
             links: Vec::new(),
             first_link: vec![0; n + 1],
@@ -139,8 +163,8 @@ impl<'a> System<'a> {
             stale: vec![true; n],
             enclosed,
             tol,
-            unit: Field::new(0, 0),
-            unit_reflecting: Field::new(0, 0),
+            unit: Field::new(0, 0, 0),
+            unit_reflecting: Field::new(0, 0, 0),
         };
         system.unit = system.initial_field();
         let lit = hierarchy
@@ -181,7 +205,7 @@ impl<'a> System<'a> {
     /// gathers, unscaled, when every element's radiosity is one.
     pub(super) fn row_sums(&self) -> Vec<f64> {
         let gathered = self.gather(&self.unit);
-        let mut out = Field::new(self.hierarchy.nodes.len(), self.clusters);
+        let mut out = Field::new(self.hierarchy.nodes.len(), self.clusters, self.tables);
         if let Some(root) = self.hierarchy.root {
             self.push_pull(root, Down::Axes([Rgb::ZERO; 6]), &gathered, false, &mut out);
         }
@@ -274,13 +298,16 @@ impl<'a> System<'a> {
             high: &field.high,
             incoming: &field.incoming,
             slot: &self.slot,
+            tables: &field.tables,
+            table_slot: &self.table_slot,
+            hierarchy: self.hierarchy,
         }
     }
 
     /// The field before any reflected light has been gathered: the direct light reflected.
     pub(super) fn initial_field(&self) -> Field {
         let n = self.hierarchy.nodes.len();
-        let mut field = Field::new(n, self.clusters);
+        let mut field = Field::new(n, self.clusters, self.tables);
         if let Some(root) = self.hierarchy.root {
             let gathered = Gathered {
                 h: vec![Rgb::ZERO; n],
@@ -300,7 +327,7 @@ impl<'a> System<'a> {
     /// One Jacobi sweep from `field`: the new field.
     pub(super) fn sweep(&self, field: &Field) -> Field {
         let gathered = self.gather(field);
-        let mut next = Field::new(field.b.len(), self.clusters);
+        let mut next = Field::new(field.b.len(), self.clusters, self.tables);
         if let Some(root) = self.hierarchy.root {
             self.push_pull(root, Down::Axes([Rgb::ZERO; 6]), &gathered, true, &mut next);
         }
@@ -459,8 +486,33 @@ impl<'a> System<'a> {
                     }
                 }
                 out.q[slot as usize] = power;
+                if let Some(table) = self.table_of(id, out) {
+                    out.tables[self.table_slot[id as usize] as usize] = table;
+                }
             }
         }
+    }
+
+    /// The intensities of cluster `id`, if it keeps a table: its children's tables, or the
+    /// surfaces of those that keep none, summed.
+    fn table_of(&self, id: u32, out: &Field) -> Option<Table> {
+        if self.table_slot[id as usize] == NONE {
+            return None;
+        }
+        let h = self.hierarchy;
+        let mut table = directions::DARK;
+        let mut stack: Vec<u32> = h.node(id).children.into_iter().flatten().collect();
+        while let Some(c) = stack.pop() {
+            let node = h.node(c);
+            match self.table_slot[c as usize] {
+                NONE if node.is_cluster() => stack.extend(node.children.into_iter().flatten()),
+                NONE => {
+                    directions::add_surface(&mut table, out.b[c as usize] * node.area, node.normal);
+                }
+                slot => directions::add_table(&mut table, &out.tables[slot as usize]),
+            }
+        }
+        Some(table)
     }
 
     /// Pulls the leaves' radiosities up the hierarchy from `id`.

@@ -20,6 +20,7 @@
 //! every parallel step collects in order.
 
 mod balance;
+mod directions;
 mod final_gather;
 mod iterate;
 mod links;
@@ -74,15 +75,19 @@ const LINK_PEAK: f64 = 3.0;
 /// balances the energy, and the two fields of unit radiosity.
 const FIELDS: usize = 5;
 
-/// Bytes the hierarchy and its links take at their peak for a mesh of `triangles` at
-/// `link_tol`: two nodes per triangle, their light (fields of five colours a node, and four
-/// numbers: scale, totals, sums), and the links.
-pub fn estimated_bytes(triangles: u64, link_tol: f64) -> u64 {
+/// Bytes the hierarchy and its links take at their peak for a mesh of `triangles` over
+/// `surfaces` at `link_tol`: two nodes per triangle, their light (fields of five colours a node,
+/// and four numbers: scale, totals, sums), the links, and the tables of intensities of the
+/// clusters of more than [`links::EXACT_CLUSTER_SURFACES`] surfaces (at most two per that many
+/// surfaces, in each field).
+pub fn estimated_bytes(triangles: u64, surfaces: u64, link_tol: f64) -> u64 {
     let node = (size_of::<tree::Node>() + FIELDS * 5 * size_of::<Rgb>() + 4 * 8) as f64;
     let ratio = DEFAULT_LINK_TOL / link_tol.max(f64::MIN_POSITIVE);
     let links = LINKS_PER_TRIANGLE * ratio.max(1.0).powf(LINK_GROWTH);
     let per_triangle = 2.0 * node + LINK_PEAK * links * size_of::<Link>() as f64;
-    (triangles as f64 * per_triangle).min(u64::MAX as f64) as u64
+    let tables = 2.0 * surfaces as f64 / f64::from(links::EXACT_CLUSTER_SURFACES)
+        * (FIELDS * size_of::<directions::Table>()) as f64;
+    (triangles as f64 * per_triangle + tables).min(u64::MAX as f64) as u64
 }
 
 /// Figures of a hierarchical solve, under `solver.hierarchy` in `report.json`.

@@ -1,14 +1,14 @@
 //! How light goes between nodes: form factors from points to elements, and the directional light
 //! of clusters.
 //!
-//! A cluster's light is kept per axis direction (+x, −x, +y, −y, +z, −z), after Sillion's (1995)
-//! clusters that send and receive as a whole. Going out, a surface's power is shared among the
-//! directions its normal leans to, in proportion to |n_k| (the shares sum to one, so no power is
-//! made or lost), and the cluster's intensity toward `d` is Σ_k max(0, d · a_k) Q_k / π. Coming
-//! in, a cluster keeps the irradiance each axis-facing plane would get, and a surface inside it
-//! with normal `n` reads Σ_k max(0, n · a_k) G_k. Both are exact for surfaces facing along the
-//! axes (boxes, rooms) and an approximation otherwise, bounded by the link oracle, which refines
-//! every cluster link that carries much light.
+//! A cluster sends as the sum of its surfaces, or from its table of intensities over directions
+//! when it holds many (see [`super::directions`]). It receives as a whole, after Sillion's
+//! (1995) clusters: it keeps the irradiance each axis-facing plane (+x, −x, +y, −y, +z, −z)
+//! would get, G_k, and a surface inside it with normal `n` reads Σ_k s_k(n) G_k, with s_k the
+//! shares |n_k| / Σ|n_j| by which its power is kept per axis direction too. That is exact for
+//! surfaces facing along the axes (boxes, rooms) and for light from all around, and an
+//! approximation otherwise, bounded by the link oracle, which refines every cluster link that
+//! carries much light.
 
 use std::f64::consts::PI;
 
@@ -46,23 +46,17 @@ pub(crate) fn power_shares(normal: DVec3) -> [f64; 6] {
     w.map(|x| x / sum.max(f64::MIN_POSITIVE))
 }
 
-/// Irradiance on a surface facing `normal` inside a cluster that receives `g`.
+/// Irradiance on a surface facing `normal` inside a cluster that receives `g`: the axis planes'
+/// irradiances weighed by the same shares the surface sends its power by, so that a cluster
+/// receives as it sends (reciprocity: the light two clusters exchange is the same both ways).
+/// Weighed by |n_k| alone, a surface at 45° to two axes read a uniform surround √2 times over,
+/// and a curved blocker's facets gathered half as much again as their view holds.
 pub(crate) fn irradiance_from_axes(g: &Axes, normal: DVec3) -> Rgb {
-    axis_weights(normal)
+    power_shares(normal)
         .iter()
         .zip(g)
         .map(|(&w, &h)| h * w)
         .sum()
-}
-
-/// Intensity (W/sr) toward unit `d` of a cluster whose power per axis direction is `q`.
-pub(crate) fn cluster_intensity(q: &Axes, d: DVec3) -> Rgb {
-    axis_weights(d)
-        .iter()
-        .zip(q)
-        .map(|(&w, &p)| p * w)
-        .sum::<Rgb>()
-        / PI
 }
 
 /// Intensity (W/sr per unit radiosity) toward unit `d` of an element.

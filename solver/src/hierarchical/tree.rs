@@ -45,6 +45,8 @@ pub(crate) struct Node {
     pub axes: [DVec3; 2],
     /// An element's reflectance; for a cluster, the largest of its surfaces' per channel.
     pub reflectance: Rgb,
+    /// The surfaces it holds: one for an element.
+    pub surfaces: u32,
     pub depth: u16,
 }
 
@@ -311,6 +313,7 @@ impl<F: Fn(SurfaceId) -> Rgb> Builder<'_, F> {
             bounds,
             hull,
             reflectance,
+            surfaces: na.surfaces + nb.surfaces,
             ..placeholder(parent, depth)
         };
         id
@@ -347,6 +350,7 @@ impl<F: Fn(SurfaceId) -> Rgb> Builder<'_, F> {
                 hull: SmallVec::from_slice(&el.points),
                 axes: moment.axes(normal, el.area),
                 reflectance: rho,
+                surfaces: 1,
                 depth,
             });
             self.moments[id as usize] = moment;
@@ -503,6 +507,7 @@ fn placeholder(parent: u32, depth: u16) -> Node {
         hull: SmallVec::new(),
         axes: [DVec3::ZERO; 2],
         reflectance: Rgb::ZERO,
+        surfaces: 1,
         depth,
     }
 }

@@ -81,6 +81,7 @@ fn flag(option: &str, command: Command) -> Option<&'static str> {
         ("refine indirect", _) => "--refine-indirect",
         ("refine tolerance", _) => "--refine-tol",
         ("tolerance", _) => "--tol",
+        ("min angle", _) => "--min-angle",
         ("refine rounds", _) => "--refine-rounds",
         ("penumbra density", _) => "--penumbra-density",
         ("event tolerance", _) => "--event-tol",

@@ -69,7 +69,7 @@ enum Command {
     /// Run uniform, uniform + adaptive, discontinuity and discontinuity + adaptive meshes over a
     /// ladder of element budgets and score each against a reference; write sweep.csv and
     /// sweep.json.
-    Sweep(SweepArgs),
+    Sweep(Box<SweepArgs>),
     /// Measure every form-factor method (analytic, Monte Carlo, hemicube) against closed forms:
     /// error against cost, point by point, the hemicube's aliasing, the 1 x 2 x 3 box's face
     /// factors and dense solutions of a unit cube; write form-factors.json and print the tables.

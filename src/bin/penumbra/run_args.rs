@@ -25,6 +25,11 @@ fn default_export() -> String {
     DEFAULT_EXPORT.to_owned()
 }
 
+// Reports written before --min-angle replay with its default.
+fn default_min_angle() -> f64 {
+    penumbra::DEFAULT_MIN_ANGLE_DEG
+}
+
 // Reports written before error-driven meshes replay with their default tolerance.
 fn default_tol() -> f64 {
     penumbra::error_mesh::DEFAULT_TOLERANCE
@@ -150,12 +155,18 @@ pub(crate) struct RunArgs {
     /// discontinuity where the scene casts shadows, else uniform).
     #[arg(help_heading = MESH, long, value_enum)]
     pub(crate) mesh: Option<MeshArg>,
-    /// Error-driven meshes (the default): split triangles until no check point (edge midpoints
-    /// and centroids) misses the exact direct light by more than this fraction of the scene's
-    /// mean reflected direct light, or --max-elements is reached.
+    /// Error-driven meshes (the default): split triangles until each surface's RMS error of the
+    /// direct light, estimated from the exact light at its triangles' edge midpoints, is within
+    /// this fraction of its mean reflected direct light, or --max-elements is reached.
     #[arg(help_heading = MESH, long, default_value_t = penumbra::error_mesh::DEFAULT_TOLERANCE)]
     #[serde(default = "default_tol")]
     pub(crate) tol: f64,
+    /// Discontinuity and error-driven meshes: the smallest angle, in degrees, that quality
+    /// refinement aims for where the discontinuities do not force a smaller one (0: no quality
+    /// refinement; at most 30).
+    #[arg(help_heading = MESH, long, value_name = "DEG", default_value_t = penumbra::DEFAULT_MIN_ANGLE_DEG)]
+    #[serde(default = "default_min_angle")]
+    pub(crate) min_angle: f64,
     /// Cap on triangles for the whole scene, spread over the surfaces by area. Default: what the
     /// scene needs: 25,000 with the hierarchical solver (its cost grows about linearly with the
     /// vertices), 10,000 with the others or --direct-only, or, when that is too few, the least
@@ -346,6 +357,7 @@ impl RunArgs {
                 )),
             time_budget: self.time_budget,
             tolerance: self.tol,
+            min_angle: self.min_angle,
             refine: self
                 .refine_tol
                 .map(|tolerance| penumbra::adaptive::RefineOptions {

@@ -36,6 +36,10 @@ pub(crate) struct SweepArgs {
     /// Tolerance of the error-driven runs (as `run --tol`).
     #[arg(long, default_value_t = penumbra::error_mesh::DEFAULT_TOLERANCE)]
     tol: f64,
+    /// Smallest angle of the discontinuity and error-driven meshes, in degrees (as `run
+    /// --min-angle`).
+    #[arg(long, value_name = "DEG", default_value_t = penumbra::DEFAULT_MIN_ANGLE_DEG)]
+    min_angle: f64,
     /// Sample points the runs are scored at (default: 4000 with --direct-only, else 1000).
     #[arg(long)]
     samples: Option<usize>,
@@ -115,6 +119,7 @@ pub(crate) fn sweep(args: &SweepArgs) -> Result<(), Failure> {
         surfaces: args.surfaces.clone(),
         refine_tol: args.refine_tol,
         tolerance: args.tol,
+        min_angle: args.min_angle,
         initial_fraction: args.initial_fraction,
         samples: sample_count,
         seed: args.seed,
