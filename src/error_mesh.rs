@@ -24,7 +24,9 @@ use std::time::Instant;
 use glam::DVec3;
 use penumbra_meshing::{BisectionMesh, SceneMesh, Split, SurfaceMesh};
 use penumbra_scenes::{AreaSampler, Rgb, Scene, SplitMix64, SurfaceId, Visibility};
-use penumbra_solver::{DirectLight, Interrupt, OVERLAY_CAP, Progress, ReceivingPoint, form_factor};
+use penumbra_solver::{
+    DirectLight, Interrupt, OVERLAY_CAP, Progress, ReceivingPoint, Solution, form_factor,
+};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -113,6 +115,11 @@ pub struct SurfaceError {
     /// Whether its estimated RMS error (of its measured triangles and the priors of the others)
     /// is within the tolerance of its mean (or of a tenth of the scene's, if darker).
     pub within_tolerance: bool,
+    /// Full solutions: the estimated RMS interpolation error of the light it reflects more than
+    /// once (from the jumps of that light's gradient across its triangles' edges), relative to
+    /// the mean of all the light it reflects (B − E).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reflected_rms: Option<f64>,
 }
 
 /// What error-driven refinement did and the error it measured (`mesh_error` in `report.json`).
@@ -140,9 +147,46 @@ pub struct MeshErrorReport {
     pub max: f64,
     /// Each refined surface, in the scene's order.
     pub surfaces: Vec<SurfaceError>,
+    /// Full solutions: the refined surfaces' estimated RMS interpolation error of the light
+    /// reflected more than once, relative to the mean of all the light they reflect (see
+    /// [`SurfaceError::reflected_rms`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reflected_rms: Option<f64>,
 }
 
 impl MeshErrorReport {
+    /// Adds the estimated interpolation error of the light reflected more than once, from a full
+    /// solution on `mesh`: the jumps of its gradient across each triangle's inner edges times
+    /// the edge's length over 8, the error of a quadratic's interpolant (the measured check
+    /// points cover only the direct light).
+    pub fn estimate_reflected(&mut self, scene: &Scene, mesh: &SceneMesh, solution: &Solution) {
+        let (mut squared, mut reflected, mut area) = (0.0, 0.0, 0.0);
+        for entry in &mut self.surfaces {
+            let Some(id) = scene.surface_id(&entry.surface) else {
+                continue;
+            };
+            let (m, surface) = (&mesh.surfaces[id], &scene.surfaces[id]);
+            let (b, direct) = (&solution.radiosity[id], &solution.direct_irradiance[id]);
+            let indirect: Vec<f64> = (b.iter().zip(direct))
+                .map(|(&b, &d)| (b - surface.emission - surface.reflectance.mul_rgb(d)).mean())
+                .collect();
+            let jumps = penumbra_solver::estimate::gradient_jump_estimate(m, &indirect);
+            let (mut s2, mut sum, mut a) = (0.0, 0.0, 0.0);
+            for (t, tri) in m.triangles.iter().enumerate() {
+                let at = m.triangle_area(t);
+                let mean = tri
+                    .iter()
+                    .map(|&v| (b[v as usize] - surface.emission).mean())
+                    .sum::<f64>()
+                    / 3.0;
+                (s2, sum, a) = (s2 + at * jumps[t] * jumps[t], sum + at * mean, a + at);
+            }
+            entry.reflected_rms = (sum > 0.0).then(|| (s2 * a).sqrt() / sum);
+            (squared, reflected, area) = (squared + s2, reflected + sum, area + a);
+        }
+        self.reflected_rms = (reflected > 0.0).then(|| (squared * area).sqrt() / reflected);
+    }
+
     /// The surfaces left above the tolerance: where the budget or the time ran out first.
     pub fn above_tolerance(&self) -> Vec<&SurfaceError> {
         self.surfaces
@@ -563,6 +607,7 @@ impl<'a> Refiner<'a> {
             },
             max: relative(max),
             surfaces,
+            reflected_rms: None,
         }
     }
 }
@@ -742,6 +787,7 @@ impl Refined {
             rms: relative((squared / m.area().max(f64::MIN_POSITIVE)).sqrt()),
             max: relative(self.error.iter().fold(0.0, |a, &b| a.max(b))),
             within_tolerance: self.done,
+            reflected_rms: None,
         }
     }
 }

@@ -432,7 +432,7 @@ pub fn run(
             .max(mesh.triangle_count()),
     };
     progress.finish();
-    let mesh_error = error_driven.then(|| {
+    let mut mesh_error = error_driven.then(|| {
         let stop = StopWhen {
             deadline: solver.deadline,
             interrupt: options.solver.interrupt.clone(),
@@ -532,6 +532,9 @@ pub fn run(
         ),
     };
     peaks.solve = memory::peak_resident_bytes();
+    if let Some(report) = mesh_error.as_mut().filter(|_| !solver.direct_only) {
+        report.estimate_reflected(scene, &mesh, &solution);
+    }
     let stats = &solution.stats;
     times.direct = stats.direct_seconds;
     times.shooting = stats.shooting_seconds;

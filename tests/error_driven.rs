@@ -117,3 +117,37 @@ fn a_torus() {
 fn the_cornell_box() {
     beats_uniform(&builtin::cornell(), 10_000);
 }
+
+/// Full solutions report the estimated interpolation error of the light reflected more than
+/// once (from its gradient's jumps), per surface and for the scene; direct-light runs report
+/// none. In the closed furnace that light is the same everywhere, and the estimate is zero; in
+/// the Cornell box it is not.
+#[test]
+fn the_reflected_light_error_is_estimated() {
+    let estimate = |scene: Scene, direct_only: bool| {
+        let options = RunOptions {
+            max_elements: 4_000.into(),
+            solver: SolverOptions {
+                direct_only,
+                ..SolverOptions::default()
+            },
+            ..RunOptions::default()
+        };
+        let report = run_scene(scene, options).mesh_error.expect("error-driven");
+        let surfaces: Vec<Option<f64>> = report.surfaces.iter().map(|s| s.reflected_rms).collect();
+        (report.reflected_rms, surfaces)
+    };
+    let (none, surfaces) = estimate(builtin::cornell(), true);
+    assert!(none.is_none() && surfaces.iter().all(Option::is_none));
+    let (cornell, surfaces) = estimate(builtin::cornell(), false);
+    let cornell = cornell.expect("estimated");
+    assert!(
+        surfaces
+            .iter()
+            .all(|s| s.is_some_and(|e| e.is_finite() && e >= 0.0))
+    );
+    let (furnace, _) = estimate(builtin::furnace(1.0, 0.5), false);
+    let furnace = furnace.expect("estimated");
+    eprintln!("reflected light's estimated RMS error: Cornell {cornell:.4}, furnace {furnace:.1e}");
+    assert!(furnace < 1e-9 && cornell > 1e-3, "{furnace} {cornell}");
+}
