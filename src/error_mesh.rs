@@ -99,6 +99,9 @@ pub enum ErrorStop {
 pub struct SurfaceError {
     /// The surface's name.
     pub surface: String,
+    /// Its index in the scene.
+    #[serde(skip)]
+    pub id: SurfaceId,
     /// Its triangles.
     pub triangles: usize,
     /// Of those, how many were measured at their check points (the others' prior stayed below
@@ -162,9 +165,7 @@ impl MeshErrorReport {
     pub fn estimate_reflected(&mut self, scene: &Scene, mesh: &SceneMesh, solution: &Solution) {
         let (mut squared, mut reflected, mut area) = (0.0, 0.0, 0.0);
         for entry in &mut self.surfaces {
-            let Some(id) = scene.surface_id(&entry.surface) else {
-                continue;
-            };
+            let id = entry.id;
             let (m, surface) = (&mesh.surfaces[id], &scene.surfaces[id]);
             let (b, direct) = (&solution.radiosity[id], &solution.direct_irradiance[id]);
             let indirect: Vec<f64> = (b.iter().zip(direct))
@@ -576,7 +577,7 @@ impl<'a> Refiner<'a> {
             .surfaces
             .iter()
             .filter(|s| s.refined)
-            .map(|s| s.summary(&scene.surfaces[s.id].name))
+            .map(|s| s.summary(scene))
             .collect();
         let (mut area, mut measured, mut sum2, mut max) = (0.0, 0.0, 0.0, 0.0f64);
         for s in &self.surfaces {
@@ -774,13 +775,14 @@ impl Refined {
         self.mesh().triangle_area(t) * 4.0 / 45.0 * (sum * sum + sum2)
     }
 
-    fn summary(&self, name: &str) -> SurfaceError {
+    fn summary(&self, scene: &Scene) -> SurfaceError {
         let m = self.mesh();
         let mean = self.mean();
         let relative = |e: f64| if mean > 0.0 { e / mean } else { 0.0 };
         let squared: f64 = self.squared.iter().sum();
         SurfaceError {
-            surface: name.to_string(),
+            surface: scene.surfaces[self.id].name.clone(),
+            id: self.id,
             triangles: m.triangle_count(),
             measured: self.measured.iter().filter(|&&m| m).count(),
             mean_reflected: mean,

@@ -15,6 +15,18 @@ fn solve(scene: &Scene, mesh: &SceneMesh, options: &SolverOptions) -> Solution {
     solve_hierarchical(scene, mesh, &vis, options, &NoProgress).expect("solves")
 }
 
+/// The dense solve of the patch system of `mesh`: the irradiance at every vertex, per surface.
+fn dense_irradiance(scene: &Scene, mesh: &SceneMesh, options: &SolverOptions) -> Vec<Vec<Rgb>> {
+    let vis = Visibility::build(scene);
+    let system = PatchSystem::assemble(scene, mesh, &vis, options, &NoProgress).expect("assembles");
+    let solved = system
+        .solve(SolverMethod::Direct, 1e-12, 1, &|| None)
+        .expect("solves");
+    system
+        .disc
+        .per_surface(&system.irradiance(&solved.patch_radiosity))
+}
+
 /// Area means of a per-vertex field over each surface (linear over each triangle).
 fn face_means(mesh: &SceneMesh, field: &[Vec<Rgb>]) -> Vec<f64> {
     mesh.surfaces
@@ -83,7 +95,6 @@ fn unit_cube_face_means_match_the_continuous_limit() {
         let floor = scene.surface_id("floor").expect("floor");
         let ceiling = scene.surface_id("ceiling").expect("ceiling");
         scene.surfaces[floor].emission = Rgb::splat(1.0);
-        let vis = Visibility::build(&scene);
         let mesh = mesh_scene_uniform(&scene, 1200).expect("cube meshes");
         let options = SolverOptions {
             epsilon: 1e-6,
@@ -91,16 +102,16 @@ fn unit_cube_face_means_match_the_continuous_limit() {
             ..SolverOptions::default()
         };
         let hierarchical = face_means(&mesh, &solve(&scene, &mesh, &options).radiosity);
-        let system =
-            PatchSystem::assemble(&scene, &mesh, &vis, &options, &NoProgress).expect("assembles");
-        let solved = system
-            .solve(SolverMethod::Direct, 1e-12, 1, &|| None)
-            .expect("solves");
-        let h = system.irradiance(&solved.patch_radiosity);
-        let b: Vec<Rgb> = (0..h.len())
-            .map(|v| system.disc.emission[v] + system.disc.reflectance[v].mul_rgb(h[v]))
+        let radiosity: Vec<Vec<Rgb>> = dense_irradiance(&scene, &mesh, &options)
+            .iter()
+            .zip(&scene.surfaces)
+            .map(|(h, s)| {
+                h.iter()
+                    .map(|&h| s.emission + s.reflectance.mul_rgb(h))
+                    .collect()
+            })
             .collect();
-        let dense = face_means(&mesh, &system.disc.per_surface(&b));
+        let dense = face_means(&mesh, &radiosity);
         let expected = |s: usize| {
             if s == floor {
                 limit[0]
@@ -205,18 +216,10 @@ fn open_room_with_sphere() -> Scene {
 #[test]
 fn a_tessellated_sphere_sends_its_light_where_its_facets_face() {
     let scene = open_room_with_sphere();
-    let vis = Visibility::build(&scene);
     let mesh = mesh_scene_uniform(&scene, 3000).expect("meshes");
     let options = SolverOptions::default();
     let hierarchical = solve(&scene, &mesh, &options);
-    let system =
-        PatchSystem::assemble(&scene, &mesh, &vis, &options, &NoProgress).expect("assembles");
-    let solved = system
-        .solve(SolverMethod::Direct, 1e-12, 1, &|| None)
-        .expect("solves");
-    let dense_h = system
-        .disc
-        .per_surface(&system.irradiance(&solved.patch_radiosity));
+    let dense_h = dense_irradiance(&scene, &mesh, &options);
     let reflected = |h: &[Vec<Rgb>]| -> Vec<Vec<Rgb>> {
         (0..scene.surfaces.len())
             .map(|s| {

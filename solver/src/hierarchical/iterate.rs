@@ -2,8 +2,8 @@
 //! along its links from the radiosities of the last sweep; then the gathered light is pushed down
 //! the hierarchy (an element passes its irradiance to its children, a cluster its light per axis
 //! direction, read by each surface for its own normal), the leaves reflect it on top of the
-//! direct light they reflect, and radiosities are pulled up again as area means (powers per
-//! axis direction for clusters).
+//! direct light they reflect, and radiosities are pulled up again as area means (for clusters,
+//! their power, and the large ones' intensities over directions).
 //!
 //! Each leaf's gathered light is scaled so that its form factors sum to its true total (see
 //! [`super::totals`]): every row of the system then sums to ρ T ≤ ρ < 1, so the sweeps are a
@@ -18,7 +18,7 @@ use rayon::prelude::*;
 use super::directions::{self, Table};
 use super::links::EXACT_CLUSTER_SURFACES;
 use super::links::{Link, Radiosities, Transfer};
-use super::transfer::{Axes, axis_weights, irradiance_from_axes, power_shares};
+use super::transfer::{Axes, axis_weights, irradiance_from_axes};
 use super::tree::{Hierarchy, NONE};
 
 /// The light in the hierarchy: radiosities and irradiances of elements, powers of clusters.
@@ -26,8 +26,8 @@ use super::tree::{Hierarchy, NONE};
 pub(crate) struct Field {
     /// Per node: an element's mean reflected radiosity (zero for clusters).
     pub b: Vec<Rgb>,
-    /// Per cluster slot: power per axis direction.
-    pub q: Vec<Axes>,
+    /// Per cluster slot: the power it sends (W).
+    pub power: Vec<Rgb>,
     /// Per table slot (clusters of more than [`EXACT_CLUSTER_SURFACES`] surfaces): intensity
     /// per sample direction.
     pub tables: Vec<Table>,
@@ -58,11 +58,7 @@ impl Field {
         for (h, &x) in self.irradiance.iter_mut().zip(extra) {
             *h += gamma * x;
         }
-        for (q, t) in self.q.iter_mut().zip(&other.q) {
-            for (a, b) in q.iter_mut().zip(t) {
-                *a += b.mul_rgb(gamma);
-            }
-        }
+        add(&mut self.power, &other.power);
         for (mine, theirs) in self.tables.iter_mut().zip(&other.tables) {
             for (a, b) in mine.iter_mut().zip(theirs) {
                 *a += b.mul_rgb(gamma);
@@ -73,7 +69,7 @@ impl Field {
     fn new(nodes: usize, clusters: usize, tables: usize) -> Field {
         Field {
             b: vec![Rgb::ZERO; nodes],
-            q: vec![[Rgb::ZERO; 6]; clusters],
+            power: vec![Rgb::ZERO; clusters],
             tables: vec![directions::DARK; tables],
             irradiance: vec![Rgb::ZERO; nodes],
             low: vec![Rgb::ZERO; nodes],
@@ -293,7 +289,7 @@ impl<'a> System<'a> {
     pub(super) fn radiosities<'f>(&'f self, field: &'f Field) -> Radiosities<'f> {
         Radiosities {
             b: &field.b,
-            q: &field.q,
+            power: &field.power,
             low: &field.low,
             high: &field.high,
             incoming: &field.incoming,
@@ -447,7 +443,8 @@ impl<'a> System<'a> {
     }
 
     /// Node `id`'s light from its children's in `out`: an element's radiosity is their area
-    /// mean (and its range theirs), a cluster's power per axis direction their sum.
+    /// mean (and its range theirs), a cluster's power their sum (and its intensities, if it
+    /// keeps a table).
     fn aggregate(&self, id: u32, out: &mut Field) {
         let h = self.hierarchy;
         let node = h.node(id);
@@ -468,24 +465,13 @@ impl<'a> System<'a> {
                 (out.b[i], out.low[i], out.high[i]) = (sum / node.area, low, high);
             }
             slot => {
-                let mut power = [Rgb::ZERO; 6];
-                for c in children {
-                    match self.slot[c as usize] {
-                        NONE => {
-                            let child = h.node(c);
-                            let sent = out.b[c as usize] * child.area;
-                            for (p, share) in power.iter_mut().zip(power_shares(child.normal)) {
-                                *p += sent * share;
-                            }
-                        }
-                        s => {
-                            for (p, q) in power.iter_mut().zip(&out.q[s as usize]) {
-                                *p += *q;
-                            }
-                        }
-                    }
-                }
-                out.q[slot as usize] = power;
+                out.power[slot as usize] = children
+                    .iter()
+                    .map(|&c| match self.slot[c as usize] {
+                        NONE => out.b[c as usize] * h.node(c).area,
+                        s => out.power[s as usize],
+                    })
+                    .sum();
                 if let Some(table) = self.table_of(id, out) {
                     out.tables[self.table_slot[id as usize] as usize] = table;
                 }

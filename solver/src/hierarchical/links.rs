@@ -26,7 +26,7 @@ use rayon::prelude::*;
 use super::directions::{self, Table};
 use super::shaft::{Shafts, Sight};
 use super::transfer::{
-    Axes, FAR_DISTANCE, element_intensity, far_factor, leaf_factor, point_factor, triangle_mean,
+    FAR_DISTANCE, element_intensity, far_factor, leaf_factor, point_factor, triangle_mean,
 };
 use super::tree::{Hierarchy, NONE, Node};
 use crate::SolverOptions;
@@ -61,17 +61,18 @@ pub(crate) struct Link {
     pub partial: bool,
 }
 
-/// The solution the oracle judges links by: every element's mean reflected radiosity, and every
-/// cluster's power per axis direction.
+/// The solution the oracle judges links by: every element's mean reflected radiosity, every
+/// cluster's power, and the large clusters' intensities over directions.
 pub(crate) struct Radiosities<'s> {
     pub b: &'s [Rgb],
-    pub q: &'s [Axes],
-    /// Each node's slot in `q` (clusters only).
+    /// Each cluster's power (W), by slot.
+    pub power: &'s [Rgb],
     /// The least and greatest radiosity of each element's leaves.
     pub low: &'s [Rgb],
     pub high: &'s [Rgb],
     /// The mean radiosity each element gathers (zero before any is gathered).
     pub incoming: &'s [Rgb],
+    /// Each node's slot in `power` (clusters only).
     pub slot: &'s [u32],
     /// Intensities of large clusters, and each node's slot among them.
     pub tables: &'s [Table],
@@ -98,10 +99,7 @@ impl Radiosities<'_> {
     /// The power the source sends (W).
     pub(super) fn power(&self, node: &Node, id: u32) -> Rgb {
         if node.is_cluster() {
-            self.q[self.slot[id as usize] as usize]
-                .iter()
-                .copied()
-                .sum()
+            self.power[self.slot[id as usize] as usize]
         } else {
             self.b[id as usize] * node.area
         }

@@ -5,7 +5,7 @@
 //! when it holds many (see [`super::directions`]). It receives as a whole, after Sillion's
 //! (1995) clusters: it keeps the irradiance each axis-facing plane (+x, −x, +y, −y, +z, −z)
 //! would get, G_k, and a surface inside it with normal `n` reads Σ_k s_k(n) G_k, with s_k the
-//! shares |n_k| / Σ|n_j| by which its power is kept per axis direction too. That is exact for
+//! shares |n_k| / Σ|n_j| ([`axis_shares`]). That is exact for
 //! surfaces facing along the axes (boxes, rooms) and for light from all around, and an
 //! approximation otherwise, bounded by the link oracle, which refines every cluster link that
 //! carries much light.
@@ -39,20 +39,20 @@ pub(crate) fn axis_weights(d: DVec3) -> [f64; 6] {
     ]
 }
 
-/// The shares of a surface's power sent along each axis direction: |n_k| over their sum.
-pub(crate) fn power_shares(normal: DVec3) -> [f64; 6] {
+/// The shares by which a surface facing `normal` reads the axis planes' irradiances: |n_k| over
+/// their sum.
+pub(crate) fn axis_shares(normal: DVec3) -> [f64; 6] {
     let w = axis_weights(normal);
     let sum: f64 = w.iter().sum();
     w.map(|x| x / sum.max(f64::MIN_POSITIVE))
 }
 
 /// Irradiance on a surface facing `normal` inside a cluster that receives `g`: the axis planes'
-/// irradiances weighed by the same shares the surface sends its power by, so that a cluster
-/// receives as it sends (reciprocity: the light two clusters exchange is the same both ways).
-/// Weighed by |n_k| alone, a surface at 45° to two axes read a uniform surround √2 times over,
-/// and a curved blocker's facets gathered half as much again as their view holds.
+/// irradiances weighed by shares that sum to one, so that a uniform surround is read as it is.
+/// Weighed by |n_k| alone, a surface at 45° to two axes read it √2 times over, and a curved
+/// blocker's facets gathered half as much again as their view holds.
 pub(crate) fn irradiance_from_axes(g: &Axes, normal: DVec3) -> Rgb {
-    power_shares(normal)
+    axis_shares(normal)
         .iter()
         .zip(g)
         .map(|(&w, &h)| h * w)
