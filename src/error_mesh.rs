@@ -30,6 +30,8 @@ use penumbra_solver::{
 use rayon::prelude::*;
 use serde::Serialize;
 
+use crate::reflected_mesh::ReflectedRefinement;
+
 /// The error a run aims for by default: each refined surface's estimated RMS interpolation
 /// error of the direct light, relative to its mean reflected direct light. On the
 /// CornellBox-Sphere and CornellBox-Lucy floors it left 0.42 % and 0.31 % RMS at random points
@@ -155,6 +157,10 @@ pub struct MeshErrorReport {
     /// [`SurfaceError::reflected_rms`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub reflected_rms: Option<f64>,
+    /// Full solutions with the hierarchical solver: what refinement for the light reflected
+    /// more than once did after the first solve.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reflected_refinement: Option<ReflectedRefinement>,
 }
 
 impl MeshErrorReport {
@@ -609,6 +615,7 @@ impl<'a> Refiner<'a> {
             max: relative(max),
             surfaces,
             reflected_rms: None,
+            reflected_refinement: None,
         }
     }
 }

@@ -122,6 +122,7 @@ pub mod memory;
 pub mod options;
 pub mod outputs;
 pub mod pipeline;
+pub mod reflected_mesh;
 pub mod shard;
 
 pub use options::{

@@ -7,6 +7,7 @@ use crate::adaptive::{RefineReport, refine_adaptively, refine_hierarchically};
 use crate::error_mesh::{MeshErrorReport, StopWhen, refine_by_error};
 use crate::memory::{self, MeshCounts};
 use crate::options::{InvalidOption, MeshMethod, RunOptions};
+use crate::reflected_mesh::refine_reflected;
 use crate::shard::ShardError;
 use penumbra_meshing::discontinuity::{
     Boundary, DiscontinuityOptions, find_discontinuities_reporting,
@@ -515,6 +516,22 @@ pub fn run(
             None,
             solve_progressive(scene, &mesh, &visibility, &solver, progress)?,
         ),
+        // Error-driven meshes are refined again for the light reflected more than once.
+        None if options.method == SolverMethod::Hierarchical && error_driven => {
+            let (done, solution) = refine_reflected(
+                scene,
+                &visibility,
+                &mut mesh,
+                budget,
+                options.tolerance,
+                &solver,
+                progress,
+            )?;
+            if let Some(report) = mesh_error.as_mut() {
+                report.reflected_refinement = Some(done);
+            }
+            (None, solution)
+        }
         None if options.method == SolverMethod::Hierarchical => (
             None,
             solve_hierarchical(scene, &mesh, &visibility, &solver, progress)?,

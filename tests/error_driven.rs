@@ -6,10 +6,16 @@ mod common;
 
 use common::in_process::run_scene;
 use glam::DVec3;
+use penumbra::error_mesh::{DEFAULT_TOLERANCE, StopWhen, refine_by_error};
+use penumbra::reflected_mesh::refine_reflected;
 use penumbra::{MeshMethod, RunOptions};
+use penumbra_meshing::{SceneMesh, TriangleLocator, mesh_scene_uniform};
 use penumbra_scenes::tessellated::{bumpy_blob, icosphere, torus};
-use penumbra_scenes::{Rgb, Scene, Surface, Visibility, builtin};
-use penumbra_solver::{DirectLight, SolverOptions, direct_interpolation_error};
+use penumbra_scenes::{Rgb, Scene, SplitMix64, Surface, Visibility, builtin};
+use penumbra_solver::{
+    DirectLight, NoProgress, Solution, SolverOptions, direct_interpolation_error,
+    solve_hierarchical,
+};
 
 /// A 4 × 4 floor under a 0.5 × 0.5 light 2 units up, with a tessellated solid between them.
 fn floor_scene(name: &str, solid: Vec<[DVec3; 3]>) -> Scene {
@@ -150,4 +156,121 @@ fn the_reflected_light_error_is_estimated() {
     let furnace = furnace.expect("estimated");
     eprintln!("reflected light's estimated RMS error: Cornell {cornell:.4}, furnace {furnace:.1e}");
     assert!(furnace < 1e-9 && cornell > 1e-3, "{furnace} {cornell}");
+}
+
+/// A 2 × 2 floor that only a ceiling 1.5 above lights: the lamp between them faces up, so all
+/// the floor's light is reflected, and it dims under the lamp.
+fn lit_from_above_by_the_ceiling() -> Scene {
+    let quad = |z: f64, h: f64| {
+        vec![
+            DVec3::new(-h, -h, z),
+            DVec3::new(h, -h, z),
+            DVec3::new(h, h, z),
+            DVec3::new(-h, h, z),
+        ]
+    };
+    let mut ceiling = quad(1.5, 1.0);
+    ceiling.reverse();
+    Scene {
+        name: "lit from above by the ceiling".into(),
+        camera: None,
+        surfaces: vec![
+            Surface::new("floor", quad(0.0, 1.0), Rgb::splat(0.7)),
+            Surface::new("ceiling", ceiling, Rgb::splat(0.7)),
+            Surface::new("lamp", quad(0.6, 0.3), Rgb::ZERO).with_emission(Rgb::splat(10.0)),
+        ],
+    }
+}
+
+/// Error-driven full solutions refine for the light reflected more than once too. A floor lit
+/// only by the ceiling is left by the direct light's refinement much as the starting mesh made
+/// it; refinement for the reflected light splits it where that light bends, and the floor's RMS
+/// error at random points (against the same solver on a uniform mesh of 20,000 triangles)
+/// falls by more than half, below a uniform mesh's of as many triangles. Measured: 1.47 % on
+/// the direct light's mesh of 794 triangles, 0.63 % refined to 1,966, uniform 0.76 % at 1,928.
+/// The default run does the same.
+#[test]
+fn the_reflected_light_is_refined_where_it_bends() {
+    let scene = lit_from_above_by_the_ceiling();
+    let floor = scene.surface_id("floor").expect("a floor");
+    let visibility = Visibility::build(&scene);
+    let options = SolverOptions::default();
+    let solve = |mesh: &SceneMesh| {
+        solve_hierarchical(&scene, mesh, &visibility, &options, &NoProgress).expect("solves")
+    };
+    let fine_mesh = mesh_scene_uniform(&scene, 20_000).expect("meshes");
+    let fine = solve(&fine_mesh);
+    let fine_floor = &fine_mesh.surfaces[floor];
+    let fine_at = TriangleLocator::new(fine_floor);
+    let error = |mesh: &SceneMesh, solution: &Solution| -> f64 {
+        let m = &mesh.surfaces[floor];
+        let at = TriangleLocator::new(m);
+        let mut rng = SplitMix64::new(5);
+        let (mut sum2, mut sum, n) = (0.0, 0.0, 2_000);
+        for _ in 0..n {
+            let p = DVec3::new(2.0 * rng.next_f64() - 1.0, 2.0 * rng.next_f64() - 1.0, 0.0);
+            let truth = fine_at
+                .interpolate(fine_floor, &fine.radiosity[floor], p)
+                .mean();
+            let value = at.interpolate(m, &solution.radiosity[floor], p).mean();
+            (sum2, sum) = (sum2 + (value - truth).powi(2), sum + truth);
+        }
+        (sum2 / n as f64).sqrt() / (sum / n as f64)
+    };
+    let mut start = mesh_scene_uniform(&scene, 600).expect("meshes");
+    let stop = StopWhen {
+        deadline: None,
+        interrupt: None,
+    };
+    refine_by_error(
+        &scene,
+        &visibility,
+        &mut start,
+        1_200,
+        DEFAULT_TOLERANCE,
+        &stop,
+        &NoProgress,
+    );
+    let before = error(&start, &solve(&start));
+    let mut refined = start.clone();
+    let (done, solution) = refine_reflected(
+        &scene,
+        &visibility,
+        &mut refined,
+        2_400,
+        DEFAULT_TOLERANCE,
+        &options,
+        &NoProgress,
+    )
+    .expect("refines");
+    let after = error(&refined, &solution);
+    let uniform_mesh = mesh_scene_uniform(&scene, refined.triangle_count()).expect("meshes");
+    let uniform = error(&uniform_mesh, &solve(&uniform_mesh));
+    eprintln!(
+        "uniform: {:.3} % at {}",
+        100.0 * uniform,
+        uniform_mesh.triangle_count()
+    );
+    eprintln!(
+        "floor: {:.3} % at {} triangles, {:.3} % at {} ({} split in {} rounds)",
+        100.0 * before,
+        start.triangle_count(),
+        100.0 * after,
+        refined.triangle_count(),
+        done.split,
+        done.rounds
+    );
+    assert!(refined.surfaces[floor].triangle_count() > start.surfaces[floor].triangle_count());
+    assert!(2.0 * after < before, "{after} against {before}");
+    assert!(after < uniform, "{after} against uniform {uniform}");
+
+    let options = RunOptions {
+        max_elements: 2_000.into(),
+        ..RunOptions::default()
+    };
+    let report = run_scene(scene.clone(), options)
+        .mesh_error
+        .expect("error-driven");
+    let split = report.reflected_refinement.map_or(0, |r| r.split);
+    assert!(split > 0, "{split}");
 }

@@ -128,26 +128,45 @@ pub fn gathered_estimate(
         .collect()
 }
 
+/// Triangles whose shape quality ([`shape_quality`]) is below this take no part in
+/// [`gradient_jump_estimate`]: the gradient across a sliver is its vertices' noise over its
+/// height. On the Cornell box's error-driven mesh (slivers along the discontinuities) the
+/// estimate of the red wall's reflected light read 74 % RMS with them, where the path tracer
+/// measures 0.6 %.
+pub const SLIVER_QUALITY: f64 = 0.2;
+
+/// 4√3·area over the sum of the squared edges: 1 for an equilateral triangle, 0 for a needle.
+pub fn shape_quality(mesh: &SurfaceMesh, t: usize) -> f64 {
+    let p: [DVec2; 3] = mesh.triangles[t].map(|v| mesh.local[v as usize]);
+    let edges2: f64 = (0..3)
+        .map(|k| (p[k] - p[(k + 1) % 3]).length_squared())
+        .sum();
+    let area = 0.5 * (p[1] - p[0]).perp_dot(p[2] - p[0]).abs();
+    4.0 * 3f64.sqrt() * area / edges2.max(f64::MIN_POSITIVE)
+}
+
 /// Interpolation error of a smooth vertex field, per triangle: the largest jump of its gradient
-/// across the triangle's inner edges, times the edge's length over 8.
+/// across the triangle's inner edges, times the edge's length over 8. Edges of slivers
+/// ([`SLIVER_QUALITY`]) count for neither side.
 pub fn gradient_jump_estimate(mesh: &SurfaceMesh, values: &[f64]) -> Vec<f64> {
     let scale = mesh.scale;
-    let gradients: Vec<DVec2> = mesh
+    let gradients: Vec<Option<DVec2>> = mesh
         .triangles
         .iter()
-        .map(|tri| {
+        .enumerate()
+        .map(|(t, tri)| {
             let [a, b, c] = tri.map(|i| mesh.local[i as usize] * scale);
             let [fa, fb, fc] = tri.map(|i| values[i as usize]);
             let det = (b - a).perp_dot(c - a);
-            if det == 0.0 {
-                return DVec2::ZERO;
+            if det == 0.0 || shape_quality(mesh, t) < SLIVER_QUALITY {
+                return None;
             }
             // Solve g·(b − a) = fb − fa, g·(c − a) = fc − fa.
             let (u, v) = (b - a, c - a);
-            DVec2::new(
+            Some(DVec2::new(
                 ((fb - fa) * v.y - (fc - fa) * u.y) / det,
                 ((fc - fa) * u.x - (fb - fa) * v.x) / det,
-            )
+            ))
         })
         .collect();
     let mut edges: HashMap<(u32, u32), usize> = HashMap::new();
@@ -157,8 +176,11 @@ pub fn gradient_jump_estimate(mesh: &SurfaceMesh, values: &[f64]) -> Vec<f64> {
             let (a, b) = (tri[k], tri[(k + 1) % 3]);
             match edges.remove(&(b, a)) {
                 Some(other) => {
+                    let (Some(g), Some(h)) = (gradients[t], gradients[other]) else {
+                        continue;
+                    };
                     let length = (mesh.local[a as usize] - mesh.local[b as usize]).length() * scale;
-                    let e = (gradients[t] - gradients[other]).length() * length / 8.0;
+                    let e = (g - h).length() * length / 8.0;
                     out[t] = out[t].max(e);
                     out[other] = out[other].max(e);
                 }
