@@ -23,7 +23,7 @@ use std::time::Instant;
 
 use glam::DVec3;
 use penumbra_meshing::{BisectionMesh, SceneMesh, Split, SurfaceMesh};
-use penumbra_scenes::{AreaSampler, Rgb, Scene, SplitMix64, SurfaceId, Visibility};
+use penumbra_scenes::{AreaSampler, Rgb, Scene, SplitMix64, Surface, SurfaceId, Visibility};
 use penumbra_solver::{
     DirectLight, Interrupt, OVERLAY_CAP, Progress, ReceivingPoint, Solution, form_factor,
 };
@@ -447,6 +447,9 @@ impl<'a> Refiner<'a> {
         let area: f64 = self.surfaces.iter().map(|s| s.mesh().area()).sum();
         let element = area / budget.max(1) as f64;
         self.smallest = SMALLEST_SHARE * element;
+        // Once, not per triangle: a scanned statue's scene has tens of thousands of surfaces.
+        let on_emitter = UNOCCLUDED_TOLERANCE * scene.diagonal();
+        let emitters: Vec<&Surface> = scene.emitters().map(|(_, e)| e).collect();
         for (i, s) in self.surfaces.iter_mut().enumerate() {
             // A face the budget would give only a few triangles keeps its least mesh: the
             // faces of a tessellated statue.
@@ -456,7 +459,9 @@ impl<'a> Refiner<'a> {
             }
             for t in 0..s.mesh().triangle_count() {
                 let a = s.mesh().triangle_area(t);
-                let e = PRIOR_RELATIVE_ERROR * s.unoccluded(scene, t) * (a / element).min(1.0);
+                let e = PRIOR_RELATIVE_ERROR
+                    * s.unoccluded(&emitters, t, on_emitter)
+                    * (a / element).min(1.0);
                 s.squared[t] = PRIOR_SQUARED_ERROR * a * e * e;
                 if s.squared[t] > 0.0 {
                     self.queue.push(Entry {
@@ -626,15 +631,14 @@ impl Refined {
     }
 
     /// The light triangle `t` would reflect at its centroid if nothing stood between it and
-    /// the emitters.
-    fn unoccluded(&self, scene: &Scene, t: usize) -> f64 {
+    /// the emitters (points within `tol` of an emitter's edge or plane count as on it).
+    fn unoccluded(&self, emitters: &[&Surface], t: usize, tol: f64) -> f64 {
         let p = self.mesh().triangle_points3(t);
         let x = ReceivingPoint::interior((p[0] + p[1] + p[2]) / 3.0, self.mesh().frame.normal);
-        let tol = UNOCCLUDED_TOLERANCE * scene.diagonal();
-        let h: Rgb = scene
-            .emitters()
-            .filter(|(_, e)| e.normal().dot(x.point - e.polygon[0]) > 0.0)
-            .map(|(_, e)| e.emission * form_factor(&x, &e.polygon, tol))
+        let h: Rgb = emitters
+            .iter()
+            .filter(|e| e.normal().dot(x.point - e.polygon[0]) > 0.0)
+            .map(|e| e.emission * form_factor(&x, &e.polygon, tol))
             .sum();
         self.value(h)
     }

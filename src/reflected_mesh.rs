@@ -83,7 +83,7 @@ pub fn refine_reflected(
             if take == 0 {
                 return Ok(None);
             }
-            let (refined, split) = split_worst(&current, &worst[..take], take);
+            let (refined, split) = split_worst(&current, &worst[..take]);
             if refined.triangle_count() <= budget {
                 break (refined, split);
             }
@@ -195,12 +195,12 @@ impl SurfaceEstimate {
     }
 }
 
-/// `mesh` with up to `most` of the `worst` triangles split (a triangle a split before it cut
-/// down is passed over), and how many were.
-fn split_worst(mesh: &SceneMesh, worst: &[(usize, usize)], most: usize) -> (SceneMesh, usize) {
+/// `mesh` with the `worst` triangles split (a triangle a split before it cut down is passed
+/// over), and how many were.
+fn split_worst(mesh: &SceneMesh, worst: &[(usize, usize)]) -> (SceneMesh, usize) {
     let mut refined = mesh.clone();
     let mut by_surface: Vec<Vec<usize>> = vec![Vec::new(); mesh.surfaces.len()];
-    for &(s, t) in worst.iter().take(most) {
+    for &(s, t) in worst {
         by_surface[s].push(t);
     }
     let mut split = 0;
