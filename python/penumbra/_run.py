@@ -92,7 +92,8 @@ def run(
     The main options: ``mesh`` ``"auto"`` (error-driven: the lines that bound umbrae and
     penumbrae as mesh edges, refined where the exact direct light's measured interpolation
     error is largest, until each surface's RMS error is within ``tol`` of its mean or the
-    budget is spent), ``"uniform"`` or ``"discontinuity"``; ``min_angle`` the smallest angle
+    budget is spent, and in full solutions again where the light reflected more than once
+    bends), ``"uniform"`` or ``"discontinuity"``; ``min_angle`` the smallest angle
     (degrees) their quality refinement aims for (0: none); ``max_elements`` caps the triangles for the
     whole scene (default 25,000 with the hierarchical solver, 10,000 with the others and
     ``direct_only``, or what the scene needs if more); ``solver`` ``"hierarchical"``,

@@ -157,7 +157,10 @@ pub(crate) struct RunArgs {
     pub(crate) mesh: Option<MeshArg>,
     /// Error-driven meshes (the default): split triangles until each surface's RMS error of the
     /// direct light, estimated from the exact light at its triangles' edge midpoints, is within
-    /// this fraction of its mean reflected direct light, or --max-elements is reached.
+    /// this fraction of its mean reflected direct light, or --max-elements is reached; full
+    /// solutions with the hierarchical solver then split again until the light reflected more
+    /// than once (its error estimated from its gradient's jumps) is within it of each surface's
+    /// mean reflected light.
     #[arg(help_heading = MESH, long, default_value_t = penumbra::error_mesh::DEFAULT_TOLERANCE)]
     #[serde(default = "default_tol")]
     pub(crate) tol: f64,
