@@ -30,7 +30,7 @@ use penumbra_solver::{
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::reflected_mesh::ReflectedRefinement;
+use crate::reflected_mesh::{ReflectedRefinement, SurfaceEstimate};
 
 /// The error a run aims for by default: each refined surface's estimated RMS interpolation
 /// error of the direct light, relative to its mean reflected direct light. On the
@@ -172,24 +172,16 @@ impl MeshErrorReport {
         let (mut squared, mut reflected, mut area) = (0.0, 0.0, 0.0);
         for entry in &mut self.surfaces {
             let id = entry.id;
-            let (m, surface) = (&mesh.surfaces[id], &scene.surfaces[id]);
-            let (b, direct) = (&solution.radiosity[id], &solution.direct_irradiance[id]);
-            let indirect: Vec<f64> = (b.iter().zip(direct))
-                .map(|(&b, &d)| (b - surface.emission - surface.reflectance.mul_rgb(d)).mean())
+            let surface = &scene.surfaces[id];
+            let direct: Vec<Rgb> = solution.direct_irradiance[id]
+                .iter()
+                .map(|&h| surface.emission + surface.reflectance.mul_rgb(h))
                 .collect();
-            let jumps = penumbra_solver::estimate::gradient_jump_estimate(m, &indirect);
-            let (mut s2, mut sum, mut a) = (0.0, 0.0, 0.0);
-            for (t, tri) in m.triangles.iter().enumerate() {
-                let at = m.triangle_area(t);
-                let mean = tri
-                    .iter()
-                    .map(|&v| (b[v as usize] - surface.emission).mean())
-                    .sum::<f64>()
-                    / 3.0;
-                (s2, sum, a) = (s2 + at * jumps[t] * jumps[t], sum + at * mean, a + at);
-            }
-            entry.reflected_rms = (sum > 0.0).then(|| (s2 * a).sqrt() / sum);
-            (squared, reflected, area) = (squared + s2, reflected + sum, area + a);
+            let e =
+                SurfaceEstimate::of(scene, &mesh.surfaces[id], &solution.radiosity[id], &direct);
+            let (s2, sum) = (e.squared.iter().sum::<f64>(), e.mean * e.area);
+            entry.reflected_rms = (sum > 0.0).then(|| (s2 * e.area).sqrt() / sum);
+            (squared, reflected, area) = (squared + s2, reflected + sum, area + e.area);
         }
         self.reflected_rms = (reflected > 0.0).then(|| (squared * area).sqrt() / reflected);
     }

@@ -13,7 +13,7 @@
 //! the noise is not chased.
 
 use penumbra_meshing::{BisectionMesh, SceneMesh, Split, SurfaceMesh};
-use penumbra_scenes::{Scene, Visibility};
+use penumbra_scenes::{Rgb, Scene, Visibility};
 use penumbra_solver::estimate::gradient_jump_estimate;
 use penumbra_solver::hierarchical::{Round, solve_hierarchical_refining};
 use penumbra_solver::{Progress, Solution, SolveError, SolverOptions};
@@ -63,8 +63,11 @@ pub fn refine_reflected(
         ..ReflectedRefinement::default()
     };
     let element = reflecting_area(scene, mesh) / budget.max(1) as f64;
-    let mut current = mesh.clone();
+    let first: &SceneMesh = mesh;
+    // The latest round's mesh, once one was refined.
+    let mut latest: Option<SceneMesh> = None;
     let mut next = |round: &Round| -> Result<Option<SceneMesh>, SolveError> {
+        let current = latest.as_ref().unwrap_or(first);
         let room = budget.saturating_sub(current.triangle_count());
         if done.rounds == MAX_ROUNDS
             || options.stop_now().is_some()
@@ -83,7 +86,7 @@ pub fn refine_reflected(
             if take == 0 {
                 return Ok(None);
             }
-            let (refined, split) = split_worst(&current, &worst[..take]);
+            let (refined, split) = split_worst(current, &worst[..take]);
             if refined.triangle_count() <= budget {
                 break (refined, split);
             }
@@ -94,11 +97,11 @@ pub fn refine_reflected(
         }
         done.rounds += 1;
         done.split += split;
-        current = refined.clone();
+        latest = Some(refined.clone());
         Ok(Some(refined))
     };
     let (refined, solution) =
-        solve_hierarchical_refining(scene, mesh, visibility, options, progress, &mut next)?;
+        solve_hierarchical_refining(scene, first, visibility, options, progress, &mut next)?;
     *mesh = refined;
     done.triangles = mesh.triangle_count();
     Ok((done, solution))
@@ -126,7 +129,10 @@ fn worst_triangles(
         .meshes
         .iter()
         .filter(|m| scene.surfaces[m.surface].reflectance.mean() > 0.0)
-        .map(|m| SurfaceEstimate::of(scene, round, m))
+        .map(|m| {
+            let s = m.surface;
+            SurfaceEstimate::of(scene, m, &round.radiosity[s], &round.direct[s])
+        })
         .collect();
     let (light, area) = estimates
         .iter()
@@ -151,21 +157,22 @@ fn worst_triangles(
 }
 
 /// One surface's reflected light and its estimated interpolation error.
-struct SurfaceEstimate {
-    surface: usize,
+pub(crate) struct SurfaceEstimate {
+    pub surface: usize,
     /// The mean of the light it reflects (B − E, channel mean), W/m².
-    mean: f64,
-    area: f64,
+    pub mean: f64,
+    pub area: f64,
     /// Each triangle's squared error of the light reflected more than once, integrated over
-    /// it.
-    squared: Vec<f64>,
+    /// it: its gradient's largest jump across the triangle's edges times the edge's length over
+    /// 8 ([`gradient_jump_estimate`]), squared, times the area.
+    pub squared: Vec<f64>,
 }
 
 impl SurfaceEstimate {
-    fn of(scene: &Scene, round: &Round, m: &SurfaceMesh) -> SurfaceEstimate {
-        let s = m.surface;
-        let emission = scene.surfaces[s].emission;
-        let (b, direct) = (&round.radiosity[s], &round.direct[s]);
+    /// From the radiosity `b` at the vertices of `m` and its direct part `direct`
+    /// (E + ρ H_direct).
+    pub(crate) fn of(scene: &Scene, m: &SurfaceMesh, b: &[Rgb], direct: &[Rgb]) -> Self {
+        let emission = scene.surfaces[m.surface].emission;
         let again: Vec<f64> = b
             .iter()
             .zip(direct)
@@ -187,7 +194,7 @@ impl SurfaceEstimate {
             })
             .collect();
         SurfaceEstimate {
-            surface: s,
+            surface: m.surface,
             mean: sum / area.max(f64::MIN_POSITIVE),
             area,
             squared,

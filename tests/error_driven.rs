@@ -17,16 +17,18 @@ use penumbra_solver::{
     solve_hierarchical,
 };
 
+/// A 2h × 2h square at height `z`, facing up.
+fn quad(z: f64, h: f64) -> Vec<DVec3> {
+    vec![
+        DVec3::new(-h, -h, z),
+        DVec3::new(h, -h, z),
+        DVec3::new(h, h, z),
+        DVec3::new(-h, h, z),
+    ]
+}
+
 /// A 4 × 4 floor under a 0.5 × 0.5 light 2 units up, with a tessellated solid between them.
 fn floor_scene(name: &str, solid: Vec<[DVec3; 3]>) -> Scene {
-    let quad = |z: f64, h: f64| {
-        vec![
-            DVec3::new(-h, -h, z),
-            DVec3::new(h, -h, z),
-            DVec3::new(h, h, z),
-            DVec3::new(-h, h, z),
-        ]
-    };
     let mut light = quad(2.0, 0.25);
     light.reverse();
     let mut surfaces = vec![
@@ -161,14 +163,6 @@ fn the_reflected_light_error_is_estimated() {
 /// A 2 × 2 floor that only a ceiling 1.5 above lights: the lamp between them faces up, so all
 /// the floor's light is reflected, and it dims under the lamp.
 fn lit_from_above_by_the_ceiling() -> Scene {
-    let quad = |z: f64, h: f64| {
-        vec![
-            DVec3::new(-h, -h, z),
-            DVec3::new(h, -h, z),
-            DVec3::new(h, h, z),
-            DVec3::new(-h, h, z),
-        ]
-    };
     let mut ceiling = quad(1.5, 1.0);
     ceiling.reverse();
     Scene {
