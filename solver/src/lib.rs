@@ -107,6 +107,7 @@ mod progress;
 mod progressive;
 mod rays;
 mod shadow_union;
+mod sheet_outline;
 mod solids;
 
 pub use direct::{DirectLight, SEQUENTIAL_SHADOWS};

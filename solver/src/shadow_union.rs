@@ -16,15 +16,13 @@
 //! cancel, and what reaches the overlay is the outline of each connected sheet of faces — its
 //! silhouette from the receiving point — however finely the mesh is tessellated.
 
-use std::collections::HashMap;
-
-use foldhash::fast::FixedState;
 use std::time::Instant;
 
 use clipper2_rust::{ClipType, Clipper64, FillRule, Path64, Paths64, Point64, PolyTree64};
 use glam::DVec2;
 
 use crate::clip::{clip_to_convex, convex_hull_2d};
+use crate::sheet_outline::{Loops, SheetEdge, outlines};
 use penumbra_scenes::polygon::signed_area_2d;
 
 /// Shadows go into one overlay until they have this many edges; the next batch is subtracted
@@ -40,14 +38,6 @@ const FIRST_BATCH_EDGES: usize = 16;
 
 /// A corner of an occluder face, welded: faces that share a point share its key.
 pub(crate) type CornerKey = u32;
-
-/// One directed edge of a projected face, between two corners.
-#[derive(Clone, Copy, Debug)]
-struct SheetEdge {
-    from: CornerKey,
-    to: CornerKey,
-    at: DVec2,
-}
 
 /// The shadows cast on one emitter piece from one receiving point.
 #[derive(Debug, Default)]
@@ -133,7 +123,7 @@ impl ShadowUnion {
         limit: &OverlayLimit,
     ) -> Result<Vec<VisibleShape>, Refusal> {
         let mut shadows: Vec<Shadow> = self.contours.into_iter().map(|c| vec![c]).collect();
-        shadows.extend(outlines(self.sheet, &self.links).ok_or(Refusal::NotFinite)?);
+        shadows.extend(outlines(&self.sheet, &self.links).ok_or(Refusal::NotFinite)?);
         if !bound
             .iter()
             .chain(visible_points(&start))
@@ -181,7 +171,7 @@ pub(crate) fn visible_points(shapes: &[VisibleShape]) -> impl Iterator<Item = &D
 /// One shadow as closed loops whose winding numbers add up to its coverage, never below zero:
 /// a convex shadow, or a connected sheet's outline with its holes (only together are they a
 /// shadow; the outline alone would cover the holes).
-type Shadow = Vec<Vec<DVec2>>;
+type Shadow = Loops;
 
 /// The shadows by area, largest first (ties in their given order).
 fn largest_first(mut shadows: Vec<Shadow>) -> Vec<Shadow> {
@@ -366,129 +356,6 @@ pub(crate) fn cancel_opposite<E: Copy>(
     kept
 }
 
-/// The closed outlines of the sheet's edges once each edge met in both directions cancels
-/// (the winding number of what remains is that of the faces), one shadow per set of faces
-/// connected by edges or `links`. `None` if the edges do not close, which faces of distinct
-/// corners always do.
-fn outlines(edges: Vec<SheetEdge>, links: &[(CornerKey, CornerKey)]) -> Option<Vec<Shadow>> {
-    let mut sheets = Components::with_capacity(edges.len());
-    for e in &edges {
-        sheets.join(e.from, e.to);
-    }
-    for &(a, b) in links {
-        sheets.join(a, b);
-    }
-    let kept = cancel_opposite(edges, |e| (e.from, e.to));
-    // Walk the surviving edges into closed loops: every corner has as many edges in as out.
-    // The edges leaving each corner, in the order of `kept`, and where the next unused one is.
-    let mut by_start: Vec<usize> = (0..kept.len()).collect();
-    by_start.sort_unstable_by_key(|&k| (kept[k].from, k));
-    let mut leaving: HashMap<CornerKey, usize, FixedState> =
-        HashMap::with_capacity_and_hasher(kept.len(), FixedState::default());
-    for (position, &k) in by_start.iter().enumerate().rev() {
-        leaving.insert(kept[k].from, position);
-    }
-    let mut used = vec![false; kept.len()];
-    let mut shadows: Vec<Shadow> = Vec::new();
-    let mut shadow_of_sheet: HashMap<u32, usize, FixedState> = HashMap::default();
-    for start in 0..kept.len() {
-        if used[start] {
-            continue;
-        }
-        used[start] = true;
-        let mut contour = vec![kept[start].at];
-        let mut at = kept[start].to;
-        while at != kept[start].from {
-            let next = leaving.get_mut(&at).and_then(|position| {
-                while let Some(&k) = by_start.get(*position).filter(|&&k| kept[k].from == at) {
-                    *position += 1;
-                    if !used[k] {
-                        return Some(k);
-                    }
-                }
-                None
-            })?;
-            used[next] = true;
-            contour.push(kept[next].at);
-            at = kept[next].to;
-        }
-        let sheet = sheets.find(kept[start].from);
-        let index = *shadow_of_sheet.entry(sheet).or_insert_with(|| {
-            shadows.push(Vec::new());
-            shadows.len() - 1
-        });
-        shadows[index].push(contour);
-    }
-    Some(shadows)
-}
-
-/// Corners joined by edges, as disjoint sets (union by size, path halving).
-struct Components {
-    index: HashMap<CornerKey, u32, FixedState>,
-    parent: Vec<u32>,
-    size: Vec<u32>,
-    last: Option<(CornerKey, u32)>,
-}
-
-impl Components {
-    /// Room for this many edges' corners.
-    fn with_capacity(edges: usize) -> Self {
-        Components {
-            index: HashMap::with_capacity_and_hasher(edges, FixedState::default()),
-            parent: Vec::with_capacity(edges),
-            size: Vec::with_capacity(edges),
-            last: None,
-        }
-    }
-
-    fn slot(&mut self, key: CornerKey) -> u32 {
-        // Edges come in chains (each one's end is the next one's start): look that up once.
-        if let Some((last, slot)) = self.last
-            && last == key
-        {
-            return slot;
-        }
-        let next = self.parent.len() as u32;
-        let slot = *self.index.entry(key).or_insert(next);
-        if slot == next {
-            self.parent.push(next);
-            self.size.push(1);
-        }
-        self.last = Some((key, slot));
-        slot
-    }
-
-    fn root(&mut self, mut i: u32) -> u32 {
-        while self.parent[i as usize] != i {
-            let grand = self.parent[self.parent[i as usize] as usize];
-            self.parent[i as usize] = grand;
-            i = grand;
-        }
-        i
-    }
-
-    fn join(&mut self, a: CornerKey, b: CornerKey) {
-        let a = self.slot(a);
-        let b = self.slot(b);
-        let (a, b) = (self.root(a), self.root(b));
-        if a != b {
-            let (small, large) = if self.size[a as usize] < self.size[b as usize] {
-                (a, b)
-            } else {
-                (b, a)
-            };
-            self.parent[small as usize] = large;
-            self.size[large as usize] += self.size[small as usize];
-        }
-    }
-
-    /// The set of a corner met by [`Self::join`].
-    fn find(&mut self, key: CornerKey) -> u32 {
-        let slot = self.slot(key);
-        self.root(slot)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -527,7 +394,7 @@ mod tests {
     #[test]
     fn a_welded_sheet_fuses_into_its_outline() {
         let union = welded_grid(3, 0.25, |_, _| true);
-        let loops = outlines(union.sheet.clone(), &[]).expect("closes");
+        let loops = outlines(&union.sheet, &[]).expect("closes");
         assert_eq!(loops.len(), 1);
         assert_eq!(loops[0].len(), 1, "one loop");
         assert_eq!(loops[0][0].len(), 12, "the outline's corners");
@@ -561,7 +428,7 @@ mod tests {
     #[test]
     fn a_sheet_with_a_hole_keeps_its_hole() {
         let union = ring();
-        let shadows = outlines(union.sheet.clone(), &[]).expect("closes");
+        let shadows = outlines(&union.sheet, &[]).expect("closes");
         assert_eq!(shadows.len(), 1);
         let mut loops: Vec<usize> = shadows[0].iter().map(Vec::len).collect();
         loops.sort_unstable();
