@@ -34,6 +34,10 @@ const MAX_GROUPS: usize = 8;
 /// each one's centroid lies within this fraction of their distance from the origin of the
 /// other's plane: the rounding of a flat face's tessellation, far below any fold.
 const GROUP_DEVIATION: f64 = 1e-9;
+/// A node of at most this many faces whose cone cannot tell how its faces turn is decided face
+/// by face: a dot product each, far less than projecting them one by one. Near a statue's
+/// silhouette the cones of small nodes straddle the line of sight while every face is clear.
+const EXACT_TURN_FACES: usize = 64;
 /// Consecutive outline edges whose directions differ by less than this sine are one straight
 /// edge: the corners between them lie within this fraction of the run's length of its chord,
 /// the rounding of corners computed along a straight edge (a tessellated face's rim), so the
@@ -130,6 +134,39 @@ pub(crate) struct OccluderTree {
     items: Vec<usize>,
     /// The nodes' sheets and plane groups.
     sheets: Vec<Sheet>,
+    /// Each face's facing normal and the least and greatest of its product with the corners.
+    turns: Vec<FaceTurn>,
+}
+
+/// What decides which way one face turns to a point.
+#[derive(Clone, Copy, Debug)]
+struct FaceTurn {
+    facing: DVec3,
+    low: f64,
+    high: f64,
+}
+
+impl FaceTurn {
+    fn of(face: &TreeFace) -> FaceTurn {
+        let heights = face.polygon.iter().map(|&p| face.facing.dot(p));
+        FaceTurn {
+            facing: face.facing,
+            low: heights.clone().fold(f64::INFINITY, f64::min),
+            high: heights.fold(f64::NEG_INFINITY, f64::max),
+        }
+    }
+
+    /// As [`Sheet::turns_away`], for this face alone.
+    fn turns_away(&self, point: DVec3, margin: f64) -> Option<bool> {
+        let along = self.facing.dot(point);
+        if along - self.high > margin {
+            Some(false)
+        } else if self.low - along > margin {
+            Some(true)
+        } else {
+            None
+        }
+    }
 }
 
 impl OccluderTree {
@@ -138,6 +175,7 @@ impl OccluderTree {
             nodes: Vec::new(),
             items: (0..faces.len()).collect(),
             sheets: Vec::new(),
+            turns: faces.iter().map(FaceTurn::of).collect(),
         };
         if !faces.is_empty() {
             let centroids: Vec<DVec3> = faces
@@ -231,6 +269,16 @@ impl OccluderTree {
         }
     }
 
+    /// Whether every face of sheet `sheet` turns away from `point` by more than `margin`
+    /// (`Some(true)`), every one towards it (`Some(false)`), or neither.
+    fn faces_turn_away(&self, sheet: usize, point: DVec3, margin: f64) -> Option<bool> {
+        let mut faces = self.faces_of(sheet).iter();
+        let first = self.turns[*faces.next()?].turns_away(point, margin)?;
+        faces
+            .all(|&i| self.turns[i].turns_away(point, margin) == Some(first))
+            .then_some(first)
+    }
+
     /// The outline of sheet `sheet`.
     pub(crate) fn outline(&self, sheet: usize) -> &[OutlineEdge] {
         &self.sheets[sheet].outline
@@ -265,6 +313,16 @@ impl OccluderTree {
                 .clone()
                 .map(|s| self.sheets[s].turns_away(shaft.point, shaft.margin))
                 .collect();
+            let turns = turns.or_else(|| {
+                (node.end - node.start <= EXACT_TURN_FACES)
+                    .then(|| {
+                        sheets
+                            .clone()
+                            .map(|s| self.faces_turn_away(s, shaft.point, shaft.margin))
+                            .collect()
+                    })
+                    .flatten()
+            });
             if let Some(turns) = turns.filter(|t| !t.is_empty()) {
                 for (s, away) in sheets.zip(turns) {
                     if !(away && self.sheets[s].closed) {
@@ -674,5 +732,69 @@ mod tests {
         // A shaft leaning to x > 20 misses the sheet altogether.
         let (loose, outlines) = walk(&tree, DVec3::new(20.0, 0.0, 0.0), &[DVec3::X]);
         assert!(loose.is_empty() && outlines.is_empty());
+    }
+
+    /// A finely tessellated bowl (the lower half of a sphere, faces turned to its centre) seen
+    /// from a point inside it close to its bottom: the cones of the nodes near the point cannot
+    /// tell which way their faces turn, yet every face turns towards the point (it lies inside
+    /// a convex shape), and small nodes are decided face by face as outlines.
+    #[test]
+    fn small_nodes_the_cone_cannot_decide_are_decided_face_by_face() {
+        let (center, radius) = (DVec3::new(0.0, 0.0, 5.0), 2.0);
+        let (rings, around) = (16u32, 32u32);
+        let key = |i: u32, j: u32| {
+            if i == 0 {
+                0
+            } else {
+                1 + (i - 1) * around + j % around
+            }
+        };
+        let corner = |i: u32, j: u32| {
+            let (polar, azimuth) = (
+                f64::from(i) / f64::from(rings) * std::f64::consts::FRAC_PI_2,
+                f64::from(j % around) / f64::from(around) * 2.0 * PI,
+            );
+            center
+                + radius
+                    * DVec3::new(
+                        polar.sin() * azimuth.cos(),
+                        polar.sin() * azimuth.sin(),
+                        -polar.cos(),
+                    )
+        };
+        let (mut polygons, mut keys) = (Vec::new(), Vec::new());
+        for i in 0..rings {
+            for j in 0..around {
+                let mut triangles = vec![[(i + 1, j), (i + 1, j + 1), (i, j)]];
+                if i > 0 {
+                    triangles.push([(i, j), (i + 1, j + 1), (i, j + 1)]);
+                }
+                for t in triangles {
+                    polygons.push(t.iter().map(|&(a, b)| corner(a, b)).collect::<Vec<_>>());
+                    keys.push(t.iter().map(|&(a, b)| key(a, b)).collect::<Vec<_>>());
+                }
+            }
+        }
+        let faces: Vec<TreeFace> = polygons
+            .iter()
+            .zip(&keys)
+            .map(|(polygon, keys)| {
+                let normal = newell_normal(polygon).normalize();
+                let inward = (center - polygon[0]).dot(normal).signum();
+                TreeFace {
+                    polygon,
+                    keys,
+                    facing: normal * inward,
+                    closed: false,
+                }
+            })
+            .collect();
+        let tree = OccluderTree::build(&faces);
+        let point = center - DVec3::new(0.05, 0.0, 0.95 * radius);
+        let (loose, outlines) = walk(&tree, point, &[]);
+        assert!(loose.is_empty(), "{} faces on their own", loose.len());
+        assert!(outlines.iter().all(|&(_, reversed)| !reversed));
+        let covered: usize = outlines.iter().map(|&(s, _)| tree.faces_of(s).len()).sum();
+        assert_eq!(covered, faces.len());
     }
 }
