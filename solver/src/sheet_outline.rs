@@ -54,20 +54,26 @@ struct Pair {
     next: u32,
 }
 
-/// Per-corner tables, valid for a corner whose stamp is the current pass.
+/// What a pass knows of one corner, valid while its stamp is the pass's.
+#[derive(Clone, Copy, Debug, Default)]
+struct Corner {
+    stamp: u32,
+    /// Disjoint sets of corners (union by size, path halving), by corner key.
+    parent: u32,
+    size: u32,
+    /// The first pair whose smaller corner this is.
+    pairs: u32,
+    /// The next kept edge leaving this corner not taken yet.
+    leaving: u32,
+    /// The shadow of the set this corner is the root of.
+    shadow: u32,
+}
+
+/// Per-corner entries (one cache line holds a corner's), and the pairs met in this pass.
 #[derive(Debug, Default)]
 struct Tables {
     pass: u32,
-    stamp: Vec<u32>,
-    /// Disjoint sets of corners (union by size, path halving), by corner key.
-    parent: Vec<u32>,
-    size: Vec<u32>,
-    /// The first pair whose smaller corner this is.
-    pairs: Vec<u32>,
-    /// The next kept edge leaving this corner not taken yet.
-    leaving: Vec<u32>,
-    /// The shadow of the set this corner is the root of.
-    shadow: Vec<u32>,
+    corners: Vec<Corner>,
     records: Vec<Pair>,
 }
 
@@ -89,7 +95,7 @@ impl Tables {
         // The edges leaving each corner, in the order of `kept`.
         let mut next = vec![NONE; kept.len()];
         for (k, e) in kept.iter().enumerate().rev() {
-            let head = &mut self.leaving[e.from as usize];
+            let head = &mut self.corners[e.from as usize].leaving;
             next[k] = *head;
             *head = k as u32;
         }
@@ -109,11 +115,12 @@ impl Tables {
                 at = kept[k].to;
             }
             let root = self.root(kept[start].from) as usize;
-            if self.shadow[root] == NONE {
-                self.shadow[root] = shadows.len() as u32;
+            let root = &mut self.corners[root];
+            if root.shadow == NONE {
+                root.shadow = shadows.len() as u32;
                 shadows.push(Vec::new());
             }
-            shadows[self.shadow[root] as usize].push(contour);
+            shadows[root.shadow as usize].push(contour);
         }
         Some(shadows)
     }
@@ -122,7 +129,7 @@ impl Tables {
     fn begin(&mut self) {
         self.pass = self.pass.wrapping_add(1);
         if self.pass == 0 {
-            self.stamp.fill(0);
+            self.corners.iter_mut().for_each(|c| c.stamp = 0);
             self.pass = 1;
         }
         self.records.clear();
@@ -131,35 +138,29 @@ impl Tables {
     /// The corner's slot, fresh in this pass.
     fn touch(&mut self, corner: CornerKey) -> usize {
         let i = corner as usize;
-        if i >= self.stamp.len() {
-            let n = (i + 1).next_power_of_two();
-            self.stamp.resize(n, 0);
-            for table in [
-                &mut self.parent,
-                &mut self.size,
-                &mut self.pairs,
-                &mut self.leaving,
-                &mut self.shadow,
-            ] {
-                table.resize(n, NONE);
-            }
+        if i >= self.corners.len() {
+            self.corners
+                .resize((i + 1).next_power_of_two(), Corner::default());
         }
-        if self.stamp[i] != self.pass {
-            self.stamp[i] = self.pass;
-            self.parent[i] = corner;
-            self.size[i] = 1;
-            self.pairs[i] = NONE;
-            self.leaving[i] = NONE;
-            self.shadow[i] = NONE;
+        let c = &mut self.corners[i];
+        if c.stamp != self.pass {
+            *c = Corner {
+                stamp: self.pass,
+                parent: corner,
+                size: 1,
+                pairs: NONE,
+                leaving: NONE,
+                shadow: NONE,
+            };
         }
         i
     }
 
     fn root(&mut self, corner: CornerKey) -> u32 {
         let mut i = corner;
-        while self.parent[i as usize] != i {
-            let grand = self.parent[self.parent[i as usize] as usize];
-            self.parent[i as usize] = grand;
+        while self.corners[i as usize].parent != i {
+            let grand = self.corners[self.corners[i as usize].parent as usize].parent;
+            self.corners[i as usize].parent = grand;
             i = grand;
         }
         i
@@ -170,13 +171,13 @@ impl Tables {
         self.touch(b);
         let (a, b) = (self.root(a) as usize, self.root(b) as usize);
         if a != b {
-            let (small, large) = if self.size[a] < self.size[b] {
+            let (small, large) = if self.corners[a].size < self.corners[b].size {
                 (a, b)
             } else {
                 (b, a)
             };
-            self.parent[small] = large as u32;
-            self.size[large] += self.size[small];
+            self.corners[small].parent = large as u32;
+            self.corners[large].size += self.corners[small].size;
         }
     }
 
@@ -188,7 +189,7 @@ impl Tables {
         } else {
             (e.to, e.from)
         };
-        let mut r = self.pairs[low as usize];
+        let mut r = self.corners[low as usize].pairs;
         while r != NONE && self.records[r as usize].high != high {
             r = self.records[r as usize].next;
         }
@@ -200,9 +201,9 @@ impl Tables {
                 net: 0,
                 forward_at: DVec2::ZERO,
                 backward_at: DVec2::ZERO,
-                next: self.pairs[low as usize],
+                next: self.corners[low as usize].pairs,
             });
-            self.pairs[low as usize] = r;
+            self.corners[low as usize].pairs = r;
         }
         let pair = &mut self.records[r as usize];
         if forward {
@@ -239,15 +240,13 @@ impl Tables {
     /// The first kept edge leaving `corner` not used yet, or `None` when every one is.
     fn take(&mut self, corner: CornerKey, next: &[u32], used: &[bool]) -> Option<usize> {
         let i = corner as usize;
-        if i >= self.stamp.len() || self.stamp[i] != self.pass {
-            return None;
-        }
+        let c = self.corners.get_mut(i).filter(|c| c.stamp == self.pass)?;
         loop {
-            let k = self.leaving[i];
+            let k = c.leaving;
             if k == NONE {
                 return None;
             }
-            self.leaving[i] = next[k as usize];
+            c.leaving = next[k as usize];
             if !used[k as usize] {
                 return Some(k as usize);
             }
