@@ -109,6 +109,20 @@ pub(crate) fn edge_term(x: &ReceivingPoint, a: DVec3, b: DVec3, tol: f64) -> f64
 /// their sum, the form factor is integrated directly instead ([`quadrature_sum`]), where the
 /// cosines are computed from the coordinates and keep all their digits.
 pub(crate) fn contour_sum(x: &ReceivingPoint, polygon: &[DVec3], tol: f64) -> f64 {
+    let (sum, magnitude) = edge_terms(x, polygon, tol);
+    if magnitude > CANCELLATION_LIMIT * sum.abs() && far_from(x.point, polygon) {
+        return quadrature_sum(x, polygon);
+    }
+    sum
+}
+
+/// The sum of the edge terms, however many digits it cancels.
+fn edge_sum(x: &ReceivingPoint, polygon: &[DVec3], tol: f64) -> f64 {
+    edge_terms(x, polygon, tol).0
+}
+
+/// The sum of the edge terms and the sum of their magnitudes.
+fn edge_terms(x: &ReceivingPoint, polygon: &[DVec3], tol: f64) -> (f64, f64) {
     let n = polygon.len();
     let (mut sum, mut magnitude) = (0.0, 0.0);
     for i in 0..n {
@@ -116,10 +130,7 @@ pub(crate) fn contour_sum(x: &ReceivingPoint, polygon: &[DVec3], tol: f64) -> f6
         sum += t;
         magnitude += t.abs();
     }
-    if magnitude > CANCELLATION_LIMIT * sum.abs() && far_from(x.point, polygon) {
-        return quadrature_sum(x, polygon);
-    }
-    sum
+    (sum, magnitude)
 }
 
 /// Whether the polygon is further from `x` than twice its diameter: far enough for a few levels
@@ -201,21 +212,39 @@ fn triangle_integral(kernel: &impl Fn(DVec3) -> f64, x: DVec3, t: [DVec3; 3], de
 }
 
 /// The form factor from the point to a planar polygon, unoccluded: the polygon is clipped to the
-/// point's tangent half-space, then Lambert's formula applies.
+/// point's tangent half-space, then Lambert's formula applies. Exact to rounding relative to the
+/// form factor itself, however grazing the view ([`contour_sum`]).
 pub fn form_factor(x: &ReceivingPoint, polygon: &[DVec3], tol: f64) -> f64 {
+    clipped_factor(x, polygon, tol, contour_sum)
+}
+
+/// As [`form_factor`], exact to rounding relative to the angle the polygon subtends rather than
+/// to the form factor: what a sum over many sources needs, where a grazing polygon's form factor
+/// is far below the rounding of the others. It skips the quadrature that keeps such a form
+/// factor's own digits, which costs thousands of kernel evaluations.
+pub(crate) fn form_factor_in_sum(x: &ReceivingPoint, polygon: &[DVec3], tol: f64) -> f64 {
+    clipped_factor(x, polygon, tol, edge_sum)
+}
+
+fn clipped_factor(
+    x: &ReceivingPoint,
+    polygon: &[DVec3],
+    tol: f64,
+    sum: fn(&ReceivingPoint, &[DVec3], f64) -> f64,
+) -> f64 {
     let heights: Vec<f64> = polygon.iter().map(|&p| x.height(p, tol)).collect();
     // Behind, or in the tangent plane itself (seen edge-on): nothing.
     if heights.iter().all(|&h| h <= 0.0) {
         return 0.0;
     }
     if heights.iter().all(|&h| h >= 0.0) {
-        return contour_sum(x, polygon, tol).abs() / (2.0 * PI);
+        return sum(x, polygon, tol).abs() / (2.0 * PI);
     }
     let clipped = clip_polygon_3d(polygon, |p| x.height(p, tol));
     if clipped.len() < 3 {
         return 0.0;
     }
-    contour_sum(x, &clipped, tol).abs() / (2.0 * PI)
+    sum(x, &clipped, tol).abs() / (2.0 * PI)
 }
 
 #[cfg(test)]
@@ -251,6 +280,33 @@ mod tests {
             let rect = [v(0., 0., c), v(a, 0., c), v(a, b, c), v(0., b, c)];
             close(form_factor(&up_at(DVec3::ZERO), &rect, 1e-12), f, 1e-9);
         }
+    }
+
+    /// A unit square 10⁻⁵ above the point's tangent plane, 6 units away, parallel to it: its edge
+    /// terms are about a sixth and cancel to 10⁻¹⁴. The form factor keeps its own digits (the
+    /// point-to-point kernel h² A / (π r⁴), to the square's size over its distance squared);
+    /// the one for sums keeps the digits of the angle (10⁻¹⁶ absolute), and is the same value
+    /// where nothing cancels.
+    #[test]
+    fn a_grazing_polygon_keeps_its_digits_only_where_they_matter() {
+        let h = 1e-5;
+        let square = [
+            v(5.5, -0.5, h),
+            v(6.5, -0.5, h),
+            v(6.5, 0.5, h),
+            v(5.5, 0.5, h),
+        ];
+        let x = up_at(DVec3::ZERO);
+        let kernel = h * h / (PI * 6f64.powi(4));
+        let exact = form_factor(&x, &square, 1e-12);
+        close(exact, kernel, 0.05);
+        let in_sum = form_factor_in_sum(&x, &square, 1e-12);
+        assert!((in_sum - exact).abs() < 1e-16, "{in_sum:e} vs {exact:e}");
+        let facing = [v(0., 0., 1.), v(1., 0., 1.), v(1., 1., 1.), v(0., 1., 1.)];
+        assert_eq!(
+            form_factor_in_sum(&x, &facing, 1e-12),
+            form_factor(&x, &facing, 1e-12)
+        );
     }
 
     /// `docs/closed-forms.md`, "Rectangles by superposition": differential area to a perpendicular

@@ -16,7 +16,7 @@ use glam::DVec3;
 use penumbra_scenes::Rgb;
 
 use super::tree::{Hierarchy, Node};
-use crate::lambert::{ReceivingPoint, form_factor};
+use crate::lambert::{ReceivingPoint, form_factor_in_sum};
 
 /// Light per axis direction: +x, −x, +y, −y, +z, −z.
 pub(crate) type Axes = [Rgb; 6];
@@ -141,7 +141,7 @@ pub(crate) fn leaf_factor(x: &ReceivingPoint, t: &[DVec3; 3], normal: DVec3, tol
             return 0.0;
         }
     }
-    form_factor(x, t, tol)
+    form_factor_in_sum(x, t, tol)
 }
 
 /// Barycentric coordinates of the point of triangle `t` nearest to `p`.
