@@ -11,8 +11,8 @@
 //!
 //! Faces are oriented by their *facing normal*: outward for faces of closed solids, else as
 //! listed. Whether a node turns towards the point is decided conservatively from a cone holding
-//! its facing normals and a sphere holding its corners; faces of an undecided node are visited
-//! one by one.
+//! its facing normals and a sphere holding its corners, and for a small node the cone cannot
+//! decide, face by face; faces of a node that turns both ways are visited one by one.
 
 use std::f64::consts::PI;
 
