@@ -185,10 +185,9 @@ impl From<SolveError> for InvalidOption {
 }
 
 impl RunOptions {
-    /// Whether the mesh is error-driven ([`MeshMethod::Auto`] without adaptive refinement or a
-    /// shard).
+    /// Whether the mesh is error-driven ([`MeshMethod::Auto`] without adaptive refinement).
     pub fn error_driven(&self) -> bool {
-        self.mesh == MeshMethod::Auto && self.refine.is_none() && self.shard.is_none()
+        self.mesh == MeshMethod::Auto && self.refine.is_none()
     }
 
     /// Checks every option's range and that the options go together. [`crate::run`] calls it

@@ -5,12 +5,14 @@
 //! `N`, so that each surface's mesh and values are those of the run not split, to the bit:
 //!
 //! - a large scene (its polygons alone need more triangles than the fitted budget's floor;
-//!   [`meshed_alone`]): the shard finds the discontinuities of its own surfaces and meshes them
+//!   [`meshed_alone`]) meshed by discontinuities (`--mesh discontinuity`): the shard finds the discontinuities of its own surfaces and meshes them
 //!   alone, since each surface's share of the budget depends on nothing but the surface and the
 //!   scene's polygons; the other surfaces get empty meshes;
-//! - otherwise (a budget chosen with `--max-elements`, or a scene within the floor) the budget
-//!   is spread over all surfaces, and each one's share depends on every surface's least mesh, so
-//!   every shard finds the discontinuities of the whole scene and meshes every surface;
+//! - otherwise (an error-driven mesh, the default, a budget chosen with `--max-elements`, or a
+//!   scene within the floor) the budget is spread over all surfaces, and each one's share depends
+//!   on every surface (an error-driven mesh splits the worst triangles of the whole scene first),
+//!   so every shard finds the discontinuities of the whole scene and meshes every surface, and
+//!   splits only the direct light at the vertices it did not measure while meshing;
 //! - the direct light at a vertex is the same whichever other surfaces have a vertex at its
 //!   point: the faces meeting there share one view of the light, taken from the point they round
 //!   to ([`penumbra_solver::DirectLight::irradiance_group`]).
@@ -142,10 +144,12 @@ impl Shard {
 /// Whether a shard of a run with these options finds the discontinuities of its own surfaces and
 /// meshes them alone: a fitted budget of a scene whose polygons need more than the budget's
 /// floor ([`penumbra_meshing::ElementBudget::shared_extra`]) gives each surface a share that
-/// depends on nothing else. Otherwise each shard meshes the whole scene, as the run not split
-/// does.
+/// depends on nothing else, unless the mesh is error-driven. Otherwise each shard meshes the
+/// whole scene, as the run not split does.
 pub fn meshed_alone(scene: &Scene, options: &RunOptions) -> bool {
+    // An error-driven mesh spends one budget over all surfaces through one queue.
     options.refine.is_none()
+        && !options.error_driven()
         && options
             .max_elements
             .shared_extra(polygon_minimum(scene), scene.surfaces.len())
@@ -346,23 +350,6 @@ pub enum MergeError {
         /// What differs, in words (`"their options"`).
         what: &'static str,
     },
-    /// Two shards of a run whose mesh the scene chose (`auto`) chose differently.
-    #[error(
-        "{} meshed its surfaces by {mesh} but {} by {first_mesh}: when the mesh is chosen by the \
-         scene, a shard whose surfaces have no discontinuities meshes them uniformly, unlike the \
-         run not split; mesh every shard by discontinuity",
-        .dir.display(), .first.display()
-    )]
-    MeshChoice {
-        /// The first shard's directory.
-        first: PathBuf,
-        /// The directory of the shard that differs from it.
-        dir: PathBuf,
-        /// The first shard's mesh: `discontinuity` or `uniform`.
-        first_mesh: String,
-        /// The other shard's mesh.
-        mesh: String,
-    },
     /// A shard is given twice.
     #[error("shard {shard} is given twice: {} and {}", .first.display(), .second.display())]
     Duplicate {
@@ -481,21 +468,6 @@ pub fn check_shards(
         }
         if file.shard.count != first.shard.count {
             return Err(mixed("their shard counts"));
-        }
-        let mesh = |f: &ShardFile| {
-            f.report
-                .pointer("/method/mesh")
-                .and_then(serde_json::Value::as_str)
-                .unwrap_or_default()
-                .to_owned()
-        };
-        if mesh(file) != mesh(first) {
-            return Err(MergeError::MeshChoice {
-                first: first_dir.clone(),
-                dir: dir.clone(),
-                first_mesh: mesh(first),
-                mesh: mesh(file),
-            });
         }
     }
     let count = first.shard.count;

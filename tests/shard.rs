@@ -41,11 +41,6 @@ fn run(scene: &str, out: &Path, extra: &[&str]) {
         path(out),
     ];
     args.extend(budget);
-    // `--mesh auto` makes a shard's mesh by discontinuities (an error-driven mesh spreads one
-    // queue over all the surfaces), so a whole run compared with shards asks for that mesh.
-    if !extra.contains(&"--shard") && !extra.contains(&"--mesh") {
-        args.extend(["--mesh", "discontinuity"]);
-    }
     args.extend(extra.iter().filter(|&&a| a != "--fit"));
     succeeds(&args);
 }
@@ -94,7 +89,9 @@ fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
 }
 
 /// `--fit`: the default budget, fitted to the scene: `boxworld-1000`'s polygons need more than
-/// its floor, so each shard finds the discontinuities of its own surfaces and meshes them alone.
+/// its floor, so with a discontinuity mesh each shard finds the discontinuities of its own
+/// surfaces and meshes them alone. The others are error-driven (the default): every shard makes
+/// the whole mesh.
 #[test]
 fn shards_merge_into_the_run_not_split_byte_for_byte() {
     let dir = tempfile::tempdir().expect("temp dir");
@@ -104,7 +101,7 @@ fn shards_merge_into_the_run_not_split_byte_for_byte() {
         ("textbook", &["--camera", "0.2,0.3,5:0.2,0.3,0:60"]),
         ("boxworld-12", &[]),
         ("tessellated-2", &[]),
-        ("boxworld-1000", &["--fit"]),
+        ("boxworld-1000", &["--fit", "--mesh", "discontinuity"]),
     ];
     for (scene, extra) in cases {
         let whole = dir.path().join(format!("{scene}-whole"));
@@ -232,23 +229,6 @@ fn merge_refuses_missing_duplicate_and_mixed_shards() {
     run("textbook", &whole, &[]);
     refused(&["merge", "--out", out_s, path(&whole)], &["shard.json"]);
     refused(&["merge", "--out", out_s], &["DIRS"]);
-    // Shards that meshed alone, where `--mesh auto` chose differently: boxworld-1000's light
-    // (surface 0) receives no discontinuities, its floor (surface 1) does.
-    let alone: Vec<PathBuf> = (0..2)
-        .map(|i| {
-            let d = dir.path().join(format!("alone-{i}"));
-            run(
-                "boxworld-1000",
-                &d,
-                &["--fit", "--shard", &format!("{i}/5002")],
-            );
-            d
-        })
-        .collect();
-    refused(
-        &["merge", "--out", out_s, path(&alone[0]), path(&alone[1])],
-        &["by discontinuity but", "with --mesh discontinuity"],
-    );
     assert!(!out.exists(), "nothing written");
 }
 

@@ -30,9 +30,7 @@ pub(crate) struct MergeArgs {
 pub(crate) fn merge(args: &MergeArgs) -> Result<(), Failure> {
     use penumbra::shard::{MergeError, check_shards, merge, read_shard, write_merged};
     let fail = |e: MergeError| {
-        if let MergeError::MeshChoice { .. } = e {
-            usage(anyhow::anyhow!("{e} (run it with --mesh discontinuity)"))
-        } else if e.is_usage() {
+        if e.is_usage() {
             usage(e)
         } else {
             Failure::from(e)

@@ -151,8 +151,8 @@ pub(crate) struct RunArgs {
     pub(crate) no_merge: bool,
     /// How surfaces are meshed (default: error-driven, along the umbra and penumbra boundaries
     /// and contact lines, refined where the interpolation of the exact direct light is
-    /// measured worst, up to --max-elements or --tol; with --refine-tol or --shard,
-    /// discontinuity where the scene casts shadows, else uniform).
+    /// measured worst, up to --max-elements or --tol; with --refine-tol, discontinuity where
+    /// the scene casts shadows, else uniform).
     #[arg(help_heading = MESH, long, value_enum)]
     pub(crate) mesh: Option<MeshArg>,
     /// Error-driven meshes (the default): split triangles until each surface's RMS error of the
