@@ -16,47 +16,10 @@ use crate::elements::{Discretization, Patch};
 use crate::error::SolveError;
 use crate::hemicube::{Hemicube, OCCLUDER};
 use crate::lambert::{ReceivingPoint, edge_term, form_factor};
+pub use crate::options::FormFactorMethod;
+use crate::progress::Interrupt;
 use crate::progress::Progress;
-use crate::progressive::Interrupt;
 use penumbra_scenes::SplitMix64;
-
-/// How point-to-patch form factors are computed.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum FormFactorMethod {
-    /// Lambert's formula over the patch, exact, times a visibility fraction from rays.
-    #[default]
-    Analytic,
-    /// Monte Carlo over the patch's area: cos cos / (π r²) at stratified points, each seen or
-    /// not by a ray; unbiased, with an error that falls as one over the square root of samples.
-    MonteCarlo {
-        /// Sample points per point–patch pair.
-        samples: usize,
-    },
-    /// A hemicube of `resolution` pixels across at each receiver: every patch's form factor
-    /// from that point at once, occlusion by z-buffer (see [`crate::hemicube`]).
-    Hemicube {
-        /// Pixels across the top face.
-        resolution: usize,
-    },
-}
-
-impl FormFactorMethod {
-    /// The method's name on the command line and in reports.
-    pub fn name(self) -> &'static str {
-        match self {
-            FormFactorMethod::Analytic => "analytic",
-            FormFactorMethod::MonteCarlo { .. } => "monte-carlo",
-            FormFactorMethod::Hemicube { .. } => "hemicube",
-        }
-    }
-
-    /// Whether the method gives a receiver's form factors to all patches at once (a row), not
-    /// one point–patch pair at a time.
-    pub fn by_rows(self) -> bool {
-        matches!(self, FormFactorMethod::Hemicube { .. })
-    }
-}
 
 /// Form factors from points to patches: Lambert's formula times a visibility fraction, or Monte
 /// Carlo over the patch.
@@ -244,7 +207,7 @@ impl<'a> PatchCoupling<'a> {
     pub fn new(
         disc: &'a Discretization,
         visibility: &'a Visibility,
-        options: &crate::progressive::SolverOptions,
+        options: &crate::options::SolverOptions,
     ) -> PatchCoupling<'a> {
         PatchCoupling {
             disc,

@@ -21,12 +21,12 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::coupling::PatchCoupling;
+use crate::direct_pass::direct_irradiance;
 use crate::elements::Discretization;
 use crate::error::SolveError;
+use crate::options::SolverOptions;
 use crate::progress::Progress;
-use crate::progressive::{
-    ConvergencePoint, Solution, SolveStats, SolverOptions, StopReason, direct_irradiance,
-};
+use crate::solution::{ConvergencePoint, Solution, SolveStats, StopReason};
 
 /// How the discrete system is solved.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]

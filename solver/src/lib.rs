@@ -92,6 +92,7 @@
 mod clip;
 pub mod coupling;
 mod direct;
+mod direct_pass;
 mod elements;
 mod error;
 pub mod estimate;
@@ -101,6 +102,7 @@ pub mod hierarchical;
 mod lambert;
 mod measure;
 mod occluder_tree;
+mod options;
 pub mod path_trace;
 pub mod photon_map;
 mod progress;
@@ -109,16 +111,17 @@ mod rays;
 mod shadow_union;
 mod sheet_outline;
 mod solids;
+mod solution;
 
 pub use direct::{DirectLight, SEQUENTIAL_SHADOWS};
+pub use direct_pass::{OVERLAY_CAP, SHARED_POINT};
 pub use elements::{Discretization, Element, Patch};
 pub use error::SolveError;
 pub use gathering::{PatchSystem, SolverMethod, SystemSolution, solve_gathering};
 pub use hierarchical::solve_hierarchical;
 pub use lambert::{ReceivingPoint, form_factor};
 pub use measure::{InterpolationError, direct_interpolation_error};
+pub use options::{DEFAULT_EPSILON, SolverOptions};
 pub use progress::{Interrupt, NoProgress, Progress};
-pub use progressive::{
-    ConvergencePoint, DEFAULT_EPSILON, OVERLAY_CAP, ProgressiveSolver, SHARED_POINT, Solution,
-    SolveStats, SolverOptions, StopReason, ambient_term, solve_direct_on, solve_progressive,
-};
+pub use progressive::{ProgressiveSolver, solve_direct_on, solve_progressive};
+pub use solution::{ConvergencePoint, Solution, SolveStats, StopReason, ambient_term};

@@ -22,6 +22,7 @@ use clipper2_rust::{ClipType, Clipper64, FillRule, Path64, Paths64, Point64, Pol
 use glam::DVec2;
 
 use crate::clip::{clip_to_convex, convex_hull_2d};
+pub(crate) use crate::sheet_outline::CornerKey;
 use crate::sheet_outline::{Loops, SheetEdge, outlines};
 use penumbra_scenes::polygon::signed_area_2d;
 
@@ -36,8 +37,6 @@ const BATCH_EDGES: usize = 1024;
 /// drop out before they reach an overlay.
 const FIRST_BATCH_EDGES: usize = 16;
 
-/// A corner of an occluder face, welded: faces that share a point share its key.
-pub(crate) type CornerKey = u32;
 
 /// The shadows cast on one emitter piece from one receiving point.
 #[derive(Debug, Default)]

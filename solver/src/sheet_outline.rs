@@ -10,7 +10,8 @@ use std::cell::RefCell;
 
 use glam::DVec2;
 
-use crate::shadow_union::CornerKey;
+/// A corner of an occluder face, welded: faces that share a point share its key.
+pub(crate) type CornerKey = u32;
 
 /// One directed edge of a projected face, between two corners, with the first one's projection.
 #[derive(Clone, Copy, Debug)]

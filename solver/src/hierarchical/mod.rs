@@ -35,27 +35,22 @@ use std::time::Instant;
 use penumbra_meshing::{SceneMesh, SurfaceMesh, TriangleLocator};
 use penumbra_scenes::{Rgb, Scene, Visibility};
 use rayon::prelude::*;
-use serde::Serialize;
 
 use crate::direct::DirectLight;
+use crate::direct_pass::{OVERLAY_CAP, check_mesh, direct_at_new, direct_irradiance};
 use crate::elements::Discretization;
 use crate::error::SolveError;
+pub use crate::options::DEFAULT_LINK_TOL;
+use crate::options::SolverOptions;
 use crate::progress::Progress;
-use crate::progressive::{
-    ConvergencePoint, OVERLAY_CAP, Solution, SolveStats, SolverOptions, StopReason, check_mesh,
-    direct_at_new, direct_irradiance,
-};
 use crate::solids::Enclosures;
+pub use crate::solution::HierarchyStats;
+use crate::solution::{ConvergencePoint, Solution, SolveStats, StopReason};
 use final_gather::{FinalGather, Gathered};
 use iterate::{Field, System};
 use links::{Link, RefineCounts, Refiner};
 use shaft::Shafts;
 use tree::{Hierarchy, NONE};
-
-/// The light a link may carry wrongly by default, as a fraction of the light the surfaces reflect
-/// of the direct light (the light the hierarchy carries in the first place: measured against the
-/// emitted power instead, a dark room would get links too coarse for its little reflected light).
-pub const DEFAULT_LINK_TOL: f64 = 2e-5;
 
 /// Refinement passes at most: link, solve, refine the links the new radiosities condemn, solve
 /// again.
@@ -88,53 +83,6 @@ pub fn estimated_bytes(triangles: u64, surfaces: u64, link_tol: f64) -> u64 {
     let tables = 2.0 * surfaces as f64 / f64::from(links::EXACT_CLUSTER_SURFACES)
         * (FIELDS * size_of::<directions::Table>()) as f64;
     (triangles as f64 * per_triangle + tables).min(u64::MAX as f64) as u64
-}
-
-/// Figures of a hierarchical solve, under `solver.hierarchy` in `report.json`.
-#[derive(Clone, Debug, Default, Serialize)]
-pub struct HierarchyStats {
-    /// The link tolerance the solve refined to.
-    pub link_tol: f64,
-    /// Element nodes (parts of surfaces), of which leaves (the mesh's triangles).
-    pub elements: usize,
-    /// See `elements`.
-    pub leaves: usize,
-    /// Cluster nodes (groups of surfaces).
-    pub clusters: usize,
-    /// Links in the final hierarchy.
-    pub links: usize,
-    /// Links by visibility: open (no blocker in the shaft), partial (rays decide).
-    pub links_open: usize,
-    /// See `links_open`.
-    pub links_partial: usize,
-    /// Links from or to a cluster.
-    pub links_with_clusters: usize,
-    /// Links by the depth of their receiver (0: the root cluster).
-    pub links_by_depth: Vec<usize>,
-    /// Pairs of nodes found hidden by one polygon, and not linked.
-    pub hidden_pairs: u64,
-    /// Passes of link refinement, each followed by sweeps.
-    pub refinement_passes: usize,
-    /// Rays for the links' visibility, and for the final gather's partial links.
-    pub link_rays: u64,
-    /// See `link_rays`.
-    pub gather_rays: u64,
-    /// Jacobi sweeps, over all passes.
-    pub sweeps: usize,
-    /// Sweeps of the solve that balances the leaves' energy (see `links_lost`).
-    pub balance_sweeps: usize,
-    /// The share of the light the leaves send toward surfaces that their links lost, before it
-    /// was given back as ambient light (channel means).
-    pub links_lost: f64,
-    /// The share of the light the balanced leaves receive that the final gather lost, before it
-    /// was given back as ambient light (channel means).
-    pub gather_lost: f64,
-    /// Seconds spent making and refining links.
-    pub link_seconds: f64,
-    /// Seconds spent sweeping.
-    pub sweep_seconds: f64,
-    /// Bytes held by the links.
-    pub link_bytes: u64,
 }
 
 /// Solves a meshed scene by hierarchical radiosity; the display values come from a final gather

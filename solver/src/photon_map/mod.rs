@@ -19,9 +19,13 @@ use glam::{DVec2, DVec3};
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use penumbra_scenes::{PlaneFrame, Rgb, Scene, SplitMix64, SurfaceId, Visibility};
 use rayon::prelude::*;
-use serde::Serialize;
 
+pub use crate::options::{
+    DEFAULT_FINAL_GATHER, DEFAULT_GATHER_PHOTONS, DEFAULT_PHOTONS, MAX_GATHER_PHOTONS, MAX_PHOTONS,
+    PhotonMapOptions,
+};
 use crate::rays::{cosine_direction, front_hit};
+pub use crate::solution::PhotonStats;
 use crate::{Interrupt, Progress, SolveError};
 use emit::Emission;
 pub use solve::solve_photon_map;
@@ -39,62 +43,6 @@ const PRECOMPUTE_EVERY: usize = 4;
 /// Bytes a stored photon, or an estimate made in advance, holds: its position, its power or
 /// value, and its tree's share.
 const POINT_BYTES: usize = 3 * 8 + size_of::<Rgb>() + 3 * 8;
-
-/// Photons a solve emits unless told otherwise. With the defaults below the Cornell box is
-/// within 1.5 % RMS of the path-traced reference at 10,000 triangles (the README's side-by-side
-/// table, `scripts/regen-docs --only methods`); its error is then the mesh's and the final
-/// gather's, not the photons'.
-pub const DEFAULT_PHOTONS: usize = 1_000_000;
-/// Photons an irradiance estimate gathers unless told otherwise.
-pub const DEFAULT_GATHER_PHOTONS: usize = 100;
-/// Final-gather rays per vertex unless told otherwise.
-pub const DEFAULT_FINAL_GATHER: usize = 1024;
-/// Most photons a solve may emit: each stores about two landings of 72 bytes.
-pub const MAX_PHOTONS: usize = 200_000_000;
-/// Most photons an estimate may gather.
-pub const MAX_GATHER_PHOTONS: usize = 100_000;
-
-/// How the map is made and read.
-#[derive(Clone, Debug, PartialEq)]
-pub struct PhotonMapOptions {
-    /// Photons emitted, shared among the emitters in proportion to their power.
-    pub photons: usize,
-    /// Photons each irradiance estimate gathers.
-    pub gather_photons: usize,
-    /// Rays per vertex of the final gather; 0 reads the map at the vertices themselves.
-    pub final_gather: usize,
-}
-
-impl Default for PhotonMapOptions {
-    fn default() -> Self {
-        PhotonMapOptions {
-            photons: DEFAULT_PHOTONS,
-            gather_photons: DEFAULT_GATHER_PHOTONS,
-            final_gather: DEFAULT_FINAL_GATHER,
-        }
-    }
-}
-
-/// What making the map did (`solver.photon_map` in `report.json`).
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
-pub struct PhotonStats {
-    /// Photons emitted.
-    pub emitted: usize,
-    /// Photons stored: landings after at least one reflection.
-    pub stored: usize,
-    /// Bytes the map holds: positions, powers, precomputed estimates and the trees.
-    pub bytes: usize,
-    /// Irradiance estimates made in advance at stored photons, which the final gather reads
-    /// (none without a final gather).
-    pub precomputed: usize,
-    /// The power of the photons that reached no surface's front (they left the scene or met a
-    /// back), W per channel: the photons' own tally of what the scene loses.
-    pub escaped: Rgb,
-    /// Seconds spent tracing the photons and building the trees.
-    pub trace_seconds: f64,
-    /// Seconds spent estimating the indirect light at the vertices (the final gather, if any).
-    pub estimate_seconds: f64,
-}
 
 /// A photon where it landed: its position and the power it brought, W per channel.
 #[derive(Clone, Copy, Debug)]

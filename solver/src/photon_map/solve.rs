@@ -9,9 +9,9 @@ use penumbra_scenes::{Rgb, Scene, SplitMix64, SurfaceId, Visibility};
 use rayon::prelude::*;
 
 use super::{PhotonMap, PhotonMapOptions, PhotonStats};
+use crate::direct_pass::{check_mesh, direct_irradiance};
 use crate::elements::Discretization;
 use crate::lambert::ReceivingPoint;
-use crate::progressive::{check_mesh, direct_irradiance};
 use crate::rays::{cosine_direction, front_hit};
 use crate::{Progress, Solution, SolveError, SolveStats, SolverOptions, StopReason};
 
