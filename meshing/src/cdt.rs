@@ -13,14 +13,13 @@ use spade::{
 };
 
 use crate::error::MeshError;
-use crate::grading::Density;
 use crate::mesh::SurfaceMesh;
 use crate::mesh_coordinates::MeshCoordinates;
 
 /// Triangles smaller than this (mesh units, where the polygon's extent is 1: (2^-24)^2, about
 /// (6e-8)^2) are left as they are by the search for the least quality mesh (the least mesh at
 /// the angle, with no area bound). Only features a few hundred merge distances apart
-/// ([`crate::constrained::MERGE_DISTANCE`], 2^-30) make triangles that small; the floor keeps the
+/// ([`crate::tolerances::MERGE_DISTANCE`], 2^-30) make triangles that small; the floor keeps the
 /// refinement from chasing them down to rounding.
 pub(crate) const QUALITY_FLOOR_AREA: f64 = 1.0 / (1u64 << 48) as f64;
 
@@ -232,7 +231,7 @@ impl SurfaceTriangulation {
         &self,
         target: usize,
         min_angle_deg: f64,
-        density: &Density,
+        density: &impl SizeField,
     ) -> SurfaceTriangulation {
         self.calibrated(target, min_angle_deg, |max_area| {
             let mut cdt = self.cdt.clone();
@@ -531,6 +530,15 @@ impl SurfaceTriangulation {
 
 type Face<'a> = spade::handles::FaceHandle<'a, InnerTag, Point2<f64>, (), spade::CdtEdge<()>, ()>;
 
+/// How many times smaller in area than the base size triangles should be, point by point: what
+/// graded refinement follows.
+pub(crate) trait SizeField {
+    /// The factor at `p` (mesh coordinates), at least one.
+    fn at(&self, p: DVec2) -> f64;
+    /// The largest factor anywhere.
+    fn max_factor(&self) -> f64;
+}
+
 fn face_centroid(face: Face<'_>) -> DVec2 {
     let [a, b, c] = face.positions().map(|p| DVec2::new(p.x, p.y));
     (a + b + c) / 3.0
@@ -623,7 +631,7 @@ pub(crate) fn extract(
 mod tests {
     use super::*;
     use crate::mesh_coordinates::snap;
-    use crate::uniform::MIN_ANGLE_DEG;
+    use crate::tolerances::MIN_ANGLE_DEG;
     use glam::DVec3;
     use penumbra_scenes::PlaneFrame;
 

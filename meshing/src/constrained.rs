@@ -18,23 +18,17 @@ use penumbra_scenes::{PlaneFrame, Surface, SurfaceId};
 use crate::cdt::{Cdt, SurfaceTriangulation, insert_segment, quietly};
 use crate::error::MeshError;
 use crate::grading::Density;
-use crate::mesh::{ON_SEGMENT_TOLERANCE, SurfaceMesh};
+use crate::mesh::SurfaceMesh;
 use crate::mesh_coordinates::{MeshCoordinates, snap};
+use crate::tolerances::{
+    CONSTRAINED_MIN_ANGLE_DEG, MAX_MIN_ANGLE_DEG, MERGE_DISTANCE, ON_SEGMENT_TOLERANCE,
+    SPLIT_MIN_ANGLE_DEG,
+};
 use penumbra_scenes::polygon::clip_segment;
 use spade::Triangulation as _;
 
-/// Constraint endpoints closer than this (in mesh units, where the polygon's extent is 1) are
-/// one vertex: 2^-30, about 1e-9.
-pub(crate) const MERGE_DISTANCE: f64 = 1.0 / (1u64 << 30) as f64;
 /// Margin of the frame around a constrained polygon, relative to its extent.
 const FRAME_MARGIN: f64 = 0.05;
-/// Smallest angle the refinement of constrained meshes aims for by default: constraints may meet
-/// at any angle, and 20 degrees keeps Ruppert's refinement from cascading around them.
-pub const CONSTRAINED_MIN_ANGLE_DEG: f64 = 20.0;
-
-/// The largest smallest angle refinement can be asked for: Ruppert's refinement terminates up
-/// to about 20.7°, and spade's off-centre variant somewhat beyond; above 30° it may not.
-pub const MAX_MIN_ANGLE_DEG: f64 = 30.0;
 
 /// A segment to be a chain of mesh edges, in the surface's plane-frame coordinates.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -316,9 +310,9 @@ impl RefinableSurface {
         Ok(RefinableSurface {
             id,
             triangulation: SurfaceTriangulation::of_surface(id, surface)?
-                .refined(target, crate::uniform::MIN_ANGLE_DEG),
+                .refined(target, crate::tolerances::MIN_ANGLE_DEG),
             segments: Vec::new(),
-            min_angle_deg: crate::uniform::MIN_ANGLE_DEG,
+            min_angle_deg: crate::tolerances::MIN_ANGLE_DEG,
         })
     }
 
@@ -347,12 +341,6 @@ impl RefinableSurface {
         self.triangulation.count()
     }
 }
-
-/// Smallest angle restored after adaptive splits. Longest-edge bisection alone keeps angles from
-/// collapsing (to no less than half the smallest one it starts from); a higher bound would spend
-/// triangles on shape where the error estimate asks for none. On the Cornell floor, direct light
-/// only, 30,000 triangles: RMS error 0.096 % with 5 degrees, 0.099 % with 10, 0.142 % with 25.
-pub const SPLIT_MIN_ANGLE_DEG: f64 = 5.0;
 
 /// Makes near T-junctions exact: a segment end within `tol` of another segment (or of a boundary
 /// edge), away from its ends, moves onto it, and that segment (or edge) is split there. Without

@@ -18,7 +18,7 @@ use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 use spade::{PositionInTriangulation, Triangulation as _};
 
-use crate::cdt::{Cdt, SurfaceTriangulation};
+use crate::cdt::{Cdt, SizeField, SurfaceTriangulation};
 use crate::mesh_coordinates::MeshCoordinates;
 
 /// How many times smaller in area triangles in a penumbra are than elsewhere, by default: about
@@ -65,7 +65,7 @@ impl Density {
         let pilot = triangulation
             .refined_to_area(
                 pilot_area,
-                crate::constrained::CONSTRAINED_MIN_ANGLE_DEG,
+                crate::tolerances::CONSTRAINED_MIN_ANGLE_DEG,
                 pilot_target,
             )
             .0;
@@ -103,9 +103,11 @@ impl Density {
             max_factor: factor,
         }
     }
+}
 
+impl SizeField for Density {
     /// The density at `p` (mesh coordinates); on a pilot edge or vertex, the largest around it.
-    pub(crate) fn at(&self, p: DVec2) -> f64 {
+    fn at(&self, p: DVec2) -> f64 {
         let of_face =
             |f: spade::handles::FixedFaceHandle<spade::handles::InnerTag>| self.factors[f.index()];
         match self.pilot.locate(spade::Point2::new(p.x, p.y)) {
@@ -128,7 +130,7 @@ impl Density {
     }
 
     /// The largest density anywhere.
-    pub(crate) fn max_factor(&self) -> f64 {
+    fn max_factor(&self) -> f64 {
         self.max_factor
     }
 }

@@ -83,22 +83,25 @@ mod locate;
 mod mesh;
 mod mesh_coordinates;
 mod progress;
+mod quality;
 mod scene_mesh;
+mod tolerances;
 mod uniform;
 mod wedges;
 
 pub use bisection::{BisectionMesh, SHORTEST_SPLIT_EDGE, Split};
 pub use budget::{ElementBudget, FIT_TRIANGLES_PER_SURFACE, polygon_minimum};
-pub use constrained::{
-    CONSTRAINED_MIN_ANGLE_DEG, ConstrainedSurface, Constraint, MAX_MIN_ANGLE_DEG, RefinableSurface,
-    SPLIT_MIN_ANGLE_DEG,
-};
+pub use constrained::{ConstrainedSurface, Constraint, RefinableSurface};
 pub use error::MeshError;
 pub use grading::DEFAULT_PENUMBRA_DENSITY;
 pub use locate::{TriangleLocator, transfer_density};
-pub use mesh::{FORCING_WEDGE_DEG, MeshQuality, SurfaceMesh, quality_of};
+pub use mesh::SurfaceMesh;
 pub use progress::{Interrupt, NoProgress, Progress};
+pub use quality::{MeshQuality, quality_of};
 pub use scene_mesh::{
     SceneMesh, mesh_scene_discontinuity, mesh_scene_discontinuity_on, mesh_scene_uniform,
+};
+pub use tolerances::{
+    CONSTRAINED_MIN_ANGLE_DEG, FORCING_WEDGE_DEG, MAX_MIN_ANGLE_DEG, SPLIT_MIN_ANGLE_DEG,
 };
 pub use uniform::mesh_surface_uniform;

@@ -8,14 +8,14 @@ use glam::DVec3;
 use penumbra_scenes::{PlaneFrame, Scene, SurfaceId, Visibility};
 
 use crate::budget::{ElementBudget, polygon_minimum, polygon_triangles};
-use crate::constrained::{
-    CONSTRAINED_MIN_ANGLE_DEG, ConstrainedSurface, Constraint, RefinableSurface,
-};
+use crate::constrained::{ConstrainedSurface, Constraint, RefinableSurface};
 use crate::discontinuity::{
     Discontinuities, DiscontinuitySegment, DiscontinuityStats, EmitterProbe, Event,
 };
 use crate::error::MeshError;
-use crate::mesh::{MeshQuality, SurfaceMesh, quality_of};
+use crate::mesh::SurfaceMesh;
+use crate::quality::{MeshQuality, quality_of};
+use crate::tolerances::CONSTRAINED_MIN_ANGLE_DEG;
 
 /// One mesh per surface, in the scene's surface order, and the discontinuities the meshes follow
 /// (none for uniform meshes).

@@ -6,9 +6,7 @@ use penumbra_scenes::{Surface, SurfaceId};
 use crate::cdt::SurfaceTriangulation;
 use crate::error::MeshError;
 use crate::mesh::SurfaceMesh;
-
-/// Smallest angle uniform refinement aims for.
-pub(crate) const MIN_ANGLE_DEG: f64 = 25.0;
+use crate::tolerances::MIN_ANGLE_DEG;
 
 /// Meshes one surface with about `target` triangles (never more, unless the polygon itself needs
 /// more than `target` to be triangulated at all).

@@ -9,7 +9,8 @@ use std::f64::consts::TAU;
 
 use glam::DVec2;
 
-use crate::mesh::{ON_SEGMENT_TOLERANCE, SurfaceMesh};
+use crate::mesh::SurfaceMesh;
+use crate::tolerances::ON_SEGMENT_TOLERANCE;
 
 /// Two input edges that meet at less than this leave triangles between them (every vertex on
 /// one of the two) that Delaunay refinement cannot improve without splitting the edges without
