@@ -37,7 +37,6 @@ const BATCH_EDGES: usize = 1024;
 /// drop out before they reach an overlay.
 const FIRST_BATCH_EDGES: usize = 16;
 
-
 /// The shadows cast on one emitter piece from one receiving point.
 #[derive(Debug, Default)]
 pub(crate) struct ShadowUnion {

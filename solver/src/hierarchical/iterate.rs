@@ -256,7 +256,7 @@ impl<'a> System<'a> {
             None => {
                 let sums = self.row_sums();
                 self.totals = (sums.iter().zip(&self.enclosed))
-                    .map(|(&sum, &enclosed)| super::totals::bounded(sum, enclosed))
+                    .map(|(&sum, &enclosed)| bounded(sum, enclosed))
                     .collect();
                 self.reflecting.clone_from(&self.totals);
                 self.stale.fill(true);
@@ -577,4 +577,10 @@ struct Gathered {
 /// `a / b`, zero where `b` is not positive.
 fn ratio(a: f64, b: f64) -> f64 {
     if b > 0.0 { a / b } else { 0.0 }
+}
+
+/// A receiver's total from the form factors found for it: one inside a closed solid, else their
+/// sum, at most one.
+pub(super) fn bounded(sum: f64, enclosed: bool) -> f64 {
+    if enclosed { 1.0 } else { sum.min(1.0) }
 }

@@ -841,7 +841,7 @@ fn final_gather_at(
     let totals: Vec<f64> = values
         .iter()
         .zip(enclosed)
-        .map(|(g, &enclosed)| totals::bounded(g.unit, enclosed))
+        .map(|(g, &enclosed)| iterate::bounded(g.unit, enclosed))
         .collect();
     let scaled = |g: &Gathered, total: f64| {
         let sum = g.near + g.far;

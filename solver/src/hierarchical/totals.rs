@@ -19,19 +19,13 @@ use glam::DVec3;
 use penumbra_scenes::Rgb;
 use rayon::prelude::*;
 
-use super::iterate::System;
+use super::iterate::{System, bounded};
 use super::links::Transfer;
 use super::transfer::point_factor;
 use super::tree::NONE;
 use crate::elements::Discretization;
 use crate::lambert::ReceivingPoint;
 use crate::solids::Enclosures;
-
-/// A receiver's total from the form factors found for it: one inside a closed solid, else their
-/// sum, at most one.
-pub(super) fn bounded(sum: f64, enclosed: bool) -> f64 {
-    if enclosed { 1.0 } else { sum.min(1.0) }
-}
 
 /// Per node: whether a leaf lies inside a closed solid (all its vertices do).
 pub(super) fn enclosed_leaves(
