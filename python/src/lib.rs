@@ -14,6 +14,7 @@ mod progress;
 mod run;
 mod scene;
 mod solution;
+mod worker;
 
 use pyo3::prelude::*;
 

@@ -14,8 +14,8 @@ use rayon::prelude::*;
 
 use crate::arrays::{rgb_array, segment_arrays};
 use crate::errors::bad_argument;
-use crate::run::{thread_pool, without_gil};
 use crate::scene::Scene;
+use crate::worker::{thread_pool, without_gil};
 
 /// Finds the surfaces points lie on: within the scene's contact distance of a polygon, inside
 /// it or on its outline.
