@@ -163,8 +163,8 @@ impl FormFactorMethod {
 pub const DEFAULT_LINK_TOL: f64 = 2e-5;
 
 /// Photons a solve emits unless told otherwise. With the defaults below the Cornell box is
-/// within 1.5 % RMS of the path-traced reference at 10,000 triangles (the README's side-by-side
-/// table, `scripts/regen-docs --only methods`); its error is then the mesh's and the final
+/// within 1.5 % RMS of the path-traced reference at 10,000 triangles (the side-by-side table of
+/// `docs/benchmarks.md`, `scripts/regen-docs --only methods`); its error is then the mesh's and the final
 /// gather's, not the photons'.
 pub const DEFAULT_PHOTONS: usize = 1_000_000;
 /// Photons an irradiance estimate gathers unless told otherwise.
