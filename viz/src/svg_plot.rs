@@ -208,26 +208,28 @@ impl SvgPlot {
             num(width),
             num(height)
         );
-        let font = format!(
-            "font-family=\"sans-serif\" font-size=\"{}\" fill=\"#202020\"",
-            num(FONT_PX * px)
-        );
-        let text_x = num(lo.x);
+        // Text is laid out in canvas pixels and scaled into the data's units: renderers that
+        // lay out fonts at whole sizes (librsvg) garble a font a tenth of a unit tall.
+        let text = |x: f64, y: f64, weight: &str, content: &str| {
+            format!(
+                "<text transform=\"translate({} {}) scale({})\" font-family=\"sans-serif\" \
+                 font-size=\"{}\" fill=\"#202020\"{weight}>{}</text>",
+                num(x),
+                num(y),
+                num(px),
+                num(FONT_PX),
+                escape(content)
+            )
+        };
         let mut y = top + (MARGIN_PX + 0.5 * TITLE_PX) * px;
         let _ = writeln!(
             out,
-            "<text x=\"{text_x}\" y=\"{}\" {font} font-weight=\"bold\">{}</text>",
-            num(y),
-            escape(&self.title)
+            "{}",
+            text(lo.x, y, " font-weight=\"bold\"", &self.title)
         );
         for note in &self.notes {
             y += NOTE_PX * px;
-            let _ = writeln!(
-                out,
-                "<text x=\"{text_x}\" y=\"{}\" {font}>{}</text>",
-                num(y),
-                escape(note)
-            );
+            let _ = writeln!(out, "{}", text(lo.x, y, "", note));
         }
 
         for layer in &self.layers {
@@ -243,13 +245,11 @@ impl SvgPlot {
             }
             out.push_str("</g>\n");
         }
-        for (at, text) in &self.labels {
+        for (at, label) in &self.labels {
             let _ = writeln!(
                 out,
-                "<text x=\"{}\" y=\"{}\" {font}>{}</text>",
-                num(at.x + 3.0 * px),
-                num(-at.y - 3.0 * px),
-                escape(text)
+                "{}",
+                text(at.x + 3.0 * px, -at.y - 3.0 * px, "", label)
             );
         }
 
@@ -268,11 +268,13 @@ impl SvgPlot {
         );
         let _ = writeln!(
             out,
-            "<text x=\"{}\" y=\"{}\" {font}>{} {}</text>",
-            num(lo.x + bar.0 + 6.0 * px),
-            num(bar_y + 4.0 * px),
-            bar.1,
-            escape(&self.unit)
+            "{}",
+            text(
+                lo.x + bar.0 + 6.0 * px,
+                bar_y + 4.0 * px,
+                "",
+                &format!("{} {}", bar.1, self.unit)
+            )
         );
 
         let mut row_y = -lo.y + (MARGIN_PX + SCALE_BAR_PX + 0.5 * LEGEND_ROW_PX) * px;
@@ -293,10 +295,13 @@ impl SvgPlot {
             );
             let _ = writeln!(
                 out,
-                "<text x=\"{}\" y=\"{}\" {font}>{}</text>",
-                num(lo.x + (LEGEND_SAMPLE_PX + 6.0) * px),
-                num(row_y + 4.0 * px),
-                escape(label)
+                "{}",
+                text(
+                    lo.x + (LEGEND_SAMPLE_PX + 6.0) * px,
+                    row_y + 4.0 * px,
+                    "",
+                    label
+                )
             );
             row_y += LEGEND_ROW_PX * px;
         }
