@@ -116,6 +116,7 @@ pub mod energy;
 pub mod error_mesh;
 pub mod experiments;
 pub mod export;
+mod fingerprint;
 #[doc(hidden)] // Support for the fuzz targets and their tests, not an API.
 pub mod fuzzing;
 pub mod memory;

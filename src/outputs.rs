@@ -14,6 +14,7 @@ use penumbra_solver::{SolverMethod, StopReason};
 use serde::Serialize;
 
 use crate::energy::EnergyBalance;
+pub use crate::options::Invocation;
 use crate::pipeline::{RunResult, StageTimes};
 
 /// The `format` of `solution.json`, and its version (`docs/schemas/solution.schema.json`).
@@ -137,18 +138,6 @@ pub fn solution_json_of(scene: &str, surfaces: &[SurfaceSolution]) -> String {
         scene,
         surfaces,
     })
-}
-
-/// How a run was asked for on the command line: `report.json` records it so that the run can
-/// be repeated (`penumbra run --replay`).
-#[derive(Clone, Debug, Serialize, serde::Deserialize)]
-pub struct Invocation {
-    /// The command line, the program first.
-    pub arguments: Vec<String>,
-    /// The directory that relative paths on it are relative to.
-    pub working_directory: String,
-    /// Every option of the command as it was resolved, defaults included, by option name.
-    pub options: serde_json::Value,
 }
 
 /// The version of penumbra that wrote a report.
@@ -389,7 +378,7 @@ pub fn report_json(result: &RunResult, svgs: &SvgSelection) -> String {
         scene: SceneSummary {
             name: &scene.name,
             source: &result.loaded.source,
-            fingerprint: crate::shard::scene_fingerprint(&result.loaded),
+            fingerprint: crate::fingerprint::scene_fingerprint(&result.loaded),
             surfaces: scene.surfaces.len(),
             emitters: scene.emitters().count(),
             bounding_box_diagonal: scene.diagonal(),

@@ -6,9 +6,9 @@ use std::time::Instant;
 use crate::adaptive::{RefineReport, refine_adaptively, refine_hierarchically};
 use crate::error_mesh::{MeshErrorReport, StopWhen, refine_by_error};
 use crate::memory::{self, MeshCounts};
+use crate::options::ShardError;
 use crate::options::{InvalidOption, MeshMethod, RunOptions};
 use crate::reflected_mesh::refine_reflected;
-use crate::shard::ShardError;
 use penumbra_meshing::discontinuity::{
     Boundary, DiscontinuityOptions, find_discontinuities_reporting,
 };
@@ -119,7 +119,7 @@ pub struct RunResult {
     pub memory: MemoryReport,
     /// The command line that asked for the run, if one did (set by the front end; recorded in
     /// `report.json`).
-    pub invocation: Option<crate::outputs::Invocation>,
+    pub invocation: Option<crate::options::Invocation>,
 }
 
 impl RunResult {
@@ -166,7 +166,7 @@ pub enum RunError {
     /// The render failed.
     #[error(transparent)]
     Render(#[from] VizError),
-    /// The options cannot be split into shards ([`crate::shard::Shard::check`]).
+    /// The options cannot be split into shards ([`crate::options::Shard::check`]).
     #[error(transparent)]
     Shard(#[from] ShardError),
     /// The run's estimated memory exceeds what it may use; refused before the stage that would
@@ -351,7 +351,7 @@ pub fn run(
     // alone: each one's share of a fitted budget then depends on nothing else.
     let shard_surfaces = options
         .shard
-        .filter(|_| crate::shard::meshed_alone(scene, options))
+        .filter(|_| crate::options::meshed_alone(scene, options))
         .map(|shard| shard.surfaces(surfaces));
     let t = Instant::now();
     let found = match options.mesh {

@@ -30,13 +30,15 @@
 
 use std::path::{Path, PathBuf};
 
-use penumbra_meshing::{SceneMesh, SurfaceMesh, polygon_minimum, quality_of};
+use penumbra_meshing::{SceneMesh, SurfaceMesh, quality_of};
 use penumbra_scenes::{LoadedScene, PlaneFrame, Rgb, Scene, SceneError, SurfaceId};
 use serde::{Deserialize, Serialize};
 
 use crate::energy::EnergyBalance;
 use crate::export::{ExportFormat, ExportSource, export};
-use crate::options::RunOptions;
+use crate::fingerprint::hex;
+pub use crate::fingerprint::scene_fingerprint;
+pub use crate::options::{Shard, ShardError, meshed_alone};
 use crate::outputs::{
     DEFAULT_SVG_SURFACES, SVG_DIR, Staging, SurfaceSolution, SvgSelection, report_json,
     solution_json_of, surface_solution, svg_name, worth_looking_at,
@@ -47,120 +49,6 @@ use crate::pipeline::RunResult;
 pub const SHARD_FILE: &str = "shard.json";
 /// The format of [`SHARD_FILE`].
 pub const SHARD_FORMAT: &str = "penumbra-shard/1";
-
-/// One of `count` parts of a scene's surfaces: those whose index is `index` modulo `count`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub struct Shard {
-    /// Which part, from 0 to `count - 1`.
-    pub index: usize,
-    /// How many parts the scene is split into, at least 1.
-    pub count: usize,
-}
-
-/// Why a shard cannot be run as asked.
-#[derive(Debug, thiserror::Error, PartialEq, Eq)]
-#[non_exhaustive]
-pub enum ShardError {
-    /// The text given to [`Shard::parse`] is not `I/N`.
-    #[error("a shard is written I/N with whole numbers I and N (I from 0 to N - 1), not {0:?}")]
-    Syntax(String),
-    /// A count of 0.
-    #[error("a scene cannot be split into 0 shards")]
-    NoShards,
-    /// An index not below the count.
-    #[error("there is no shard {index} of {count}: shards are numbered from 0 to {}", .count - 1)]
-    OutOfRange {
-        /// The index asked for.
-        index: usize,
-        /// The count of shards.
-        count: usize,
-    },
-    /// A full solution was asked for: only the direct light can be split.
-    #[error(
-        "a full solution cannot be split by surface: light bounces between all surfaces, so each \
-         one's radiosity depends on every other's; only the direct light can be split"
-    )]
-    NeedsDirectOnly,
-    /// Adaptive refinement was asked for.
-    #[error(
-        "adaptive refinement cannot be split by surface: it spends one element budget over the \
-         whole scene, against the scene's mean radiosity"
-    )]
-    Refinement,
-    /// A time budget was given.
-    #[error(
-        "a time budget cannot be split by surface: it would cut the shards short at different \
-         points, and their parts would not belong to one run"
-    )]
-    TimeBudget,
-}
-
-impl Shard {
-    /// Shard `index` of `count`.
-    pub fn new(index: usize, count: usize) -> Result<Shard, ShardError> {
-        if count == 0 {
-            return Err(ShardError::NoShards);
-        }
-        if index >= count {
-            return Err(ShardError::OutOfRange { index, count });
-        }
-        Ok(Shard { index, count })
-    }
-
-    /// `I/N`, as a scheduler's task number gives it (`0/8` to `7/8`).
-    pub fn parse(text: &str) -> Result<Shard, ShardError> {
-        let syntax = || ShardError::Syntax(text.to_owned());
-        let (i, n) = text.trim().split_once('/').ok_or_else(syntax)?;
-        let number = |s: &str| s.trim().parse::<usize>().map_err(|_| syntax());
-        Shard::new(number(i)?, number(n)?)
-    }
-
-    /// Whether surface `s` is this shard's.
-    pub fn contains(self, s: SurfaceId) -> bool {
-        s % self.count == self.index
-    }
-
-    /// For each of `surfaces` surfaces, whether it is this shard's.
-    pub fn surfaces(self, surfaces: usize) -> Vec<bool> {
-        (0..surfaces).map(|s| self.contains(s)).collect()
-    }
-
-    /// Refuses options whose results cannot be split by surface.
-    pub fn check(self, options: &RunOptions) -> Result<(), ShardError> {
-        Shard::new(self.index, self.count)?;
-        if !options.solver.direct_only {
-            return Err(ShardError::NeedsDirectOnly);
-        }
-        if options.refine.is_some() {
-            return Err(ShardError::Refinement);
-        }
-        if options.time_budget.is_some() {
-            return Err(ShardError::TimeBudget);
-        }
-        Ok(())
-    }
-}
-
-/// Whether a shard of a run with these options finds the discontinuities of its own surfaces and
-/// meshes them alone: a fitted budget of a scene whose polygons need more than the budget's
-/// floor ([`penumbra_meshing::ElementBudget::shared_extra`]) gives each surface a share that
-/// depends on nothing else, unless the mesh is error-driven. Otherwise each shard meshes the
-/// whole scene, as the run not split does.
-pub fn meshed_alone(scene: &Scene, options: &RunOptions) -> bool {
-    // An error-driven mesh spends one budget over all surfaces through one queue.
-    options.refine.is_none()
-        && !options.error_driven()
-        && options
-            .max_elements
-            .shared_extra(polygon_minimum(scene), scene.surfaces.len())
-            .is_some()
-}
-
-impl std::fmt::Display for Shard {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{}/{}", self.index, self.count)
-    }
-}
 
 /// How the scene was given, so that `merge` can load it again to render the joined solution.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -208,24 +96,6 @@ pub struct ShardFile {
     pub svgs: Vec<String>,
     /// This shard's surfaces, each with its `index` in the scene, in the scene's order.
     pub surfaces: Vec<SurfaceSolution>,
-}
-
-/// FNV-1a, 64 bits: a fingerprint against mixing up runs, not a cryptographic hash.
-fn fnv1a(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
-        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
-    })
-}
-
-fn hex(bytes: &[u8]) -> String {
-    format!("{:016x}", fnv1a(bytes))
-}
-
-/// The fingerprint of a scene: of its JSON form, so of every number in it.
-pub fn scene_fingerprint(loaded: &LoadedScene) -> String {
-    hex(serde_json::to_string(&loaded.scene)
-        .unwrap_or_default()
-        .as_bytes())
 }
 
 /// The fingerprint of a run: its scene, and the options `report.json` records (the thread
@@ -892,6 +762,7 @@ pub fn write_merged(merged: &Merged, dir: &Path) -> anyhow::Result<Vec<PathBuf>>
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::options::RunOptions;
 
     #[test]
     fn shards_are_parsed_and_checked() {
