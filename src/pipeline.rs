@@ -572,10 +572,10 @@ pub fn run(
         .iter()
         .zip(&solution.radiosity)
         .map(|(m, b)| {
-            let extra = scene.surfaces[m.surface]
-                .reflectance
-                .mul_rgb(solution.ambient);
-            b.iter().map(|&c| c + extra).collect()
+            let rho = scene.surfaces[m.surface].reflectance;
+            b.iter()
+                .map(|&c| penumbra_solver::displayed(c, rho, solution.ambient))
+                .collect()
         })
         .collect();
     let render = penumbra_viz::render(scene, &mesh, &display, &options.render)?;

@@ -519,8 +519,10 @@ pub fn merge(
         .iter()
         .zip(&scene.surfaces)
         .map(|(s, surface)| {
-            let extra = surface.reflectance.mul_rgb(ambient);
-            s.radiosity.iter().map(|&c| Rgb::from(c) + extra).collect()
+            s.radiosity
+                .iter()
+                .map(|&c| penumbra_solver::displayed(Rgb::from(c), surface.reflectance, ambient))
+                .collect()
         })
         .collect();
     let render = penumbra_viz::render(

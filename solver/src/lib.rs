@@ -124,4 +124,4 @@ pub use measure::{InterpolationError, direct_interpolation_error};
 pub use options::{DEFAULT_EPSILON, SolverOptions};
 pub use progress::{Interrupt, NoProgress, Progress};
 pub use progressive::{ProgressiveSolver, solve_direct_on, solve_progressive};
-pub use solution::{ConvergencePoint, Solution, SolveStats, StopReason, ambient_term};
+pub use solution::{ConvergencePoint, Solution, SolveStats, StopReason, ambient_term, displayed};

@@ -180,6 +180,12 @@ pub struct PhotonStats {
     pub estimate_seconds: f64,
 }
 
+/// What a display shows for radiosity `b` on a surface of reflectance `reflectance`: `b` plus
+/// the surface's share of the display-only ambient term, ρ·ambient. Never part of a solution.
+pub fn displayed(b: Rgb, reflectance: Rgb, ambient: Rgb) -> Rgb {
+    b + reflectance.mul_rgb(ambient)
+}
+
 /// The ambient term of a solution that left `unshot` power unshot: spread over `area` and
 /// reflected on without end at the mean reflectance.
 pub fn ambient_term(unshot: Rgb, area: f64, mean_reflectance: Rgb) -> Rgb {

@@ -164,7 +164,7 @@ impl Display {
     /// What `render.png` shows for radiosity `b` on a surface of reflectance `rho`, before the
     /// exposure: `b` plus the surface's share of the ambient term, ρ·ambient.
     fn shown(&self, b: [f64; 3], rho: [f64; 3]) -> Rgb {
-        Rgb::from(b) + Rgb::from(rho).mul_rgb(self.ambient)
+        penumbra_solver::displayed(Rgb::from(b), Rgb::from(rho), self.ambient)
     }
 
     /// The 8-bit sRGB colour `render.png` gives radiosity `b` on a surface of reflectance
