@@ -536,16 +536,13 @@ pub fn run(
             None,
             solve_hierarchical(scene, &mesh, &visibility, &solver, progress)?,
         ),
-        None if options.method == SolverMethod::PhotonMap => {
-            let photons = &solver.photon_map;
-            let (mut solution, stats) =
-                solve_photon_map(scene, &mesh, &visibility, &solver, photons, progress)?;
-            solution.stats.photon_map = Some(stats);
-            (None, solution)
-        }
+        None if options.method == SolverMethod::PhotonMap => (
+            None,
+            solve_photon_map(scene, &mesh, &visibility, &solver, progress)?,
+        ),
         None => (
             None,
-            solve_gathering(scene, &mesh, &visibility, &solver, options.method, progress)?.0,
+            solve_gathering(scene, &mesh, &visibility, &solver, options.method, progress)?,
         ),
     };
     peaks.solve = memory::peak_resident_bytes();

@@ -328,7 +328,7 @@ pub fn solve_gathering(
     options: &SolverOptions,
     method: SolverMethod,
     progress: &dyn Progress,
-) -> Result<(Solution, Vec<ConvergencePoint>), SolveError> {
+) -> Result<Solution, SolveError> {
     options.validate()?;
     let started = Instant::now();
     let system = PatchSystem::assemble(scene, mesh, visibility, options, progress)?;
@@ -382,15 +382,12 @@ pub fn solve_gathering(
         photon_map: None,
         closed: Some(crate::solids::closed_scene(scene, visibility, disc)),
     };
-    Ok((
-        Solution {
-            radiosity: disc.per_surface(&radiosity),
-            irradiance: disc.per_surface(&h),
-            direct_irradiance: disc.per_surface(&system.direct),
-            ambient: Rgb::ZERO,
-            stats,
-            convergence: history.clone(),
-        },
-        history,
-    ))
+    Ok(Solution {
+        radiosity: disc.per_surface(&radiosity),
+        irradiance: disc.per_surface(&h),
+        direct_irradiance: disc.per_surface(&system.direct),
+        ambient: Rgb::ZERO,
+        stats,
+        convergence: history,
+    })
 }

@@ -30,8 +30,7 @@ fn every_solver_keeps_the_exact_direct_part() {
                 SolverMethod::Jacobi,
                 &NoProgress,
             )
-            .expect("solves")
-            .0,
+            .expect("solves"),
         ),
         (
             "hierarchical",

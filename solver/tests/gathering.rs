@@ -19,11 +19,7 @@ fn solve(scene: &Scene, mesh: &SceneMesh, method: SolverMethod, epsilon: f64) ->
         SolverMethod::Progressive => {
             solve_progressive(scene, mesh, &vis, &options, &NoProgress).expect("solves")
         }
-        _ => {
-            solve_gathering(scene, mesh, &vis, &options, method, &NoProgress)
-                .expect("solves")
-                .0
-        }
+        _ => solve_gathering(scene, mesh, &vis, &options, method, &NoProgress).expect("solves"),
     }
 }
 
@@ -153,8 +149,9 @@ fn furnace_at_reflectance_zero_and_nearly_one() {
             max_shots: max,
             ..SolverOptions::default()
         };
-        let (s, history) =
+        let s =
             solve_gathering(&scene, &mesh, &vis, &options, method, &NoProgress).expect("solves");
+        let history = &s.convergence;
         let (lo, hi) = s
             .radiosity
             .iter()

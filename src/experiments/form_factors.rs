@@ -687,7 +687,7 @@ fn cube_solution(config: &MethodConfig, options: &StudyOptions) -> Result<CubeRo
         ..SolverOptions::default()
     };
     let started = Instant::now();
-    let (solution, _) = solve_gathering(
+    let solution = solve_gathering(
         &scene,
         &mesh,
         &visibility,

@@ -8,7 +8,7 @@ use penumbra_meshing::{SceneMesh, TriangleLocator};
 use penumbra_scenes::{Rgb, Scene, SplitMix64, SurfaceId, Visibility};
 use rayon::prelude::*;
 
-use super::{PhotonMap, PhotonMapOptions, PhotonStats};
+use super::PhotonMap;
 use crate::direct_pass::{check_mesh, direct_irradiance};
 use crate::elements::Discretization;
 use crate::lambert::ReceivingPoint;
@@ -22,10 +22,10 @@ pub fn solve_photon_map(
     mesh: &SceneMesh,
     visibility: &Visibility,
     options: &SolverOptions,
-    photons: &PhotonMapOptions,
     progress: &dyn Progress,
-) -> Result<(Solution, PhotonStats), SolveError> {
+) -> Result<Solution, SolveError> {
     options.validate()?;
+    let photons = &options.photon_map;
     check_mesh(scene, mesh)?;
     let started = Instant::now();
     let disc = Discretization::new(scene, mesh, options.elements_per_patch);
@@ -77,15 +77,17 @@ pub fn solve_photon_map(
                 .collect()
         })
         .collect();
-    let solution = Solution {
+    Ok(Solution {
         radiosity,
         irradiance,
         direct_irradiance: disc.per_surface(&direct),
         ambient: Rgb::ZERO,
-        stats,
+        stats: SolveStats {
+            photon_map: Some(map.stats),
+            ..stats
+        },
         convergence: Vec::new(),
-    };
-    Ok((solution, map.stats))
+    })
 }
 
 /// The energy account of `irradiance` at the vertices: what the surfaces absorb, and what

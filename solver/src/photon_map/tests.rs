@@ -23,16 +23,18 @@ fn solve(
     mesh: &penumbra_meshing::SceneMesh,
     photons: &PhotonMapOptions,
 ) -> (crate::Solution, PhotonStats) {
-    let options = crate::SolverOptions::default();
-    solve_photon_map(
-        scene,
-        mesh,
-        visibility,
-        &options,
-        photons,
-        &crate::NoProgress,
-    )
-    .expect("solved")
+    let options = crate::SolverOptions {
+        photon_map: photons.clone(),
+        ..crate::SolverOptions::default()
+    };
+    let solution =
+        solve_photon_map(scene, mesh, visibility, &options, &crate::NoProgress).expect("solved");
+    let stats = solution
+        .stats
+        .photon_map
+        .clone()
+        .expect("the map's figures");
+    (solution, stats)
 }
 
 /// Points spread over every face of a scene, corners and edges included: a jittered grid in
