@@ -208,30 +208,26 @@ impl SvgPlot {
             num(width),
             num(height)
         );
-        // Text is laid out in canvas pixels and scaled into the data's units: renderers that
-        // lay out fonts at whole sizes (librsvg) garble a font a tenth of a unit tall.
-        let text = |x: f64, y: f64, weight: &str, content: &str| {
-            format!(
-                "<text transform=\"translate({} {}) scale({})\" font-family=\"sans-serif\" \
-                 font-size=\"{}\" fill=\"#202020\"{weight}>{}</text>",
-                num(x),
-                num(y),
-                num(px),
-                num(FONT_PX),
-                escape(content)
-            )
-        };
         let mut y = top + (MARGIN_PX + 0.5 * TITLE_PX) * px;
         let _ = writeln!(
             out,
             "{}",
-            text(lo.x, y, " font-weight=\"bold\"", &self.title)
+            svg_text(px, lo.x, y, " font-weight=\"bold\"", &self.title)
         );
         for note in &self.notes {
             y += NOTE_PX * px;
-            let _ = writeln!(out, "{}", text(lo.x, y, "", note));
+            let _ = writeln!(out, "{}", svg_text(px, lo.x, y, "", note));
         }
 
+        self.write_layers(&mut out, px);
+        self.write_scale_bar(&mut out, lo, extent, px);
+        self.write_legend(&mut out, lo, px);
+        out.push_str("</svg>\n");
+        out
+    }
+
+    /// The layers, each a group of one line style, and the labels over them.
+    fn write_layers(&self, out: &mut String, px: f64) {
         for layer in &self.layers {
             let _ = writeln!(
                 out,
@@ -249,10 +245,13 @@ impl SvgPlot {
             let _ = writeln!(
                 out,
                 "{}",
-                text(at.x + 3.0 * px, -at.y - 3.0 * px, "", label)
+                svg_text(px, at.x + 3.0 * px, -at.y - 3.0 * px, "", label)
             );
         }
+    }
 
+    /// A bar of a round length under the plot, from its left edge, with its length.
+    fn write_scale_bar(&self, out: &mut String, lo: DVec2, extent: f64, px: f64) {
         // Scale bar under the plot, from its left edge.
         let bar = nice_length(0.25 * extent);
         let bar_y = -lo.y + (MARGIN_PX + 0.5 * SCALE_BAR_PX) * px;
@@ -269,14 +268,18 @@ impl SvgPlot {
         let _ = writeln!(
             out,
             "{}",
-            text(
+            svg_text(
+                px,
                 lo.x + bar.0 + 6.0 * px,
                 bar_y + 4.0 * px,
                 "",
                 &format!("{} {}", bar.1, self.unit)
             )
         );
+    }
 
+    /// A row per legend entry: its layer's line style and its label.
+    fn write_legend(&self, out: &mut String, lo: DVec2, px: f64) {
         let mut row_y = -lo.y + (MARGIN_PX + SCALE_BAR_PX + 0.5 * LEGEND_ROW_PX) * px;
         for (label, class) in &self.legend {
             let style = self
@@ -296,7 +299,8 @@ impl SvgPlot {
             let _ = writeln!(
                 out,
                 "{}",
-                text(
+                svg_text(
+                    px,
                     lo.x + (LEGEND_SAMPLE_PX + 6.0) * px,
                     row_y + 4.0 * px,
                     "",
@@ -305,9 +309,22 @@ impl SvgPlot {
             );
             row_y += LEGEND_ROW_PX * px;
         }
-        out.push_str("</svg>\n");
-        out
     }
+}
+
+/// A `<text>` at `(x, y)` in data units, laid out in canvas pixels and scaled by `px` data units
+/// per pixel: renderers that lay out fonts at whole sizes (librsvg) garble a font a tenth of a
+/// unit tall.
+fn svg_text(px: f64, x: f64, y: f64, weight: &str, content: &str) -> String {
+    format!(
+        "<text transform=\"translate({} {}) scale({})\" font-family=\"sans-serif\" \
+         font-size=\"{}\" fill=\"#202020\"{weight}>{}</text>",
+        num(x),
+        num(y),
+        num(px),
+        num(FONT_PX),
+        escape(content)
+    )
 }
 
 /// Stroke attributes of a style at `px` data units per canvas pixel.
