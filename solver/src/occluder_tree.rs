@@ -19,7 +19,7 @@ use std::f64::consts::PI;
 use glam::DVec3;
 use penumbra_scenes::polygon::newell_normal;
 
-use crate::shadow_union::{CornerKey, cancel_opposite};
+use crate::sheet_outline::{CornerKey, cancel_opposite};
 
 /// Nodes with at most this many faces are leaves.
 const LEAF_FACES: usize = 4;

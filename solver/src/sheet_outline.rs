@@ -35,6 +35,46 @@ pub(crate) fn outlines(
     TABLES.with_borrow_mut(|tables| tables.outlines(edges, links))
 }
 
+/// The directed edges left once each edge met in both directions cancels (only the surplus in
+/// one direction stays), in a fixed order: the same cancellation as [`outlines`], by sorting,
+/// for edges of any kind (the occluder tree's outlines, made once when it is built).
+pub(crate) fn cancel_opposite<E: Copy>(
+    mut edges: Vec<E>,
+    ends: impl Fn(&E) -> (CornerKey, CornerKey),
+) -> Vec<E> {
+    let pair = |e: &E| {
+        let (from, to) = ends(e);
+        (from.min(to), from.max(to))
+    };
+    let forward = |e: &E| {
+        let (from, to) = ends(e);
+        from < to
+    };
+    // Each corner pair's edges together, forward ones (from the smaller key) first. Edges with
+    // equal keys are the same edge, so an unstable sort keeps the result fixed.
+    edges.sort_unstable_by_key(|e| {
+        let (lo, hi) = pair(e);
+        (u64::from(lo) << 33) | (u64::from(hi) << 1) | u64::from(!forward(e))
+    });
+    let mut kept = Vec::with_capacity(edges.len() / 4);
+    let mut i = 0;
+    while i < edges.len() {
+        let j = i + edges[i..]
+            .iter()
+            .take_while(|e| pair(e) == pair(&edges[i]))
+            .count();
+        let ahead = edges[i..j].iter().filter(|e| forward(e)).count();
+        let back = (j - i) - ahead;
+        if ahead > back {
+            kept.extend_from_slice(&edges[i..i + ahead - back]);
+        } else {
+            kept.extend_from_slice(&edges[i + ahead..i + back]);
+        }
+        i = j;
+    }
+    kept
+}
+
 thread_local! {
     static TABLES: RefCell<Tables> = RefCell::new(Tables::default());
 }
