@@ -43,7 +43,7 @@ pub struct RefineOptions {
 }
 
 /// Why refinement stopped (`refinement.stop` in `report.json`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum RefineStop {
     /// No residual exceeds the tolerance.
@@ -77,7 +77,7 @@ pub const ROUND_EPSILON: f64 = 0.02;
 
 /// One round: the residuals found, and what was split (an entry of `refinement.rounds` in
 /// `report.json`).
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, serde::Deserialize)]
 pub struct RefineRound {
     /// Triangles of the mesh at the start of the round.
     pub triangles: usize,
@@ -98,13 +98,13 @@ pub struct RefineRound {
 }
 
 /// What adaptive refinement did (`refinement` in `report.json`).
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, serde::Deserialize)]
 pub struct RefineReport {
     /// The tolerance asked for, relative to [`RefineReport::tolerance_relative_to`].
     pub tolerance: f64,
     /// What the tolerance is a fraction of: always `"mean_reflected_radiosity"`, the
     /// area-weighted mean of B − E over the surfaces that reflect, round by round.
-    pub tolerance_relative_to: &'static str,
+    pub tolerance_relative_to: String,
     /// Each round, in order. The last one splits nothing.
     pub rounds: Vec<RefineRound>,
     /// Why refinement stopped.
@@ -127,7 +127,7 @@ impl RefineReport {
     ) -> RefineReport {
         RefineReport {
             tolerance: options.tolerance,
-            tolerance_relative_to: TOLERANCE_RELATIVE_TO,
+            tolerance_relative_to: TOLERANCE_RELATIVE_TO.to_owned(),
             rounds,
             stop,
             residual,

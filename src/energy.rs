@@ -37,7 +37,7 @@ pub const CLOSURE_TOLERANCE: f64 = 1e-2;
 /// Where the emitted power went, per channel and as fractions of the emitted power (channel
 /// means), and whether that account closes (`energy` in `report.json`). Powers are radiosity
 /// times area: W/m² times the scene's units squared, so watts per channel for a scene in metres.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
 pub struct EnergyBalance {
     /// Power leaving the emitters by their own emission, per channel.
     pub emitted: Rgb,

@@ -82,7 +82,7 @@ const MEAN_SEED: u64 = 0x6d65_616e;
 const SPLIT_MARGIN: usize = 32;
 
 /// Why error-driven refinement stopped (`mesh_error.stop` in `report.json`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ErrorStop {
     /// Every refined surface's estimated RMS error is within the tolerance.
@@ -97,7 +97,7 @@ pub enum ErrorStop {
 
 /// One surface's measured interpolation error of the direct light (an entry of
 /// `mesh_error.surfaces` in `report.json`).
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, serde::Deserialize)]
 pub struct SurfaceError {
     /// The surface's name.
     pub surface: String,
@@ -128,7 +128,7 @@ pub struct SurfaceError {
 }
 
 /// What error-driven refinement did and the error it measured (`mesh_error` in `report.json`).
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, serde::Deserialize)]
 pub struct MeshErrorReport {
     /// The tolerance asked for, relative to the scene's mean reflected direct light.
     pub tolerance: f64,

@@ -124,6 +124,9 @@ pub mod options;
 pub mod outputs;
 pub mod pipeline;
 pub mod reflected_mesh;
+pub mod report;
+pub mod run_error;
+pub mod run_result;
 pub mod shard;
 
 pub use options::{

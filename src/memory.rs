@@ -74,7 +74,7 @@ impl MeshCounts {
 }
 
 /// Bytes a run needs, in parts (`memory.estimate` in `report.json`).
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, serde::Deserialize)]
 pub struct MemoryEstimate {
     /// The scene: a fixed amount per surface (its polygon, BVH triangles, discontinuity lists
     /// and mesh's fixed parts).

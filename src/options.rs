@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize};
 use crate::adaptive::RefineOptions;
 
 /// How surfaces are meshed (`--mesh`; `method.mesh_requested` in `report.json`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum MeshMethod {
     /// Constrained Delaunay triangulation of each polygon, refined to a uniform size.

@@ -7,20 +7,18 @@ use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 
-use penumbra_meshing::{ElementBudget, MeshQuality};
 use penumbra_scenes::{Rgb, Scene, SurfaceId};
-use penumbra_solver::SolveStats;
-use penumbra_solver::{SolverMethod, StopReason};
 use serde::Serialize;
 
-use crate::energy::EnergyBalance;
 pub use crate::options::Invocation;
-use crate::pipeline::{RunResult, StageTimes};
+pub use crate::report::{
+    REPORT_FORMAT, VERSION, estimated_direct_warning, mesh_error_warning, quality_warning,
+};
+use crate::report::{Report, solver_name};
+use crate::run_result::RunResult;
 
 /// The `format` of `solution.json`, and its version (`docs/schemas/solution.schema.json`).
 pub const SOLUTION_FORMAT: &str = "penumbra-solution/1";
-/// The `format` of `report.json`, and its version (`docs/schemas/report.schema.json`).
-pub const REPORT_FORMAT: &str = "penumbra-report/1";
 
 #[derive(Serialize)]
 struct SolutionFile<'a> {
@@ -140,315 +138,12 @@ pub fn solution_json_of(scene: &str, surfaces: &[SurfaceSolution]) -> String {
     })
 }
 
-/// The version of penumbra that wrote a report.
-pub const VERSION: &str = env!("CARGO_PKG_VERSION");
-
-#[derive(Serialize)]
-struct Report<'a> {
-    format: &'static str,
-    /// The version of penumbra that made the run.
-    version: &'static str,
-    /// The command line and every option, when the run came from one.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    invocation: Option<&'a Invocation>,
-    /// The run was cut short (interrupted, or its time budget spent): the solution is the best
-    /// so far, not a converged one, or its mesh lacks the events of the emitter–receiver pairs
-    /// the discontinuity search had no time for.
-    partial: bool,
-    scene: SceneSummary<'a>,
-    /// The loader's warnings, then the run's (an energy balance that does not close).
-    warnings: Vec<String>,
-    method: Method,
-    counts: Counts,
-    discontinuities: Option<&'a penumbra_meshing::discontinuity::DiscontinuityStats>,
-    /// Adaptive refinement: rounds, residuals and why it stopped (absent when not asked for).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    refinement: Option<&'a crate::adaptive::RefineReport>,
-    /// Error-driven meshes: the interpolation error of the direct light measured at every
-    /// triangle's check points, per surface and for the scene, and why refinement stopped
-    /// (absent for other meshes).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    mesh_error: Option<&'a crate::error_mesh::MeshErrorReport>,
-    times_seconds: &'a StageTimes,
-    /// Estimated need, the limit it was checked against, and the peak after each stage.
-    memory: &'a crate::pipeline::MemoryReport,
-    solver: &'a SolveStats,
-    energy: EnergyBalance,
-    mesh_quality: MeshQuality,
-    render: RenderSummary,
-    svgs: SvgSummary,
-}
-
-/// Which surfaces got an SVG, and why.
-#[derive(Serialize)]
-struct SvgSummary {
-    /// `auto` (the surfaces worth looking at), `all`, `none` or `named`.
-    selection: &'static str,
-    /// The files written, relative to the output directory, in surface order.
-    written: Vec<String>,
-}
-
-#[derive(Serialize)]
-struct SceneSummary<'a> {
-    name: &'a str,
-    source: &'a str,
-    /// A hash of every number of the scene as loaded: a replay checks it found the same scene.
-    fingerprint: String,
-    surfaces: usize,
-    emitters: usize,
-    bounding_box_diagonal: f64,
-}
-
-#[derive(Serialize)]
-struct Method {
-    /// The mesh that was built (`auto` chooses by whether the scene casts shadows).
-    mesh: &'static str,
-    mesh_requested: crate::options::MeshMethod,
-    solver: &'static str,
-    /// The element budget used: the mesh's, or the cap of adaptive refinement.
-    max_elements: usize,
-    /// What was asked for: `"fit"` (the default: what the scene needs) or a number.
-    max_elements_requested: BudgetRequested,
-    penumbra_density: f64,
-    /// Error-driven meshes' tolerance, relative to the scene's mean reflected direct light.
-    tolerance: f64,
-    /// The smallest angle discontinuity and error-driven meshes aimed for (0: none).
-    min_angle: f64,
-    eee: bool,
-    /// Which EV and VE events: `complete` or `extremal`.
-    events: penumbra_meshing::discontinuity::EventSet,
-    eee_tolerance: f64,
-    event_tolerance: f64,
-    /// Seconds the run was allowed (absent: no limit).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    time_budget: Option<f64>,
-    epsilon: f64,
-    max_shots: usize,
-    visibility_rays: usize,
-    form_factors: penumbra_solver::coupling::FormFactorMethod,
-    elements_per_patch: usize,
-    direct_only: bool,
-    seed: u64,
-    threads: usize,
-}
-
-#[derive(Serialize)]
-struct Counts {
-    triangles: usize,
-    vertices: usize,
-    patches: usize,
-    discontinuity_segments: usize,
-}
-
-/// The element budget as asked for: `"fit"` or a number.
-#[derive(Serialize)]
-#[serde(untagged)]
-enum BudgetRequested {
-    Fit(&'static str),
-    AtMost(usize),
-}
-
-impl From<ElementBudget> for BudgetRequested {
-    fn from(b: ElementBudget) -> Self {
-        match b {
-            ElementBudget::AtMost(n) => BudgetRequested::AtMost(n),
-            ElementBudget::Fit { .. } => BudgetRequested::Fit("fit"),
-        }
-    }
-}
-
-#[derive(Serialize)]
-struct RenderSummary {
-    width: u32,
-    height: u32,
-    exposure: f64,
-    ambient: Rgb,
-    /// The camera the image was made from: the scene's, or one that frames it.
-    camera: penumbra_scenes::Camera,
-}
-
-/// What to say when the direct light at some vertices is an estimate by rays, not exact.
-pub fn estimated_direct_warning(stats: &SolveStats) -> Option<String> {
-    let late = stats.direct_estimated - stats.direct_beyond_cap;
-    let mut causes = Vec::new();
-    if late > 0 {
-        causes.push(format!("{late} left when the time budget ran out"));
-    }
-    if stats.direct_beyond_cap > 0 {
-        causes.push(format!(
-            "{} whose view of a light needs a polygon difference too large to hold \
-             (solver.direct_beyond_cap)",
-            stats.direct_beyond_cap
-        ));
-    }
-    (!causes.is_empty()).then(|| {
-        format!(
-            "the direct light at {} of {} vertices is estimated with rays, not exact \
-             (solver.direct_estimated): {}",
-            stats.direct_estimated,
-            stats.receivers,
-            causes.join("; ")
-        )
-    })
-}
-
-/// A warning when `below` of the mesh's `triangles` have angles under the aim of quality
-/// refinement that the input does not force: the budget could not hold some surface's least
-/// mesh at that angle, or adaptive splits (which restore smaller angles only) made them.
-pub fn quality_warning(below: usize, triangles: usize, adaptive: bool) -> Option<String> {
-    (below > 0).then(|| {
-        let cause = if adaptive {
-            format!(
-                "adaptive splits restore angles of {} degrees only",
-                penumbra_meshing::SPLIT_MIN_ANGLE_DEG
-            )
-        } else {
-            "the element budget cannot hold the least mesh at that angle of every surface".into()
-        };
-        format!(
-            "{below} of {} triangles have an angle under {} degrees that the input does not \
-             force (mesh_quality.triangles_below_min_angle): {cause}",
-            triangles,
-            penumbra_meshing::FORCING_WEDGE_DEG
-        )
-    })
-}
-
-/// A warning naming the surfaces left above the tolerance when error-driven refinement stopped
-/// before meeting it (the budget or the time ran out).
-pub fn mesh_error_warning(report: &crate::error_mesh::MeshErrorReport) -> Option<String> {
-    let above = report.above_tolerance();
-    if report.stop == crate::error_mesh::ErrorStop::Tolerance || above.is_empty() {
-        return None;
-    }
-    const NAMED: usize = 5;
-    let mut names: Vec<String> = above
-        .iter()
-        .take(NAMED)
-        .map(|s| format!("{} ({:.2} % RMS)", s.surface, 100.0 * s.rms))
-        .collect();
-    if above.len() > NAMED {
-        names.push(format!("and {} more", above.len() - NAMED));
-    }
-    let why = match report.stop {
-        crate::error_mesh::ErrorStop::Budget => "the element budget ran out (--max-elements)",
-        crate::error_mesh::ErrorStop::TimeBudget => "the time budget ran out",
-        _ => "the run was interrupted",
-    };
-    Some(format!(
-        "{why} before the direct light's interpolation error met the tolerance of {} (RMS, \
-         relative to each surface's mean) on {} surface(s): {} (mesh_error.surfaces)",
-        report.tolerance,
-        above.len(),
-        names.join(", ")
-    ))
-}
-
-/// `report.json`, for a run whose SVGs are chosen by `svgs`: how the run was made, what it
-/// built, stage times, memory, the solver's figures, the energy balance, mesh quality and the
-/// warnings of the loader and the run (`docs/schemas/report.schema.json`).
+/// `report.json`, for a run whose SVGs are chosen by `svgs` ([`Report::of_run`]).
 pub fn report_json(result: &RunResult, svgs: &SvgSelection) -> String {
-    let scene = &result.loaded.scene;
-    let stats = &result.solution.stats;
-    let opts = &result.options;
-    let energy = EnergyBalance::of(stats);
-    let mut warnings = result.loaded.warnings.clone();
-    warnings.extend(energy.warning());
-    warnings.extend(estimated_direct_warning(stats));
-    let mesh_quality = result.mesh.quality();
-    // Error-driven meshes choose their triangles' shapes by the error they measure.
-    if result.mesh_error.is_none() {
-        warnings.extend(quality_warning(
-            mesh_quality.triangles_below_min_angle,
-            mesh_quality.triangles,
-            result.refinement.is_some(),
-        ));
-    }
-    warnings.extend(result.mesh_error.as_ref().and_then(mesh_error_warning));
-    let report = Report {
-        format: REPORT_FORMAT,
-        version: VERSION,
-        invocation: result.invocation.as_ref(),
-        partial: matches!(stats.stop, StopReason::Interrupted | StopReason::TimeBudget)
-            || result
-                .mesh
-                .discontinuity_stats
-                .as_ref()
-                .is_some_and(|d| d.pairs_skipped > 0),
-        scene: SceneSummary {
-            name: &scene.name,
-            source: &result.loaded.source,
-            fingerprint: crate::fingerprint::scene_fingerprint(&result.loaded),
-            surfaces: scene.surfaces.len(),
-            emitters: scene.emitters().count(),
-            bounding_box_diagonal: scene.diagonal(),
-        },
-        warnings,
-        method: Method {
-            mesh: if result.mesh_error.is_some() {
-                "error-driven"
-            } else if result.mesh.discontinuity_stats.is_some() {
-                "discontinuity"
-            } else {
-                "uniform"
-            },
-            mesh_requested: opts.mesh,
-            solver: report_solver_name(result),
-            max_elements: result.budget,
-            max_elements_requested: opts.max_elements.into(),
-            penumbra_density: opts.penumbra_density,
-            tolerance: opts.tolerance,
-            min_angle: opts.min_angle,
-            eee: opts.discontinuity.eee,
-            events: opts.discontinuity.events,
-            eee_tolerance: opts.discontinuity.eee_tolerance,
-            event_tolerance: opts.discontinuity.event_tolerance,
-            time_budget: opts.time_budget,
-            epsilon: opts.solver.epsilon,
-            max_shots: opts.solver.max_shots,
-            visibility_rays: opts.solver.visibility_rays,
-            form_factors: opts.solver.form_factors,
-            elements_per_patch: opts.solver.elements_per_patch,
-            direct_only: opts.solver.direct_only,
-            seed: opts.solver.seed,
-            threads: rayon::current_num_threads(),
-        },
-        counts: Counts {
-            triangles: result.mesh.triangle_count(),
-            vertices: result.mesh.vertex_count(),
-            patches: stats.patches,
-            discontinuity_segments: result.mesh.segment_count(),
-        },
-        discontinuities: result.mesh.discontinuity_stats.as_ref(),
-        refinement: result.refinement.as_ref(),
-        mesh_error: result.mesh_error.as_ref(),
-        times_seconds: &result.times,
-        memory: &result.memory,
-        solver: stats,
-        energy,
-        mesh_quality,
-        render: RenderSummary {
-            width: result.render.image.width(),
-            height: result.render.image.height(),
-            exposure: result.render.exposure,
-            ambient: result.solution.ambient,
-            camera: scene
-                .camera
-                .unwrap_or_else(|| penumbra_viz::default_camera(scene)),
-        },
-        svgs: SvgSummary {
-            selection: svgs.name(),
-            written: svgs
-                .surfaces(result)
-                .into_iter()
-                .map(|i| format!("{SVG_DIR}/{}", svg_name(i, &scene.surfaces[i].name)))
-                .collect(),
-        },
-    };
-    to_json(&report)
+    Report::of_run(result, svgs).to_json()
 }
 
-fn to_json<T: Serialize>(value: &T) -> String {
+pub(crate) fn to_json<T: Serialize>(value: &T) -> String {
     // Serializing plain structs of numbers and strings cannot fail.
     let mut s = serde_json::to_string_pretty(value).expect("serializable output (this is a bug)");
     s.push('\n');
@@ -610,7 +305,7 @@ pub fn convergence_files(result: &RunResult) -> anyhow::Result<Vec<(String, Vec<
         csv += &format!("{},{:.6e},{:.6}\n", p.iteration, p.residual, p.seconds);
     }
     let mut files = vec![("convergence.csv".to_owned(), csv.into_bytes())];
-    let name = report_solver_name(result);
+    let name = solver_name(result.options.solver.direct_only, result.options.method);
     let y_label = "residual, relative to the light put in".to_owned();
     let charts = [
         (
@@ -641,16 +336,6 @@ pub fn convergence_files(result: &RunResult) -> anyhow::Result<Vec<(String, Vec<
         files.push((format!("{stem}.png"), chart.png()?));
     }
     Ok(files)
-}
-
-/// The solver as `report.json` names it: "direct" has always meant the direct light only, so
-/// the dense solve of the full system is "dense-direct".
-fn report_solver_name(result: &RunResult) -> &'static str {
-    match (result.options.solver.direct_only, result.options.method) {
-        (true, _) => "direct",
-        (false, SolverMethod::Direct) => "dense-direct",
-        (false, method) => method.name(),
-    }
 }
 
 /// Files written all or nothing, as far as the file system allows: each is staged as a

@@ -33,7 +33,7 @@ const LEAST_SPLITS_SHARE: f64 = 0.002;
 const DARK_SHARE: f64 = 0.1;
 
 /// What refinement for the reflected light did (`mesh_error.reflected` in `report.json`).
-#[derive(Clone, Debug, Default, Serialize)]
+#[derive(Clone, Debug, Default, Serialize, serde::Deserialize)]
 pub struct ReflectedRefinement {
     /// Rounds that split triangles.
     pub rounds: usize,

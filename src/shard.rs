@@ -40,10 +40,11 @@ use crate::fingerprint::hex;
 pub use crate::fingerprint::scene_fingerprint;
 pub use crate::options::{Shard, ShardError, meshed_alone};
 use crate::outputs::{
-    DEFAULT_SVG_SURFACES, SVG_DIR, Staging, SurfaceSolution, SvgSelection, report_json,
-    solution_json_of, surface_solution, svg_name, worth_looking_at,
+    DEFAULT_SVG_SURFACES, SVG_DIR, Staging, SurfaceSolution, SvgSelection, solution_json_of,
+    surface_solution, svg_name, worth_looking_at,
 };
-use crate::pipeline::RunResult;
+use crate::report::{Report, ShardPart, ShardsSummary};
+use crate::run_result::{RunResult, StageTimes};
 
 /// The file a shard writes into its output directory.
 pub const SHARD_FILE: &str = "shard.json";
@@ -91,7 +92,7 @@ pub struct ShardFile {
     pub meshed_alone: bool,
     /// The shard's `report.json`: the discontinuities, mesh and counts of the surfaces it meshed
     /// (its own, or the whole scene's), and the power its surfaces absorbed and received.
-    pub report: serde_json::Value,
+    pub report: Report,
     /// The SVGs written beside this file, relative to its directory.
     pub svgs: Vec<String>,
     /// This shard's surfaces, each with its `index` in the scene, in the scene's order.
@@ -102,16 +103,14 @@ pub struct ShardFile {
 /// count aside, which changes no output, and what shards that mesh alone find for their own
 /// surfaces: the budget resolved and the mesh `auto` chose), the render's size and the SVG
 /// selection.
-fn run_fingerprint(report: &serde_json::Value, scene: &str, svgs: &SvgSelection) -> String {
-    let mut method = report.get("method").cloned().unwrap_or_default();
+fn run_fingerprint(report: &Report, scene: &str, svgs: &SvgSelection) -> String {
+    let mut method = serde_json::to_value(&report.method).unwrap_or_default();
     if let Some(m) = method.as_object_mut() {
         for found in ["threads", "max_elements", "mesh"] {
             m.remove(found);
         }
     }
-    let render = report
-        .get("render")
-        .map(|r| (r.get("width"), r.get("height")));
+    let render = (report.render.width, report.render.height);
     let key = serde_json::json!({
         "scene": scene,
         "method": method,
@@ -134,7 +133,7 @@ pub fn write_shard(
     use anyhow::Context;
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let scene = &result.loaded.scene;
-    let report: serde_json::Value = serde_json::from_str(&report_json(result, svgs))?;
+    let report = Report::of_run(result, svgs);
     let ours: Vec<SurfaceId> = svgs
         .surfaces(result)
         .into_iter()
@@ -362,7 +361,7 @@ pub fn check_shards(
         return Err(MergeError::Missing { missing, count });
     }
     for (dir, file) in &shards {
-        if file.report.get("partial") == Some(&serde_json::Value::Bool(true)) {
+        if file.report.partial {
             return Err(MergeError::Partial { dir: dir.clone() });
         }
         if let Some(s) = file.surfaces.iter().find(|s| {
@@ -403,6 +402,87 @@ pub struct Merged {
     pub svgs: Vec<(PathBuf, String)>,
 }
 
+/// What the shards' light adds up to: patches lie within one surface, so what is left
+/// unshot, its magnitude and the ambient term made from it (linear in it, when every shard has
+/// the whole mesh's area and mean reflectance) add up over the shards, to rounding.
+#[derive(Default)]
+struct LightSums {
+    absorbed: Rgb,
+    received: Rgb,
+    unshot: Rgb,
+    ambient: Rgb,
+    residual: f64,
+    times: StageTimes,
+}
+
+impl LightSums {
+    /// Adds a shard's figures; `emitted` is the scene's, every shard's.
+    fn add(&mut self, report: &Report, emitted: Rgb) {
+        let solver = &report.solver;
+        self.absorbed += solver.absorbed;
+        self.received += emitted - solver.escaped;
+        self.unshot += solver.unshot;
+        self.ambient += report.render.ambient;
+        self.residual += solver.residual;
+        self.times += &report.times_seconds;
+    }
+}
+
+/// The shards' parts joined: the surfaces in the scene's order, the SVGs and each shard's
+/// figures.
+struct Parts {
+    surfaces: Vec<SurfaceSolution>,
+    svgs: Vec<(PathBuf, String)>,
+    parts: Vec<ShardPart>,
+    light: LightSums,
+}
+
+/// Joins the shards' surfaces, SVGs and light; every surface of the scene must be in one.
+fn join_parts(
+    shards: Vec<(PathBuf, ShardFile)>,
+    surfaces: usize,
+    emitted: Rgb,
+) -> Result<Parts, MergeError> {
+    let count = shards.first().map_or(1, |(_, f)| f.shard.count);
+    let mut joined: Vec<Option<SurfaceSolution>> = vec![None; surfaces];
+    let (mut svgs, mut parts, mut light) = (Vec::new(), Vec::new(), LightSums::default());
+    for (dir, file) in shards {
+        light.add(&file.report, emitted);
+        parts.push(ShardPart {
+            shard: file.shard.to_string(),
+            directory: dir.display().to_string(),
+            surfaces: file.surfaces.len(),
+            vertices_lit: file.surfaces.iter().map(|s| s.vertices.len()).sum(),
+            threads: file.report.method.threads,
+            times_seconds: file.report.times_seconds.clone(),
+            peak_bytes: file.report.memory.peak_bytes.clone(),
+        });
+        svgs.extend(file.svgs.into_iter().map(|svg| (dir.join(&svg), svg)));
+        for s in file.surfaces {
+            if let Some(slot) = s.index.and_then(|i| joined.get_mut(i)) {
+                *slot = Some(SurfaceSolution { index: None, ..s });
+            }
+        }
+    }
+    let surfaces = joined
+        .into_iter()
+        .enumerate()
+        .map(|(i, s)| {
+            s.ok_or_else(|| MergeError::Missing {
+                missing: vec![i % count],
+                count,
+            })
+        })
+        .collect::<Result<_, _>>()?;
+    svgs.sort_by(|a, b| a.1.cmp(&b.1));
+    Ok(Parts {
+        surfaces,
+        svgs,
+        parts,
+        light,
+    })
+}
+
 /// Joins checked shards ([`check_shards`]). `loaded` is the scene they were run on (checked
 /// against their fingerprint), needed to render the joined solution.
 pub fn merge(
@@ -419,251 +499,172 @@ pub fn merge(
         });
     }
     let mut report = first.report.clone();
-    if first.meshed_alone {
-        let reports: Vec<&serde_json::Value> = shards.iter().map(|(_, f)| &f.report).collect();
+    let meshed_alone = first.meshed_alone;
+    if meshed_alone {
+        let reports: Vec<&Report> = shards.iter().map(|(_, f)| &f.report).collect();
         sum_mesh_figures(&mut report, &reports);
     }
     let (width, height) = (first.render_width, first.render_height);
-    let first_meshed_alone = first.meshed_alone;
     let warnings = first.warnings.clone();
     let count = first.shard.count;
     let scene = &loaded.scene;
-
-    // Solutions in the scene's order; report figures summed.
-    let mut surfaces: Vec<Option<SurfaceSolution>> = vec![None; scene.surfaces.len()];
-    let mut svgs = Vec::new();
-    let mut parts = Vec::new();
-    // Patches lie within one surface, so what is left unshot, its magnitude and the ambient
-    // term made from it (linear in it, when every shard has the whole mesh's area and mean
-    // reflectance) add up over the shards, to rounding.
-    let mut absorbed = Rgb::ZERO;
-    let mut received = Rgb::ZERO;
-    let mut unshot = Rgb::ZERO;
-    let mut ambient = Rgb::ZERO;
-    let mut residual = 0.0;
-    let mut times = serde_json::Map::new();
-    let emitted = rgb_at(&report, &["solver", "emitted"]);
-    for (dir, file) in shards {
-        absorbed += rgb_at(&file.report, &["solver", "absorbed"]);
-        received += emitted - rgb_at(&file.report, &["solver", "escaped"]);
-        unshot += rgb_at(&file.report, &["solver", "unshot"]);
-        ambient += rgb_at(&file.report, &["render", "ambient"]);
-        residual += file
-            .report
-            .pointer("/solver/residual")
-            .and_then(serde_json::Value::as_f64)
-            .unwrap_or(0.0);
-        if let Some(t) = file.report.get("times_seconds").and_then(|t| t.as_object()) {
-            for (stage, seconds) in t {
-                let sum = times.get(stage).and_then(serde_json::Value::as_f64);
-                let add = seconds.as_f64().unwrap_or(0.0);
-                times.insert(stage.clone(), (sum.unwrap_or(0.0) + add).into());
-            }
-        }
-        let vertices: usize = file.surfaces.iter().map(|s| s.vertices.len()).sum();
-        parts.push(serde_json::json!({
-            "shard": file.shard.to_string(),
-            "directory": dir.display().to_string(),
-            "surfaces": file.surfaces.len(),
-            "vertices_lit": vertices,
-            "threads": file.report.pointer("/method/threads"),
-            "times_seconds": file.report.get("times_seconds"),
-            "peak_bytes": file.report.pointer("/memory/peak_bytes"),
-        }));
-        for svg in file.svgs {
-            svgs.push((dir.join(&svg), svg));
-        }
-        for s in file.surfaces {
-            if let Some(i) = s.index
-                && let Some(slot) = surfaces.get_mut(i)
-            {
-                *slot = Some(SurfaceSolution { index: None, ..s });
-            }
-        }
-    }
-    if first_meshed_alone {
+    let emitted = report.solver.emitted;
+    let mut parts = join_parts(shards, scene.surfaces.len(), emitted)?;
+    if meshed_alone {
         // Shards that meshed alone each knew only their own surfaces' area and reflectance.
-        ambient = ambient_of(scene, unshot);
-    }
-    let surfaces: Vec<SurfaceSolution> = surfaces
-        .into_iter()
-        .enumerate()
-        .map(|(i, s)| {
-            s.ok_or_else(|| MergeError::Missing {
-                missing: vec![i % count],
-                count,
-            })
-        })
-        .collect::<Result<_, _>>()?;
-    svgs.sort_by(|a, b| a.1.cmp(&b.1));
-    let auto = report
-        .pointer("/svgs/selection")
-        .and_then(serde_json::Value::as_str)
-        == Some("auto");
-    if first_meshed_alone && auto {
-        // Each shard chose among its own surfaces (it knows no other's discontinuities); the
-        // run's choice is among the shards' choices.
-        let segments: Vec<usize> = surfaces.iter().map(|s| s.discontinuities.len()).collect();
-        let chosen: std::collections::HashSet<String> =
-            worth_looking_at(scene, &segments, DEFAULT_SVG_SURFACES)
-                .into_iter()
-                .map(|s| format!("{SVG_DIR}/{}", svg_name(s, &scene.surfaces[s].name)))
-                .collect();
-        svgs.retain(|(_, name)| chosen.contains(name));
+        parts.light.ambient = ambient_of(scene, parts.light.unshot);
+        if report.svgs.selection == "auto" {
+            keep_svgs_worth_looking_at(scene, &mut parts);
+        }
     }
 
-    // The render, from the joined meshes (their 3D vertices and triangles).
     let render_started = std::time::Instant::now();
-    let mesh = joined_mesh(loaded, &surfaces)?;
-    let display: Vec<Vec<Rgb>> = surfaces
+    let mesh = joined_mesh(loaded, &parts.surfaces)?;
+    let render = render_joined(scene, &mesh, &parts, width, height)?;
+    let render_png = penumbra_viz::encode_png(&render.image)?;
+    parts.light.times.render = render_started.elapsed().as_secs_f64();
+
+    report.partial = false;
+    // The first shard's command line would replay that shard alone.
+    report.invocation = None;
+    if meshed_alone {
+        report.mesh_quality = quality_of(&mesh.surfaces);
+    }
+    join_light(&mut report, &parts, warnings, render.exposure);
+    report.svgs.written = parts.svgs.iter().map(|(_, name)| name.clone()).collect();
+    report.times_seconds = parts.light.times.clone();
+    report.times_seconds.merge = Some(started.elapsed().as_secs_f64());
+    report.shards = Some(ShardsSummary {
+        count,
+        parts: std::mem::take(&mut parts.parts),
+    });
+    Ok(Merged {
+        scene_name: scene.name.clone(),
+        shards: count,
+        surfaces: parts.surfaces.len(),
+        triangles: parts.surfaces.iter().map(|s| s.triangles.len()).sum(),
+        vertices: parts.surfaces.iter().map(|s| s.vertices.len()).sum(),
+        solution_json: solution_json_of(&scene.name, &parts.surfaces),
+        report_json: report.to_json(),
+        render_png,
+        svgs: parts.svgs,
+    })
+}
+
+/// Shards that meshed alone each chose SVGs among their own surfaces (each knows no other's
+/// discontinuities): the run's choice is among theirs.
+fn keep_svgs_worth_looking_at(scene: &Scene, parts: &mut Parts) {
+    let segments: Vec<usize> = parts
+        .surfaces
+        .iter()
+        .map(|s| s.discontinuities.len())
+        .collect();
+    let chosen: std::collections::HashSet<String> =
+        worth_looking_at(scene, &segments, DEFAULT_SVG_SURFACES)
+            .into_iter()
+            .map(|s| format!("{SVG_DIR}/{}", svg_name(s, &scene.surfaces[s].name)))
+            .collect();
+    parts.svgs.retain(|(_, name)| chosen.contains(name));
+}
+
+/// The render of the joined meshes (their 3D vertices and triangles).
+fn render_joined(
+    scene: &Scene,
+    mesh: &SceneMesh,
+    parts: &Parts,
+    width: u32,
+    height: u32,
+) -> Result<penumbra_viz::Render, MergeError> {
+    let display: Vec<Vec<Rgb>> = parts
+        .surfaces
         .iter()
         .zip(&scene.surfaces)
         .map(|(s, surface)| {
             s.radiosity
                 .iter()
-                .map(|&c| penumbra_solver::displayed(Rgb::from(c), surface.reflectance, ambient))
+                .map(|&c| {
+                    penumbra_solver::displayed(Rgb::from(c), surface.reflectance, parts.light.ambient)
+                })
                 .collect()
         })
         .collect();
-    let render = penumbra_viz::render(
-        scene,
-        &mesh,
-        &display,
-        &penumbra_viz::RenderOptions {
-            width,
-            height,
-            ..Default::default()
-        },
-    )?;
-    let render_png = penumbra_viz::encode_png(&render.image)?;
-    times.insert(
-        "render".to_owned(),
-        render_started.elapsed().as_secs_f64().into(),
-    );
+    let options = penumbra_viz::RenderOptions {
+        width,
+        height,
+        ..Default::default()
+    };
+    Ok(penumbra_viz::render(scene, mesh, &display, &options)?)
+}
 
-    // The report: the first shard's (its scene, options, discontinuities, mesh and counts are
-    // every shard's), with the light's figures joined.
-    let solver_absorbed = serde_json::to_value(absorbed).unwrap_or_default();
-    let escaped = emitted - received;
-    let energy = EnergyBalance::new(emitted, absorbed, escaped, unshot, None);
-    let mut all_warnings = warnings;
-    all_warnings.extend(energy.warning());
-    let triangles = surfaces.iter().map(|s| s.triangles.len()).sum();
-    let vertices = surfaces.iter().map(|s| s.vertices.len()).sum();
-    if let Some(r) = report.as_object_mut() {
-        r.insert("partial".to_owned(), false.into());
-        // The first shard's command line would replay that shard alone.
-        r.remove("invocation");
-        if first_meshed_alone {
-            let quality = quality_of(&mesh.surfaces);
-            r.insert(
-                "mesh_quality".to_owned(),
-                serde_json::to_value(quality).unwrap_or_default(),
-            );
-        }
-        // The joined meshes' quality, or the first shard's whole-scene mesh's.
-        let quality_count = |key: &str| {
-            r.get("mesh_quality")
-                .and_then(|q| q.get(key))
-                .and_then(serde_json::Value::as_u64)
-                .unwrap_or(0) as usize
-        };
-        all_warnings.extend(crate::outputs::quality_warning(
-            quality_count("triangles_below_min_angle"),
-            quality_count("triangles"),
-            false,
-        ));
-        r.insert("warnings".to_owned(), all_warnings.into());
-        r.insert(
-            "energy".to_owned(),
-            serde_json::to_value(&energy).unwrap_or_default(),
-        );
-        if let Some(solver) = r.get_mut("solver").and_then(|s| s.as_object_mut()) {
-            solver.insert("absorbed".to_owned(), solver_absorbed);
-            solver.insert(
-                "escaped".to_owned(),
-                serde_json::to_value(escaped).unwrap_or_default(),
-            );
-            let json = |rgb: Rgb| serde_json::to_value(rgb).unwrap_or_default();
-            solver.insert("unshot".to_owned(), json(unshot));
-            solver.insert("unshot_fraction".to_owned(), residual.into());
-            solver.insert("residual".to_owned(), residual.into());
-            if let Some(t) = times.get("direct") {
-                solver.insert("direct_seconds".to_owned(), t.clone());
-            }
-        }
-        if let Some(render_summary) = r.get_mut("render").and_then(|s| s.as_object_mut()) {
-            render_summary.insert("exposure".to_owned(), render.exposure.into());
-            render_summary.insert(
-                "ambient".to_owned(),
-                serde_json::to_value(ambient).unwrap_or_default(),
-            );
-        }
-        if let Some(s) = r.get_mut("svgs").and_then(|s| s.as_object_mut()) {
-            let written: Vec<&String> = svgs.iter().map(|(_, name)| name).collect();
-            s.insert(
-                "written".to_owned(),
-                serde_json::to_value(written).unwrap_or_default(),
-            );
-        }
-        times.insert("merge".to_owned(), started.elapsed().as_secs_f64().into());
-        r.insert("times_seconds".to_owned(), times.into());
-        r.insert(
-            "shards".to_owned(),
-            serde_json::json!({"count": count, "parts": parts}),
-        );
-    }
-    let mut report_json = serde_json::to_string_pretty(&report).unwrap_or_default();
-    report_json.push('\n');
-    Ok(Merged {
-        scene_name: scene.name.clone(),
-        shards: count,
-        surfaces: surfaces.len(),
-        triangles,
-        vertices,
-        solution_json: solution_json_of(&scene.name, &surfaces),
-        report_json,
-        render_png,
-        svgs,
-    })
+/// The light's figures joined over the shards into the first shard's `report` (its scene,
+/// options, discontinuities, mesh and counts are every shard's), with the warnings they call
+/// for.
+fn join_light(report: &mut Report, parts: &Parts, warnings: Vec<String>, exposure: f64) {
+    let light = &parts.light;
+    let emitted = report.solver.emitted;
+    let escaped = emitted - light.received;
+    let energy = EnergyBalance::new(emitted, light.absorbed, escaped, light.unshot, None);
+    report.warnings = warnings;
+    report.warnings.extend(energy.warning());
+    // The joined meshes' quality, or the first shard's whole-scene mesh's.
+    report.warnings.extend(crate::outputs::quality_warning(
+        report.mesh_quality.triangles_below_min_angle,
+        report.mesh_quality.triangles,
+        false,
+    ));
+    report.energy = energy;
+    let solver = &mut report.solver;
+    solver.absorbed = light.absorbed;
+    solver.escaped = escaped;
+    solver.unshot = light.unshot;
+    solver.unshot_fraction = light.residual;
+    solver.residual = light.residual;
+    solver.direct_seconds = light.times.direct;
+    report.render.exposure = exposure;
+    report.render.ambient = light.ambient;
 }
 
 /// The figures of shards that each meshed their own surfaces, joined into `report`: the
 /// discontinuity search's, the mesh's counts and the budget resolved, summed (the largest of
 /// those named `..._max`).
-fn sum_mesh_figures(report: &mut serde_json::Value, shards: &[&serde_json::Value]) {
-    let sum = |path: &str| -> serde_json::Value {
-        let values: Vec<&serde_json::Value> =
-            shards.iter().filter_map(|r| r.pointer(path)).collect();
+fn sum_mesh_figures(report: &mut Report, shards: &[&Report]) {
+    report.method.max_elements = shards.iter().map(|r| r.method.max_elements).sum();
+    let counts = &mut report.counts;
+    counts.triangles = shards.iter().map(|r| r.counts.triangles).sum();
+    counts.vertices = shards.iter().map(|r| r.counts.vertices).sum();
+    counts.patches = shards.iter().map(|r| r.counts.patches).sum();
+    counts.discontinuity_segments = shards.iter().map(|r| r.counts.discontinuity_segments).sum();
+    let found: Vec<serde_json::Value> = shards
+        .iter()
+        .filter_map(|r| r.discontinuities.as_ref())
+        .filter_map(|d| serde_json::to_value(d).ok())
+        .collect();
+    if let Some(mut sum) = report
+        .discontinuities
+        .as_ref()
+        .and_then(|d| serde_json::to_value(d).ok())
+    {
+        sum_numbers(&mut sum, &found);
+        report.discontinuities = serde_json::from_value(sum).ok();
+    }
+}
+
+/// Each number field of the object `sum` made the sum of that field over `all` (the largest
+/// for fields named `..._max`): counts stay integers.
+fn sum_numbers(sum: &mut serde_json::Value, all: &[serde_json::Value]) {
+    let Some(fields) = sum.as_object_mut() else {
+        return;
+    };
+    for (key, slot) in fields.iter_mut().filter(|(_, v)| v.is_number()) {
+        let values: Vec<&serde_json::Value> = all.iter().filter_map(|r| r.get(key)).collect();
         let floats = values.iter().filter_map(|v| v.as_f64());
-        if path.ends_with("_max") {
+        *slot = if key.ends_with("_max") {
             floats.fold(f64::NEG_INFINITY, f64::max).into()
         } else if values.iter().all(|v| v.is_u64()) {
             values.iter().filter_map(|v| v.as_u64()).sum::<u64>().into()
         } else {
             floats.sum::<f64>().into()
-        }
-    };
-    let mut paths = vec![
-        "/method/max_elements".to_owned(),
-        "/counts/triangles".to_owned(),
-        "/counts/vertices".to_owned(),
-        "/counts/patches".to_owned(),
-        "/counts/discontinuity_segments".to_owned(),
-    ];
-    if let Some(found) = report.get("discontinuities").and_then(|d| d.as_object()) {
-        paths.extend(
-            found
-                .iter()
-                .filter(|(_, v)| v.is_number())
-                .map(|(key, _)| format!("/discontinuities/{key}")),
-        );
-    }
-    for path in paths {
-        let total = sum(&path);
-        if let Some(slot) = report.pointer_mut(&path) {
-            *slot = total;
-        }
+        };
     }
 }
 
@@ -678,14 +679,6 @@ fn ambient_of(scene: &Scene, unshot: Rgb) -> Rgb {
         .sum::<Rgb>()
         / area;
     penumbra_solver::ambient_term(unshot, area, mean_reflectance)
-}
-
-/// An RGB triple at `path` in a report, zero if absent.
-fn rgb_at(report: &serde_json::Value, path: &[&str]) -> Rgb {
-    path.iter()
-        .try_fold(report, |v, key| v.get(key))
-        .and_then(|v| serde_json::from_value::<Rgb>(v.clone()).ok())
-        .unwrap_or(Rgb::ZERO)
 }
 
 /// Meshes to render, from the joined surfaces' 3D vertices and triangles (in each surface's

@@ -256,7 +256,7 @@ fn mean_reflected(solution: &serde_json::Value) -> f64 {
 }
 
 /// `--replay` runs a report's recorded options again: the same solution, byte for byte; it
-/// takes no other options, and refuses a file that records none.
+/// takes no other options, and refuses a file that is not a report or records no command line.
 #[test]
 fn replays_repeat_a_run() {
     let dir = tempfile::tempdir().expect("temp dir");
@@ -308,6 +308,18 @@ fn replays_repeat_a_run() {
         "--replay",
         first.join("solution.json").to_str().expect("utf-8"),
     ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("its format is \"penumbra-solution/1\""),
+        "{}",
+        stderr(&o)
+    );
+    // A report written by a library caller records no command line.
+    let mut bare = report.clone();
+    bare.as_object_mut().expect("object").remove("invocation");
+    let bare_path = dir.path().join("bare.json");
+    std::fs::write(&bare_path, bare.to_string()).expect("writes");
+    let o = penumbra(&["run", "--replay", bare_path.to_str().expect("utf-8")]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(
         stderr(&o).contains("no command line to replay"),

@@ -46,4 +46,7 @@ pub enum MeshError {
         /// The broken invariant.
         what: String,
     },
+    /// The interrupt ([`crate::Interrupt`]) was set: meshing stopped, and its mesh was let go.
+    #[error("meshing was interrupted")]
+    Interrupted,
 }

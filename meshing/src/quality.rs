@@ -8,7 +8,7 @@ use crate::tolerances::FORCING_WEDGE_DEG;
 
 /// Mesh quality figures: the smallest angle and the distribution of aspect ratios
 /// (circumradius over twice the inradius: 1 for an equilateral triangle).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, serde::Deserialize)]
 pub struct MeshQuality {
     /// Triangles measured.
     pub triangles: usize,

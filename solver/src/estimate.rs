@@ -229,7 +229,7 @@ pub fn direct_residuals(
 }
 
 /// A scene's residuals summed up.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, serde::Deserialize)]
 pub struct ResidualSummary {
     /// The largest triangle residual.
     pub max: f64,

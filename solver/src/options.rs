@@ -120,7 +120,7 @@ impl SolverOptions {
 }
 
 /// How point-to-patch form factors are computed.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum FormFactorMethod {
     /// Lambert's formula over the patch, exact, times a visibility fraction from rays.

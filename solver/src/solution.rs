@@ -5,7 +5,7 @@ use penumbra_scenes::Rgb;
 use serde::Serialize;
 
 /// Why the solver stopped.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum StopReason {
     /// Unshot power fell below epsilon of the emitted power.
@@ -22,7 +22,7 @@ pub enum StopReason {
 }
 
 /// Figures of a solve. Powers are in W per channel (radiosity times area in scene units).
-#[derive(Clone, Debug, Default, Serialize)]
+#[derive(Clone, Debug, Default, Serialize, serde::Deserialize)]
 pub struct SolveStats {
     /// Why the solver stopped.
     pub stop: StopReason,
@@ -82,7 +82,7 @@ pub struct SolveStats {
 
 /// One step of a solver: its residual relative to the light put in (for progressive refinement
 /// the unshot fraction, for gathering ‖c + K B̄ − B̄‖ / ‖c‖) and the seconds since it began.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, serde::Deserialize)]
 pub struct ConvergencePoint {
     /// Steps done (0: the start, before any).
     pub iteration: usize,
@@ -113,7 +113,7 @@ pub struct Solution {
 }
 
 /// Figures of a hierarchical solve, under `solver.hierarchy` in `report.json`.
-#[derive(Clone, Debug, Default, Serialize)]
+#[derive(Clone, Debug, Default, Serialize, serde::Deserialize)]
 pub struct HierarchyStats {
     /// The link tolerance the solve refined to.
     pub link_tol: f64,
@@ -160,7 +160,7 @@ pub struct HierarchyStats {
 }
 
 /// What making the map did (`solver.photon_map` in `report.json`).
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, serde::Deserialize)]
 pub struct PhotonStats {
     /// Photons emitted.
     pub emitted: usize,

@@ -23,9 +23,10 @@ use penumbra_scenes::{Camera, Rgb};
 use serde::Deserialize;
 
 use crate::outputs::{
-    SOLUTION_FORMAT, SurfaceSolution, SvgSelection, report_json, surface_solution,
+    SOLUTION_FORMAT, SurfaceSolution, SvgSelection, surface_solution,
 };
 use crate::pipeline::RunResult;
+use crate::report::Report;
 
 use mesh::{FlatMesh, Line};
 pub use viewer::VIEWER_FORMAT;
@@ -193,7 +194,7 @@ pub struct ExportSource {
     /// The surfaces, as `solution.json` gives them.
     pub surfaces: Vec<SurfaceSolution>,
     /// `report.json`.
-    pub report: serde_json::Value,
+    pub report: Report,
 }
 
 #[derive(Deserialize)]
@@ -212,8 +213,7 @@ impl ExportSource {
         ExportSource {
             scene: result.loaded.scene.name.clone(),
             surfaces,
-            // The report is penumbra's own serialization: it parses.
-            report: serde_json::from_str(&report_json(result, svgs)).unwrap_or_default(),
+            report: Report::of_run(result, svgs),
         }
     }
 
@@ -246,18 +246,9 @@ impl ExportSource {
             );
             return Err(malformed("solution.json", "solution", reason));
         }
-        let report: serde_json::Value = serde_json::from_str(report)
+        let report = Report::parse(report)
             .map_err(|e| malformed("report.json", "report", e.to_string()))?;
-        if report.get("format").and_then(|f| f.as_str()) != Some(crate::outputs::REPORT_FORMAT) {
-            let reason = format!("its format is not {:?}", crate::outputs::REPORT_FORMAT);
-            return Err(malformed("report.json", "report", reason));
-        }
-        let (name, count) = (
-            report.pointer("/scene/name"),
-            report.pointer("/scene/surfaces"),
-        );
-        if name.and_then(|n| n.as_str()) != Some(solution.scene.as_str())
-            || count.and_then(serde_json::Value::as_u64) != Some(solution.surfaces.len() as u64)
+        if report.scene.name != solution.scene || report.scene.surfaces != solution.surfaces.len()
         {
             let reason = format!(
                 "it is not the report of solution.json's run (scene {:?} of {} surfaces)",
@@ -280,24 +271,23 @@ impl ExportSource {
     /// How `render.png` showed values: `report.json`'s `render.exposure` and
     /// `render.ambient`.
     pub fn display(&self) -> Result<Display, String> {
-        let render = self.report.get("render").ok_or("it has no render")?;
-        let exposure = render
-            .get("exposure")
-            .and_then(serde_json::Value::as_f64)
-            .filter(|e| e.is_finite() && *e > 0.0)
-            .ok_or("its render.exposure is not a positive number")?;
-        let ambient = render
-            .get("ambient")
-            .and_then(|a| Rgb::deserialize(a).ok())
-            .filter(|a| a.is_finite())
-            .ok_or("its render.ambient is not an RGB colour")?;
-        Ok(Display { exposure, ambient })
+        let render = &self.report.render;
+        if !(render.exposure.is_finite() && render.exposure > 0.0) {
+            return Err("its render.exposure is not a positive number".into());
+        }
+        if !render.ambient.is_finite() {
+            return Err("its render.ambient is not an RGB colour".into());
+        }
+        Ok(Display {
+            exposure: render.exposure,
+            ambient: render.ambient,
+        })
     }
 
     /// The camera `render.png` was made from (`report.json`'s `render.camera`), if recorded
     /// and usable: finite, looking somewhere, with a field of view in (0, 180) degrees.
     pub fn camera(&self) -> Option<Camera> {
-        let camera = Camera::deserialize(self.report.pointer("/render/camera")?).ok()?;
+        let camera = self.report.render.camera?;
         let view = camera.target - camera.eye;
         let finite = camera.eye.is_finite() && view.is_finite() && camera.up.is_finite();
         let upright = view.cross(camera.up).length_squared() > 0.0;

@@ -174,7 +174,7 @@ impl Default for DiscontinuityOptions {
 }
 
 /// What discontinuity finding did.
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, serde::Deserialize)]
 pub struct DiscontinuityStats {
     /// Emitter–receiver pairs that face each other.
     pub pairs: usize,

@@ -3,6 +3,7 @@
 use std::path::Path;
 
 use clap::Parser;
+use penumbra::report::Report;
 
 use crate::failure::{Failure, usage};
 use crate::run_args::RunArgs;
@@ -19,18 +20,14 @@ pub(crate) fn recorded(report: &Path, given: &RunArgs) -> Result<Recorded, Failu
     refuse_other_options(given)?;
     let bad = |why: String| usage(anyhow::anyhow!("--replay {}: {why}", report.display()));
     let text = std::fs::read_to_string(report).map_err(|e| bad(format!("cannot read it: {e}")))?;
-    let json: serde_json::Value =
-        serde_json::from_str(&text).map_err(|e| bad(format!("not a report.json: {e}")))?;
-    let version = json["version"].as_str().unwrap_or("before 0.1.0");
-    let invocation = &json["invocation"];
-    let Some(options) = invocation.get("options") else {
+    let recorded = Report::parse(&text).map_err(|e| bad(e.to_string()))?;
+    let version = recorded.version.as_str();
+    let Some(invocation) = &recorded.invocation else {
         return Err(bad(
-            "it records no command line to replay (it was not written by `penumbra run`, or by \
-             a version before replays)"
-                .into(),
+            "it records no command line to replay (it was not written by `penumbra run`)".into(),
         ));
     };
-    let mut args: RunArgs = serde_json::from_value(options.clone()).map_err(|e| {
+    let mut args: RunArgs = serde_json::from_value(invocation.options.clone()).map_err(|e| {
         bad(format!(
             "its options are not those of this version ({}; it was written by penumbra \
              {version}): {e}",
@@ -40,8 +37,8 @@ pub(crate) fn recorded(report: &Path, given: &RunArgs) -> Result<Recorded, Failu
     args.out.clone_from(&given.out);
     args.quiet = given.quiet;
     args.replay = None;
-    if let (Some(scene), Some(dir)) = (&args.scene, invocation["working_directory"].as_str()) {
-        args.scene = Some(resolve(scene, Path::new(dir)));
+    if let Some(scene) = &args.scene {
+        args.scene = Some(resolve(scene, Path::new(&invocation.working_directory)));
     }
     if version != penumbra::outputs::VERSION && !given.quiet {
         eprintln!(
@@ -52,7 +49,7 @@ pub(crate) fn recorded(report: &Path, given: &RunArgs) -> Result<Recorded, Failu
     }
     Ok(Recorded {
         args,
-        fingerprint: json["scene"]["fingerprint"].as_str().map(str::to_owned),
+        fingerprint: Some(recorded.scene.fingerprint.clone()),
     })
 }
 

@@ -6,6 +6,8 @@ use crate::progress_bar::Bars;
 use anyhow::Context;
 use penumbra::export::{ExportFormat, export_run};
 use penumbra::outputs::{Invocation, SvgSelection, write_outputs};
+use penumbra::RunResult;
+use penumbra::pipeline::{Kept, Stage};
 use penumbra_solver::Interrupt;
 
 use crate::failure::{Command, Failure, invalid_option, run_failure, usage};
@@ -91,28 +93,17 @@ pub(crate) fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
 
 /// A run; `fingerprint` is the scene's as a replayed report recorded it.
 fn run_with(args: &RunArgs, fingerprint: Option<&str>) -> Result<ExitCode, Failure> {
-    if let Some(n) = args.threads {
-        if !(1..=MAX_THREADS).contains(&n) {
-            return Err(usage(anyhow::anyhow!(
-                "--threads must be from 1 to {MAX_THREADS}, not {n}"
-            )));
-        }
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build_global()
-            .context("cannot start the worker threads")?;
-    }
+    start_threads(args.threads)?;
     let interrupt = Interrupt::default();
     let mut options = args.options(&interrupt);
     options
         .validate()
         .map_err(|e| invalid_option(&e, Command::Run))?;
-    let shard = args
+    options.shard = args
         .shard
         .as_deref()
         .map(|text| shard_of(text, args))
         .transpose()?;
-    options.shard = shard;
     let spec = args.scene.as_deref().unwrap_or_default();
     let mut loaded = load(spec, obj_options(args.no_merge))?;
     // The camera the options give, if any: it replaces the scene's, and a shard records it.
@@ -122,17 +113,7 @@ fn run_with(args: &RunArgs, fingerprint: Option<&str>) -> Result<ExitCode, Failu
         loaded.scene.camera = camera;
     }
     if !args.quiet {
-        for w in &loaded.warnings {
-            eprintln!("warning: {w}");
-        }
-        if let Some(recorded) = fingerprint
-            && recorded != penumbra::shard::scene_fingerprint(&loaded)
-        {
-            eprintln!(
-                "warning: {spec} is not the scene the recorded run loaded (its fingerprint \
-                 differs): the results will differ"
-            );
-        }
+        warn_on_load(&loaded, spec, fingerprint);
     }
     let svgs = svg_selection(&args.svg, &loaded.scene)?;
     let exports = crate::export::formats("--export", &args.export)?;
@@ -154,68 +135,151 @@ fn run_with(args: &RunArgs, fingerprint: Option<&str>) -> Result<ExitCode, Failu
         Err(e) => return Err(run_failure(e, Command::Run)),
     };
     if !args.quiet {
-        let stats = &result.solution.stats;
-        let energy = penumbra::energy::EnergyBalance::of(stats).warning();
-        for w in energy
-            .into_iter()
-            .chain(penumbra::outputs::estimated_direct_warning(stats))
-        {
-            eprintln!("warning: {w}");
-        }
+        warn_on_result(&result);
     }
     result.invocation = Some(invocation(args)?);
-    if let Some(shard) = shard {
-        let origin = penumbra::shard::SceneOrigin {
-            spec: spec.to_owned(),
-            no_merge: args.no_merge,
-            camera,
-        };
-        let written = penumbra::shard::write_shard(&result, shard, origin, &args.out, &svgs)?;
-        if !args.quiet {
-            let on = shard.surfaces(result.mesh.surfaces.len());
-            let lit = |count: fn(&penumbra_meshing::SurfaceMesh) -> usize| -> usize {
-                result
-                    .mesh
-                    .surfaces
-                    .iter()
-                    .zip(&on)
-                    .filter(|(_, on)| **on)
-                    .map(|(m, _)| count(m))
-                    .sum()
+    match options.shard {
+        Some(shard) => {
+            let origin = penumbra::shard::SceneOrigin {
+                spec: spec.to_owned(),
+                no_merge: args.no_merge,
+                camera,
             };
-            println!(
-                "{}: shard {shard}: {} of {} surfaces, {} triangles, {} vertices lit; direct light \
-                 {:.2} s, {:.2} s in all",
-                result.loaded.scene.name,
-                on.iter().filter(|&&b| b).count(),
-                on.len(),
-                lit(penumbra_meshing::SurfaceMesh::triangle_count),
-                lit(penumbra_meshing::SurfaceMesh::vertex_count),
-                result.times.direct,
-                result.times.total
-            );
-            println!(
-                "wrote {} files to {} (join the shards with `penumbra merge`)",
-                written.len(),
+            write_shard(&result, shard, origin, args, &svgs)?;
+        }
+        None => write_run(&result, args, &svgs, &exports)?,
+    }
+    if interrupt.is_set() {
+        if let Some(stopped) = result.stopped {
+            eprintln!(
+                "interrupted in the {} stage: wrote {} to {}, marked partial in report.json",
+                stage_name(stopped.stage),
+                match stopped.kept {
+                    Kept::SolutionSoFar => "the solution so far",
+                    Kept::LeastMeshDirect => "the scene's least mesh with its direct light",
+                },
                 args.out.display()
             );
         }
-        if interrupt.is_set() {
-            return Ok(signals.status());
-        }
-        return Ok(ExitCode::SUCCESS);
+        return Ok(signals.status());
     }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// How `report.json` names a stage.
+fn stage_name(stage: Stage) -> String {
+    serde_json::to_value(stage)
+        .ok()
+        .and_then(|v| v.as_str().map(str::to_owned))
+        .unwrap_or_default()
+}
+
+/// `--threads`: the worker pool's size, if given.
+fn start_threads(threads: Option<usize>) -> Result<(), Failure> {
+    let Some(n) = threads else {
+        return Ok(());
+    };
+    if !(1..=MAX_THREADS).contains(&n) {
+        return Err(usage(anyhow::anyhow!(
+            "--threads must be from 1 to {MAX_THREADS}, not {n}"
+        )));
+    }
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(n)
+        .build_global()
+        .context("cannot start the worker threads")?;
+    Ok(())
+}
+
+/// The loader's warnings, and one when a replayed run's scene is not the one it recorded
+/// (`fingerprint`).
+fn warn_on_load(loaded: &penumbra_scenes::LoadedScene, spec: &str, fingerprint: Option<&str>) {
+    for w in &loaded.warnings {
+        eprintln!("warning: {w}");
+    }
+    if let Some(recorded) = fingerprint
+        && recorded != penumbra::shard::scene_fingerprint(loaded)
+    {
+        eprintln!(
+            "warning: {spec} is not the scene the recorded run loaded (its fingerprint \
+             differs): the results will differ"
+        );
+    }
+}
+
+/// The run's warnings worth saying at once: energy that does not balance, direct light
+/// estimated by rays.
+fn warn_on_result(result: &RunResult) {
+    let stats = &result.solution.stats;
+    let energy = penumbra::energy::EnergyBalance::of(stats).warning();
+    for w in energy
+        .into_iter()
+        .chain(penumbra::outputs::estimated_direct_warning(stats))
+    {
+        eprintln!("warning: {w}");
+    }
+}
+
+/// A shard's files, and what it lit.
+fn write_shard(
+    result: &RunResult,
+    shard: penumbra::shard::Shard,
+    origin: penumbra::shard::SceneOrigin,
+    args: &RunArgs,
+    svgs: &SvgSelection,
+) -> Result<(), Failure> {
+    let written = penumbra::shard::write_shard(result, shard, origin, &args.out, svgs)?;
+    if args.quiet {
+        return Ok(());
+    }
+    let on = shard.surfaces(result.mesh.surfaces.len());
+    let lit = |count: fn(&penumbra_meshing::SurfaceMesh) -> usize| -> usize {
+        result
+            .mesh
+            .surfaces
+            .iter()
+            .zip(&on)
+            .filter(|(_, on)| **on)
+            .map(|(m, _)| count(m))
+            .sum()
+    };
+    println!(
+        "{}: shard {shard}: {} of {} surfaces, {} triangles, {} vertices lit; direct light \
+         {:.2} s, {:.2} s in all",
+        result.loaded.scene.name,
+        on.iter().filter(|&&b| b).count(),
+        on.len(),
+        lit(penumbra_meshing::SurfaceMesh::triangle_count),
+        lit(penumbra_meshing::SurfaceMesh::vertex_count),
+        result.times.direct,
+        result.times.total
+    );
+    println!(
+        "wrote {} files to {} (join the shards with `penumbra merge`)",
+        written.len(),
+        args.out.display()
+    );
+    Ok(())
+}
+
+/// A whole run's files: its own, then its exports (the run's files are written even when its
+/// exports cannot be).
+fn write_run(
+    result: &RunResult,
+    args: &RunArgs,
+    svgs: &SvgSelection,
+    exports: &[ExportFormat],
+) -> Result<(), Failure> {
     let mut extra = if args.convergence {
-        penumbra::outputs::convergence_files(&result)?
+        penumbra::outputs::convergence_files(result)?
     } else {
         Vec::new()
     };
-    // The run's own files are written even when its exports cannot be.
-    let exported = export_run(&result, &svgs, &exports);
+    let exported = export_run(result, svgs, exports);
     if let Ok(files) = &exported {
         extra.extend(files.iter().cloned());
     }
-    let written = write_outputs(&result, &args.out, &svgs, extra)?;
+    let written = write_outputs(result, &args.out, svgs, extra)?;
     if !args.quiet {
         let stats = &result.solution.stats;
         println!(
@@ -245,14 +309,7 @@ fn run_with(args: &RunArgs, fingerprint: Option<&str>) -> Result<ExitCode, Failu
         )
         .into());
     }
-    if interrupt.is_set() {
-        eprintln!(
-            "interrupted: wrote the solution so far to {}, marked partial in report.json",
-            args.out.display()
-        );
-        return Ok(signals.status());
-    }
-    Ok(ExitCode::SUCCESS)
+    Ok(())
 }
 
 /// The command line of this run, for `report.json`.
