@@ -245,11 +245,16 @@ pub enum ReportError {
     #[error("not a report.json of penumbra {VERSION}: {0}")]
     Malformed(#[from] serde_json::Error),
     /// A JSON document of another kind, or another version of the format.
-    #[error("its format is {found:?}, not {REPORT_FORMAT:?}")]
+    #[error("its format is {}, not {REPORT_FORMAT:?}", quoted_or_none(.found))]
     Format {
         /// The `format` it has, if any.
         found: Option<String>,
     },
+}
+
+/// `"text"`, or `none` when there is no text.
+fn quoted_or_none(text: &Option<String>) -> String {
+    text.as_deref().map_or("none".to_owned(), |t| format!("{t:?}"))
 }
 
 impl Report {

@@ -179,6 +179,94 @@ fn the_schemas_are_valid_and_document_every_field() {
     }
 }
 
+/// A value of every field `schema` names (resolved against `root`'s `$defs`), each within its
+/// schema's rules: the document a reader of the schema may meet that has everything in it.
+fn example_of(schema: &Value, root: &Value) -> Value {
+    if let Some(path) = schema["$ref"].as_str() {
+        let name = path.trim_start_matches("#/$defs/");
+        return example_of(&root["$defs"][name], root);
+    }
+    if let Some(value) = schema.get("const") {
+        return value.clone();
+    }
+    if let Some(first) = schema["enum"].as_array().and_then(|e| e.first()) {
+        return first.clone();
+    }
+    for choice in ["oneOf", "anyOf"] {
+        if let Some(options) = schema[choice].as_array() {
+            let option = options.iter().find(|o| o["type"] != "null");
+            return example_of(option.expect("a choice that is not null"), root);
+        }
+    }
+    let types: Vec<&str> = match &schema["type"] {
+        Value::String(t) => vec![t.as_str()],
+        Value::Array(ts) => ts.iter().filter_map(Value::as_str).collect(),
+        _ => vec!["object"],
+    };
+    match types.into_iter().find(|&t| t != "null").unwrap_or("null") {
+        "object" => {
+            let properties = schema["properties"].as_object().into_iter().flatten();
+            Value::Object(
+                properties
+                    .map(|(name, sub)| (name.clone(), example_of(sub, root)))
+                    .collect(),
+            )
+        }
+        "array" => {
+            let items = schema["minItems"].as_u64().unwrap_or(1).max(1) as usize;
+            Value::Array(vec![example_of(&schema["items"], root); items])
+        }
+        "string" => json!(match schema["pattern"].as_str() {
+            Some("^[0-9]+/[0-9]+$") => "1/2",
+            Some("^[0-9]+\\.[0-9]+\\.[0-9]+") => "1.2.3",
+            Some("^[0-9a-f]{16}$") => "0123456789abcdef",
+            Some("^surfaces/[0-9]{3,}-[A-Za-z0-9_-]*\\.svg$") => "surfaces/000-floor.svg",
+            Some(other) => panic!("no example for the pattern {other}: add one"),
+            None => "text",
+        }),
+        "boolean" => json!(true),
+        "integer" => json!(schema["minimum"].as_u64().unwrap_or(1)),
+        "number" => json!(number_within(schema)),
+        "null" => Value::Null,
+        other => panic!("no example of the type {other}"),
+    }
+}
+
+/// A number within a number schema's bounds.
+fn number_within(schema: &Value) -> f64 {
+    let low = schema["minimum"]
+        .as_f64()
+        .or(schema["exclusiveMinimum"].as_f64())
+        .unwrap_or(0.0);
+    match schema["maximum"].as_f64() {
+        Some(high) => (low + high) / 2.0,
+        None => low + 0.5,
+    }
+}
+
+/// The schema of `report.json` and the one type that writes and reads it name the same fields:
+/// a report with every field the schema names reads into [`penumbra::report::Report`] (which
+/// refuses fields it does not have), and written back it matches the schema (which refuses
+/// fields it does not name) and has every field it had.
+#[test]
+fn the_report_type_and_its_schema_name_the_same_fields() {
+    let root = schema(REPORT_SCHEMA);
+    let everything = example_of(&root, &root);
+    assert_matches(REPORT_SCHEMA, &everything, "the example report");
+    let text = everything.to_string();
+    let report = penumbra::report::Report::parse(&text).unwrap_or_else(|e| {
+        panic!("a report with every field of docs/schemas/{REPORT_SCHEMA} does not read: {e}")
+    });
+    let written: Value = serde_json::from_str(&report.to_json()).expect("JSON");
+    assert_matches(REPORT_SCHEMA, &written, "the example report written back");
+    assert_eq!(written, everything, "a field was lost in the round trip");
+    // Not vacuous: a field the type lacks is refused, by name.
+    let mut more = everything.clone();
+    more["scene"]["colour"] = json!("red");
+    let refused = penumbra::report::Report::parse(&more.to_string()).expect_err("refused");
+    assert!(refused.to_string().contains("colour"), "{refused}");
+}
+
 /// A field the schema does not know, and values it does not allow, are rejected, and the
 /// message names where in the document they are.
 #[test]
