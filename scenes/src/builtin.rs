@@ -127,13 +127,43 @@ fn facing(mut polygon: Vec<DVec3>, point: DVec3, outward: bool) -> Vec<DVec3> {
 /// their five visible faces.
 pub fn cornell() -> Scene {
     let white = Rgb::splat(0.73);
+    let mut surfaces = cornell_room(white);
+    let short_top = [
+        v(130.0, 165.0, 65.0),
+        v(82.0, 165.0, 225.0),
+        v(240.0, 165.0, 272.0),
+        v(290.0, 165.0, 114.0),
+    ];
+    let tall_top = [
+        v(423.0, 330.0, 247.0),
+        v(265.0, 330.0, 296.0),
+        v(314.0, 330.0, 456.0),
+        v(472.0, 330.0, 406.0),
+    ];
+    for (block, top) in [("short_block", short_top), ("tall_block", tall_top)] {
+        surfaces.extend(cornell_block(block, top, white));
+    }
+    Scene {
+        name: "cornell".into(),
+        camera: Some(Camera {
+            eye: v(278.0, 273.0, -800.0),
+            target: v(278.0, 273.0, 0.0),
+            up: v(0.0, 1.0, 0.0),
+            // 35 mm focal length on a 25 mm film.
+            fov_deg: 2.0 * (12.5f64 / 35.0).atan().to_degrees(),
+        }),
+        surfaces,
+    }
+}
+
+/// The Cornell box's room: floor, ceiling, the three walls and the light, all facing inside.
+fn cornell_room(white: Rgb) -> Vec<Surface> {
     let red = Rgb::new(0.63, 0.065, 0.05);
     let green = Rgb::new(0.14, 0.45, 0.091);
     let inside = v(278.0, 274.4, 279.6);
     let wall =
         |name: &str, p: Vec<DVec3>, rho: Rgb| Surface::new(name, facing(p, inside, false), rho);
-
-    let mut surfaces = vec![
+    vec![
         wall(
             "floor",
             vec![
@@ -204,49 +234,28 @@ pub fn cornell() -> Scene {
             Rgb::splat(0.78),
         )
         .with_emission(Rgb::new(57.8, 49.0, 25.1)),
-    ];
+    ]
+}
 
-    let short_top = [
-        v(130.0, 165.0, 65.0),
-        v(82.0, 165.0, 225.0),
-        v(240.0, 165.0, 272.0),
-        v(290.0, 165.0, 114.0),
-    ];
-    let tall_top = [
-        v(423.0, 330.0, 247.0),
-        v(265.0, 330.0, 296.0),
-        v(314.0, 330.0, 456.0),
-        v(472.0, 330.0, 406.0),
-    ];
-    for (block, top) in [("short_block", short_top), ("tall_block", tall_top)] {
-        let center = polygon::centroid(&top) * DVec3::new(1.0, 0.5, 1.0);
+/// A Cornell box block standing on the floor under its measured `top`: the top and four sides,
+/// facing out from a point inside the block.
+fn cornell_block(block: &str, top: [DVec3; 4], white: Rgb) -> Vec<Surface> {
+    let center = polygon::centroid(&top) * DVec3::new(1.0, 0.5, 1.0);
+    let mut surfaces = vec![Surface::new(
+        format!("{block}_top"),
+        facing(top.to_vec(), center, true),
+        white,
+    )];
+    for i in 0..4 {
+        let (a, b) = (top[i], top[(i + 1) % 4]);
+        let side = vec![v(a.x, 0.0, a.z), v(b.x, 0.0, b.z), b, a];
         surfaces.push(Surface::new(
-            format!("{block}_top"),
-            facing(top.to_vec(), center, true),
+            format!("{block}_side{i}"),
+            facing(side, center, true),
             white,
         ));
-        for i in 0..4 {
-            let (a, b) = (top[i], top[(i + 1) % 4]);
-            let side = vec![v(a.x, 0.0, a.z), v(b.x, 0.0, b.z), b, a];
-            surfaces.push(Surface::new(
-                format!("{block}_side{i}"),
-                facing(side, center, true),
-                white,
-            ));
-        }
     }
-
-    Scene {
-        name: "cornell".into(),
-        camera: Some(Camera {
-            eye: v(278.0, 273.0, -800.0),
-            target: v(278.0, 273.0, 0.0),
-            up: v(0.0, 1.0, 0.0),
-            // 35 mm focal length on a 25 mm film.
-            fov_deg: 2.0 * (12.5f64 / 35.0).atan().to_degrees(),
-        }),
-        surfaces,
-    }
+    surfaces
 }
 
 /// `docs/closed-forms.md`, "The textbook scene": a unit square light (exitance 1) at height 3

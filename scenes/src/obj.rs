@@ -119,54 +119,11 @@ fn parse(
     read_library: impl Fn(&Path) -> (PathBuf, std::io::Result<String>),
 ) -> Result<(Scene, Vec<String>), SceneError> {
     let lines = SourceLines::scan(text);
-    let library_warnings = RefCell::new(Vec::new());
-    let load_library = |library: &Path| {
-        let (looked_for, read) = read_library(library);
-        let at = lines
-            .libraries
-            .get(library.to_string_lossy().as_ref())
-            .map(|line| format!(" (mtllib at line {line})"))
-            .unwrap_or_default();
-        let consequence = format!(
-            "faces with its materials get reflectance {DEFAULT_REFLECTANCE} and no emission"
-        );
-        let result = read.map_err(|e| {
-            library_warnings
-                .borrow_mut()
-                .push(if e.kind() == std::io::ErrorKind::NotFound {
-                    format!(
-                        "material library not found: looked for {}{at}; {consequence}",
-                        looked_for.display()
-                    )
-                } else {
-                    format!(
-                        "cannot read material library {}{at}: {e}; {consequence}",
-                        looked_for.display()
-                    )
-                });
-            tobj::LoadError::OpenFileFailed
-        })?;
-        load_mtl(&result).inspect_err(|e| {
-            library_warnings.borrow_mut().push(format!(
-                "materials could not be read from {}{at} ({e}); {consequence}",
-                looked_for.display()
-            ));
-        })
-    };
-    let load_options = tobj::LoadOptions {
-        triangulate: false,
-        single_index: true,
-        ignore_points: true,
-        ignore_lines: true,
-    };
-    let (models, materials) = tobj::load_obj_buf(&mut text.as_bytes(), &load_options, load_library)
-        .map_err(|e| SceneError::Obj {
-            path: path.to_path_buf(),
-            message: format!("{e}; check the file is a valid OBJ"),
-        })?;
-    let mut warnings = library_warnings.into_inner();
-    // tobj reports a library error only when no library loaded; it is already a warning above.
-    let materials = materials.unwrap_or_default();
+    let Loaded {
+        models,
+        materials,
+        mut warnings,
+    } = load_models(text, path, &lines, read_library)?;
     warnings.extend(undefined_materials(&lines, &materials));
 
     let collected = collect_faces(&models, &materials, &lines);
@@ -180,31 +137,144 @@ fn parse(
         "ignored",
         "polylines (`l` statements; they are lines, not surfaces)",
     ));
-    let scene_diagonal = Bounds::from_points(
-        collected
-            .faces
+    let scene_diagonal = finite_diagonal(&collected.faces);
+    let (faces, repaired) = repaired_faces(collected.faces, scene_diagonal);
+    warnings.extend(repaired);
+    warnings.extend(clamped_reflectance_warnings(&faces, &materials));
+
+    let material_of = |face: &Face| surface_material(face, &materials);
+    let (surfaces, summary) = if options.merge_coplanar {
+        merged_surfaces(&faces, scene_diagonal, material_of)
+    } else {
+        unmerged_surfaces(&faces, material_of)
+    };
+    warnings.extend(summary);
+    let (surfaces, renamed) = unique_names(surfaces);
+    warnings.extend(renamed);
+    Ok((
+        Scene {
+            name: scene_name(path),
+            camera: None,
+            surfaces,
+        },
+        warnings,
+    ))
+}
+
+/// What tobj reads of an OBJ file and its material libraries.
+struct Loaded {
+    models: Vec<tobj::Model>,
+    materials: Vec<tobj::Material>,
+    /// One for each material library that could not be read: the import goes on without its
+    /// materials.
+    warnings: Vec<String>,
+}
+
+/// The models and materials tobj reads from `text`, with the libraries it names.
+fn load_models(
+    text: &str,
+    path: &Path,
+    lines: &SourceLines,
+    read_library: impl Fn(&Path) -> (PathBuf, std::io::Result<String>),
+) -> Result<Loaded, SceneError> {
+    // tobj takes the library loader as `Fn`, so the warnings it notes need a cell.
+    let library_warnings = RefCell::new(Vec::new());
+    let load_options = tobj::LoadOptions {
+        triangulate: false,
+        single_index: true,
+        ignore_points: true,
+        ignore_lines: true,
+    };
+    let (models, materials) = tobj::load_obj_buf(&mut text.as_bytes(), &load_options, |library| {
+        load_library(library, lines, &read_library, &library_warnings)
+    })
+    .map_err(|e| SceneError::Obj {
+        path: path.to_path_buf(),
+        message: format!("{e}; check the file is a valid OBJ"),
+    })?;
+    // tobj reports a library error only when no library loaded; `load_library` has warned of it.
+    let materials = materials.unwrap_or_default();
+    Ok(Loaded {
+        models,
+        materials,
+        warnings: library_warnings.into_inner(),
+    })
+}
+
+/// Reads and parses the material library `library`; when it cannot, notes in `warnings` why,
+/// naming the `mtllib` line.
+fn load_library(
+    library: &Path,
+    lines: &SourceLines,
+    read_library: impl Fn(&Path) -> (PathBuf, std::io::Result<String>),
+    warnings: &RefCell<Vec<String>>,
+) -> tobj::MTLLoadResult {
+    let (looked_for, read) = read_library(library);
+    let looked_for = looked_for.display();
+    let at = lines
+        .libraries
+        .get(library.to_string_lossy().as_ref())
+        .map(|line| format!(" (mtllib at line {line})"))
+        .unwrap_or_default();
+    let text = read.map_err(|e| {
+        let problem = if e.kind() == std::io::ErrorKind::NotFound {
+            format!("material library not found: looked for {looked_for}{at}")
+        } else {
+            format!("cannot read material library {looked_for}{at}: {e}")
+        };
+        warnings.borrow_mut().push(library_warning(&problem));
+        tobj::LoadError::OpenFileFailed
+    })?;
+    load_mtl(&text).inspect_err(|e| {
+        warnings.borrow_mut().push(library_warning(&format!(
+            "materials could not be read from {looked_for}{at} ({e})"
+        )));
+    })
+}
+
+/// `problem` with a material library, followed by what its faces get instead.
+fn library_warning(problem: &str) -> String {
+    format!(
+        "{problem}; faces with its materials get reflectance {DEFAULT_REFLECTANCE} and no emission"
+    )
+}
+
+/// The diagonal of the box around the faces whose corners are all finite: a corner that is not
+/// is validation's to refuse, and must not make the scene's scale infinite.
+fn finite_diagonal(faces: &[Face]) -> f64 {
+    Bounds::from_points(
+        faces
             .iter()
             .filter(|f| f.polygon.iter().all(|p| p.is_finite()))
             .flat_map(|f| &f.polygon),
     )
-    .diagonal();
+    .diagonal()
+}
+
+/// `faces` repaired ([`repair_face`]), and the warnings saying what was repaired.
+fn repaired_faces(faces: Vec<Face>, scene_diagonal: f64) -> (Vec<Face>, Vec<String>) {
     let mut repairs = Repairs::default();
-    let faces: Vec<Face> = collected
-        .faces
+    let faces = faces
         .into_iter()
         .flat_map(|f| repair_face(f, scene_diagonal, &mut repairs))
         .collect();
-    warnings.extend(repairs.warnings());
+    (faces, repairs.warnings())
+}
 
+/// One warning per material the faces use whose `Kd` reaches 1, in material order.
+fn clamped_reflectance_warnings(faces: &[Face], materials: &[tobj::Material]) -> Vec<String> {
     let mut used: Vec<usize> = faces.iter().filter_map(|f| f.material).collect();
     used.sort_unstable();
     used.dedup();
-    warnings.extend(
-        used.iter()
-            .filter_map(|&m| materials.get(m))
-            .filter_map(clamped_reflectance_warning),
-    );
-    let material_of = |face: &Face| match face.material.and_then(|m| materials.get(m)) {
+    used.iter()
+        .filter_map(|&m| materials.get(m))
+        .filter_map(clamped_reflectance_warning)
+        .collect()
+}
+
+/// A face's reflectance and emission from its material, or the defaults without one.
+fn surface_material(face: &Face, materials: &[tobj::Material]) -> (Rgb, Rgb) {
+    match face.material.and_then(|m| materials.get(m)) {
         Some(m) => (
             m.diffuse
                 .map(|kd| Rgb::from(kd).map(clamp_reflectance))
@@ -212,45 +282,38 @@ fn parse(
             m.emissive.map(Rgb::from).unwrap_or(Rgb::ZERO),
         ),
         None => (Rgb::splat(DEFAULT_REFLECTANCE), Rgb::ZERO),
-    };
-    let surfaces = if options.merge_coplanar {
-        let (surfaces, summary) = merged_surfaces(&faces, scene_diagonal, material_of);
-        warnings.extend(summary);
-        surfaces
-    } else {
-        if !faces.is_empty() {
-            warnings.push(
-                "coplanar faces were not merged (merging is off): every face is a surface".into(),
-            );
-        }
-        faces
-            .iter()
-            .map(|f| {
-                let (reflectance, emission) = material_of(f);
-                Surface {
-                    name: f.source.name.clone(),
-                    polygon: f.polygon.clone(),
-                    emission,
-                    reflectance,
-                }
-            })
-            .collect()
-    };
-    let (surfaces, renamed) = unique_names(surfaces);
-    warnings.extend(renamed);
-    let name = path
-        .file_stem()
+    }
+}
+
+/// Every face as a surface of its own, and a line saying merging was off.
+fn unmerged_surfaces(
+    faces: &[Face],
+    material_of: impl Fn(&Face) -> (Rgb, Rgb),
+) -> (Vec<Surface>, Option<String>) {
+    let line = (!faces.is_empty()).then(|| {
+        "coplanar faces were not merged (merging is off): every face is a surface".to_string()
+    });
+    let surfaces = faces
+        .iter()
+        .map(|f| {
+            let (reflectance, emission) = material_of(f);
+            Surface {
+                name: f.source.name.clone(),
+                polygon: f.polygon.clone(),
+                emission,
+                reflectance,
+            }
+        })
+        .collect();
+    (surfaces, line)
+}
+
+/// The scene's name: the file's stem.
+fn scene_name(path: &Path) -> String {
+    path.file_stem()
         .and_then(|s| s.to_str())
         .unwrap_or("scene")
-        .to_string();
-    Ok((
-        Scene {
-            name,
-            camera: None,
-            surfaces,
-        },
-        warnings,
-    ))
+        .to_string()
 }
 
 /// A `Kd` channel as a reflectance: at or above 1, [`MAX_OBJ_REFLECTANCE`]; anything else as it
