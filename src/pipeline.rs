@@ -11,7 +11,9 @@ use std::time::Instant;
 use penumbra_meshing::discontinuity::{
     Boundary, Discontinuities, DiscontinuityOptions, find_discontinuities_reporting,
 };
-use penumbra_meshing::{MeshError, SceneMesh, mesh_scene_discontinuity_on, mesh_scene_uniform};
+use penumbra_meshing::{
+    DiscontinuityMeshing, MeshError, SceneMesh, mesh_scene_discontinuity_on, mesh_scene_uniform,
+};
 use penumbra_scenes::{LoadedScene, Rgb, Scene, Visibility};
 use penumbra_solver::{Progress, SolveError, SolverOptions, StopReason};
 use penumbra_viz::Render;
@@ -24,8 +26,8 @@ pub use crate::run_result::{
     Kept, MemoryReport, RunResult, Stage, StagePeaks, StageTimes, Stopped,
 };
 pub use plan::BASE_SHARE;
-pub use solve::LEAST_MESH_SECONDS;
 use plan::{Plan, initial_budget_too_small, planned_budget};
+pub use solve::LEAST_MESH_SECONDS;
 use solve::{Meshed, Solved, least_mesh_lit, solve_with};
 
 /// Runs the whole pipeline on a loaded scene: validates `options`, then builds visibility,
@@ -84,8 +86,9 @@ struct Stages<'a> {
     /// The solver's options, with the run's deadline.
     solver: SolverOptions,
     started: Instant,
-    /// The stage the run is in.
+    /// The stage the run is in, and when it started.
     stage: Stage,
+    stage_started: Instant,
     times: StageTimes,
     peaks: StagePeaks,
 }
@@ -117,9 +120,30 @@ impl<'a> Stages<'a> {
             },
             started,
             stage: Stage::Plan,
+            stage_started: started,
             times: StageTimes::default(),
             peaks: StagePeaks::default(),
         })
+    }
+
+    /// Starts `stage`.
+    fn enter(&mut self, stage: Stage) {
+        self.stage = stage;
+        self.stage_started = Instant::now();
+    }
+
+    /// The time of the stage the run stopped in, up to now.
+    fn time_stopped_stage(&mut self) {
+        let seconds = self.stage_started.elapsed().as_secs_f64();
+        match self.stage {
+            Stage::Visibility => self.times.visibility = seconds,
+            Stage::Discontinuities => self.times.discontinuities = seconds,
+            Stage::Mesh => self.times.mesh = seconds,
+            Stage::Direct => self.times.direct = seconds,
+            Stage::Solve => self.times.shooting = seconds,
+            Stage::Refine => self.times.refine = seconds,
+            Stage::Plan | Stage::Render => {}
+        }
     }
 
     /// [`RunError`] for the interrupt, if it is set: between stages, before a solution exists.
@@ -132,7 +156,7 @@ impl<'a> Stages<'a> {
 
     /// The visibility stage: the scene's BVH.
     fn visibility(&mut self) -> Visibility {
-        self.stage = Stage::Visibility;
+        self.enter(Stage::Visibility);
         let t = Instant::now();
         let visibility = Visibility::build(self.scene);
         self.times.visibility = t.elapsed().as_secs_f64();
@@ -146,8 +170,7 @@ impl<'a> Stages<'a> {
         self.check_interrupt()?;
         let mut meshed = self.mesh(visibility, found, plan)?;
         self.check_interrupt()?;
-        let estimate =
-            plan.check_built(self.scene, self.options, &meshed.mesh, meshed.budget)?;
+        let estimate = plan.check_built(self.scene, self.options, &meshed.mesh, meshed.budget)?;
         // The column cache gets what the estimate leaves.
         let cache_bytes = plan.limit.map_or(self.solver.cache_bytes, |limit| {
             memory::cache_bytes(self.solver.cache_bytes, estimate.total(), limit)
@@ -170,7 +193,7 @@ impl<'a> Stages<'a> {
         if self.options.mesh == MeshMethod::Uniform {
             return None;
         }
-        self.stage = Stage::Discontinuities;
+        self.enter(Stage::Discontinuities);
         let t = Instant::now();
         let (scene, options) = (self.scene, self.options);
         let search = DiscontinuityOptions {
@@ -208,7 +231,7 @@ impl<'a> Stages<'a> {
         found: Option<Discontinuities>,
         plan: &Plan,
     ) -> Result<Meshed, RunError> {
-        self.stage = Stage::Mesh;
+        self.enter(Stage::Mesh);
         let t = Instant::now();
         self.progress.start("meshing", 1);
         let mut mesh = self.first_mesh(visibility, found, plan)?;
@@ -244,16 +267,19 @@ impl<'a> Stages<'a> {
                     || found.stats.segments > 0
                     || found.stats.pairs_skipped > 0 =>
             {
-                let density = if error_driven { 1.0 } else { options.penumbra_density };
-                mesh_scene_discontinuity_on(
-                    self.scene,
-                    visibility,
-                    found,
-                    plan.initial_budget,
-                    density,
-                    options.min_angle,
-                    self.shard_surfaces().as_deref(),
-                )
+                let on = self.shard_surfaces();
+                let meshing = DiscontinuityMeshing {
+                    penumbra_density: if error_driven {
+                        1.0
+                    } else {
+                        options.penumbra_density
+                    },
+                    min_angle_deg: options.min_angle,
+                    on: on.as_deref(),
+                    interrupt: options.solver.interrupt.as_ref(),
+                };
+                let budget = plan.initial_budget;
+                mesh_scene_discontinuity_on(self.scene, visibility, found, budget, &meshing)
             }
             _ => mesh_scene_uniform(self.scene, plan.initial_budget),
         };
@@ -295,7 +321,7 @@ impl<'a> Stages<'a> {
         meshed: &mut Meshed,
         cache_bytes: usize,
     ) -> Result<Solved, RunError> {
-        self.stage = Stage::Direct;
+        self.enter(Stage::Direct);
         let t = Instant::now();
         let solver = SolverOptions {
             cache_bytes,
@@ -338,8 +364,9 @@ impl<'a> Stages<'a> {
     /// direct light, the stage it stopped in named.
     fn least_mesh(&mut self, visibility: &Visibility, plan: &Plan) -> Result<Lit, RunError> {
         let stage = self.stage;
+        self.time_stopped_stage();
         let (meshed, mut solution) = least_mesh_lit(self.scene, visibility, &self.solver)?;
-        self.times.direct = solution.stats.direct_seconds;
+        self.times.direct += solution.stats.direct_seconds;
         solution.stats.stop = StopReason::Interrupted;
         Ok(Lit {
             meshed,
@@ -361,7 +388,7 @@ impl<'a> Stages<'a> {
     /// for display (each surface reflects its share of the light not shot yet).
     fn render(&mut self, lit: &Lit) -> Result<Render, RunError> {
         if lit.stopped.is_none() {
-            self.stage = Stage::Render;
+            self.enter(Stage::Render);
         }
         let t = Instant::now();
         let solution = &lit.solved.solution;

@@ -254,7 +254,8 @@ pub enum ReportError {
 
 /// `"text"`, or `none` when there is no text.
 fn quoted_or_none(text: &Option<String>) -> String {
-    text.as_deref().map_or("none".to_owned(), |t| format!("{t:?}"))
+    text.as_deref()
+        .map_or("none".to_owned(), |t| format!("{t:?}"))
 }
 
 impl Report {

@@ -583,7 +583,11 @@ fn render_joined(
             s.radiosity
                 .iter()
                 .map(|&c| {
-                    penumbra_solver::displayed(Rgb::from(c), surface.reflectance, parts.light.ambient)
+                    penumbra_solver::displayed(
+                        Rgb::from(c),
+                        surface.reflectance,
+                        parts.light.ambient,
+                    )
                 })
                 .collect()
         })

@@ -926,41 +926,72 @@ fn one_signal_stops_a_run_promptly() {
     }
 }
 
-/// A signal before any solution exists (while the discontinuities, the mesh or the direct light
-/// of a large scene are computed) ends the run with the signal's status and writes nothing: the
-/// old contents of `--out` stay.
+/// A signal before any mesh has values (while the discontinuities of a large scene are found,
+/// or its mesh is refined) ends the run with the signal's status within a second, having
+/// written the scene's least mesh with its direct light, and a report that names the stage it
+/// stopped in.
 #[test]
-fn runs_interrupted_before_a_solution_leave_the_output_alone() {
+fn runs_interrupted_before_a_solution_keep_the_least_mesh_lit() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let out = dir.path().join("out");
-    std::fs::create_dir(&out).expect("mkdir");
-    std::fs::write(out.join("report.json"), b"old").expect("writes");
-    // Finding and meshing the shadows of 3,000 boxes takes seconds; the signal comes at one.
-    let (o, _) = signalled(
-        &[
-            "run",
-            "boxworld-3000",
-            "--max-elements",
-            "200000",
-            "--quiet",
-            "--out",
-            out.to_str().expect("utf-8"),
-        ],
-        "INT",
-        1.0,
-    );
-    let stderr = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(130), "{stderr}");
-    assert!(stderr.contains("nothing written"), "{stderr}");
-    let left: Vec<_> = std::fs::read_dir(&out)
-        .expect("readable")
-        .map(|e| e.expect("entry").file_name())
-        .collect();
-    assert_eq!(left, vec![std::ffi::OsString::from("report.json")]);
-    assert_eq!(
-        std::fs::read(out.join("report.json")).expect("reads"),
-        b"old"
-    );
+    // Meshing 400,000 triangles by discontinuities takes seconds (the boxes' many surfaces
+    // tens of seconds); the signal comes within it.
+    let cases: [(&str, &[&str], f64, &[&str]); 2] = [
+        (
+            "cornell",
+            &["--max-elements", "400000", "--mesh", "discontinuity"],
+            0.8,
+            &["mesh"],
+        ),
+        (
+            "boxworld-300",
+            &["--max-elements", "400000", "--mesh", "discontinuity"],
+            1.0,
+            &["discontinuities", "mesh"],
+        ),
+    ];
+    for (scene, options, after, stages) in cases {
+        let out = dir.path().join(scene);
+        std::fs::create_dir(&out).expect("mkdir");
+        std::fs::write(out.join("report.json"), b"old").expect("writes");
+        let out_arg = out.to_str().expect("utf-8");
+        let mut args = vec!["run", scene, "--quiet", "--svg", "none", "--out", out_arg];
+        args.extend(options);
+        let (o, waited) = signalled(&args, "INT", after);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(130), "{scene}: {stderr}");
+        assert!(waited < 1.0, "{scene}: {waited:.2} s to stop: {stderr}");
+        let report = json(&out.join("report.json"));
+        let stopped = &report["stopped"];
+        assert!(
+            stages.contains(&stopped["stage"].as_str().unwrap_or_default()),
+            "{scene}: {stopped}"
+        );
+        assert_eq!(stopped["reason"], "interrupted", "{scene}");
+        assert_eq!(stopped["kept"], "least_mesh_direct", "{scene}");
+        assert_eq!(report["partial"], true, "{scene}");
+        assert_eq!(report["solver"]["stop"], "interrupted", "{scene}");
+        // The least mesh: every polygon's own triangles, lit where the light falls.
+        let solution = json(&out.join("solution.json"));
+        let surfaces = solution["surfaces"].as_array().expect("surfaces");
+        let triangles: usize = surfaces
+            .iter()
+            .map(|s| s["triangles"].as_array().map_or(0, Vec::len))
+            .sum();
+        assert_eq!(report["counts"]["triangles"], triangles, "{scene}");
+        assert!(
+            triangles < 2 * surfaces.len() + 64,
+            "{scene}: {triangles} triangles"
+        );
+        assert!(check_radiosity(&solution) > 0, "{scene}");
+        let brightest = surfaces
+            .iter()
+            .flat_map(|s| s["direct"].as_array().into_iter().flatten())
+            .flat_map(|c| c.as_array().into_iter().flatten())
+            .filter_map(serde_json::Value::as_f64)
+            .fold(0.0, f64::max);
+        assert!(brightest > 0.0, "{scene}: no direct light");
+        assert!(stderr.contains("least mesh"), "{scene}: {stderr}");
+    }
 }
 
 /// A run that would need more memory than it may use stops before it starts (exit 2), and

@@ -15,6 +15,7 @@ use spade::{
 use crate::error::MeshError;
 use crate::mesh::SurfaceMesh;
 use crate::mesh_coordinates::MeshCoordinates;
+use crate::progress::Interrupt;
 
 /// Triangles smaller than this (mesh units, where the polygon's extent is 1: (2^-24)^2, about
 /// (6e-8)^2) are left as they are by the search for the least quality mesh (the least mesh at
@@ -40,6 +41,11 @@ const CAPPED_BELOW: f64 = 0.5;
 /// `SurfaceTriangulation::filled`), and the share of the target that ends them.
 const FILL_ROUNDS: usize = 8;
 const FILLED_SHARE: f64 = 0.9;
+
+/// Whether `stop` is set.
+fn stopped(stop: Option<&Interrupt>) -> bool {
+    stop.is_some_and(Interrupt::is_set)
+}
 
 /// Vertices a refinement to `target` triangles may add: the target (about twice what it needs)
 /// and a few for small targets.
@@ -218,7 +224,18 @@ impl SurfaceTriangulation {
     /// A refinement with about `target` triangles (never more, unless the triangulation already
     /// has more) and angles of at least `min_angle_deg` where the budget allows.
     pub(crate) fn refined(&self, target: usize, min_angle_deg: f64) -> SurfaceTriangulation {
-        self.calibrated(target, min_angle_deg, |max_area| {
+        self.refined_until(target, min_angle_deg, None)
+    }
+
+    /// [`Self::refined`], given up between its trial refinements once `stop` is set (the
+    /// triangulation returned is then any of them: the caller lets it go).
+    pub(crate) fn refined_until(
+        &self,
+        target: usize,
+        min_angle_deg: f64,
+        stop: Option<&Interrupt>,
+    ) -> SurfaceTriangulation {
+        self.calibrated(target, min_angle_deg, stop, |max_area| {
             self.refined_to_area(max_area, min_angle_deg, target)
         })
     }
@@ -232,14 +249,18 @@ impl SurfaceTriangulation {
         target: usize,
         min_angle_deg: f64,
         density: &impl SizeField,
+        stop: Option<&Interrupt>,
     ) -> SurfaceTriangulation {
-        self.calibrated(target, min_angle_deg, |max_area| {
+        self.calibrated(target, min_angle_deg, stop, |max_area| {
             let mut cdt = self.cdt.clone();
             let smallest = max_area / density.max_factor();
             let allowed = allowance(target);
             let mut complete =
                 self.refine_cdt(&mut cdt, min_angle_deg, Some(max_area), max_area, allowed);
             for _ in 0..GRADING_ROUNDS {
+                if stopped(stop) {
+                    break;
+                }
                 let points = split_points(&cdt, |face| {
                     let centroid = face_centroid(face);
                     face.area() > max_area / density.at(centroid)
@@ -414,6 +435,7 @@ impl SurfaceTriangulation {
         &self,
         target: usize,
         min_angle_deg: f64,
+        stop: Option<&Interrupt>,
         refine: impl Fn(f64) -> (Cdt, bool),
     ) -> SurfaceTriangulation {
         let mut best = self.clone();
@@ -427,6 +449,9 @@ impl SurfaceTriangulation {
         let mut max_area = self.area_for(target);
         let mut last_count = None;
         for _ in 0..8 {
+            if stopped(stop) {
+                return best;
+            }
             let (cdt, complete) = refine(max_area);
             let refined = self.with_cdt(cdt);
             let count = refined.count();
@@ -446,6 +471,9 @@ impl SurfaceTriangulation {
             } else {
                 ratio * 0.98
             };
+        }
+        if stopped(stop) {
+            return best;
         }
         if !self.quality && (best_count as f64) < CAPPED_BELOW * target as f64 {
             let capped = self.refined_capped(target, min_angle_deg);

@@ -20,6 +20,7 @@ use crate::error::MeshError;
 use crate::grading::Density;
 use crate::mesh::SurfaceMesh;
 use crate::mesh_coordinates::{MeshCoordinates, snap};
+use crate::progress::Interrupt;
 use crate::tolerances::{
     CONSTRAINED_MIN_ANGLE_DEG, MAX_MIN_ANGLE_DEG, MERGE_DISTANCE, ON_SEGMENT_TOLERANCE,
     SPLIT_MIN_ANGLE_DEG,
@@ -230,7 +231,8 @@ impl ConstrainedSurface {
     /// Refines to about `target` triangles and makes the mesh, with separate vertices on the two
     /// sides of every value discontinuity.
     pub fn into_mesh(self, surface: &Surface, target: usize) -> SurfaceMesh {
-        self.into_refinable(target, 1.0, &|_| false).mesh(surface)
+        self.into_refinable(target, 1.0, &|_| false, None)
+            .mesh(surface)
     }
 
     /// Like [`Self::into_mesh`], with triangles `penumbra_density` times smaller in area where
@@ -243,7 +245,7 @@ impl ConstrainedSurface {
         penumbra_density: f64,
         varies: &(dyn Fn(&[DVec3]) -> bool + Sync),
     ) -> SurfaceMesh {
-        self.into_refinable(target, penumbra_density, varies)
+        self.into_refinable(target, penumbra_density, varies, None)
             .mesh(surface)
     }
 
@@ -258,6 +260,7 @@ impl ConstrainedSurface {
         target: usize,
         penumbra_density: f64,
         varies: &(dyn Fn(&[DVec3]) -> bool + Sync),
+        stop: Option<&Interrupt>,
     ) -> RefinableSurface {
         self.quality_triangles(target);
         let base = match self.quality {
@@ -266,10 +269,10 @@ impl ConstrainedSurface {
         };
         let angle = self.min_angle_deg;
         let triangulation = if self.segments.is_empty() || penumbra_density <= 1.0 {
-            base.refined(target, angle)
+            base.refined_until(target, angle, stop)
         } else {
             let density = Density::probe(&base, target, penumbra_density, varies);
-            base.refined_graded(target, angle, &density)
+            base.refined_graded(target, angle, &density, stop)
         };
         RefinableSurface {
             id: self.id,

@@ -99,7 +99,8 @@ pub use mesh::SurfaceMesh;
 pub use progress::{Interrupt, NoProgress, Progress};
 pub use quality::{MeshQuality, quality_of};
 pub use scene_mesh::{
-    SceneMesh, mesh_scene_discontinuity, mesh_scene_discontinuity_on, mesh_scene_uniform,
+    DiscontinuityMeshing, SceneMesh, mesh_scene_discontinuity, mesh_scene_discontinuity_on,
+    mesh_scene_uniform,
 };
 pub use tolerances::{
     CONSTRAINED_MIN_ANGLE_DEG, FORCING_WEDGE_DEG, MAX_MIN_ANGLE_DEG, SPLIT_MIN_ANGLE_DEG,

@@ -14,6 +14,7 @@ use crate::discontinuity::{
 };
 use crate::error::MeshError;
 use crate::mesh::SurfaceMesh;
+use crate::progress::Interrupt;
 use crate::quality::{MeshQuality, quality_of};
 use crate::tolerances::CONSTRAINED_MIN_ANGLE_DEG;
 
@@ -187,15 +188,48 @@ pub fn mesh_scene_discontinuity(
     budget: impl Into<ElementBudget>,
     penumbra_density: f64,
 ) -> Result<SceneMesh, MeshError> {
-    mesh_scene_discontinuity_on(
-        scene,
-        visibility,
-        found,
-        budget,
+    let options = DiscontinuityMeshing {
         penumbra_density,
-        CONSTRAINED_MIN_ANGLE_DEG,
-        None,
-    )
+        ..DiscontinuityMeshing::default()
+    };
+    mesh_scene_discontinuity_on(scene, visibility, found, budget, &options)
+}
+
+/// How [`mesh_scene_discontinuity_on`] meshes.
+#[derive(Clone, Copy, Debug)]
+pub struct DiscontinuityMeshing<'a> {
+    /// Triangles this many times smaller in area where the light varies (1: no grading).
+    pub penumbra_density: f64,
+    /// The smallest angle refinement aims for where the constraints allow (0: none; at most
+    /// [`MAX_MIN_ANGLE_DEG`](crate::MAX_MIN_ANGLE_DEG)).
+    pub min_angle_deg: f64,
+    /// The surfaces to mesh, when each one's share of the budget depends on it alone (`None`:
+    /// all).
+    pub on: Option<&'a [bool]>,
+    /// Meshing stops, with [`MeshError::Interrupted`], once this is set: between the surfaces'
+    /// steps (one surface's refinement is not cut).
+    pub interrupt: Option<&'a Interrupt>,
+}
+
+impl Default for DiscontinuityMeshing<'_> {
+    fn default() -> Self {
+        DiscontinuityMeshing {
+            penumbra_density: 1.0,
+            min_angle_deg: CONSTRAINED_MIN_ANGLE_DEG,
+            on: None,
+            interrupt: None,
+        }
+    }
+}
+
+impl DiscontinuityMeshing<'_> {
+    /// [`MeshError::Interrupted`] once the interrupt is set.
+    fn go_on(&self) -> Result<(), MeshError> {
+        match self.interrupt {
+            Some(i) if i.is_set() => Err(MeshError::Interrupted),
+            _ => Ok(()),
+        }
+    }
 }
 
 /// Discontinuity segment ends within this many contact distances of another end or segment are
@@ -203,22 +237,20 @@ pub fn mesh_scene_discontinuity(
 /// hits stop counting) plus its trimming tolerance (at most one more).
 pub(crate) const JOIN_CONTACT_DISTANCES: f64 = 4.0;
 
-/// [`mesh_scene_discontinuity`] of the surfaces `on` holds (all when `None`), when each
-/// surface's share of the budget depends on it alone ([`ElementBudget::shared_extra`]): the
-/// others get an empty mesh, and the budget, counts and least mesh are those of the surfaces
-/// meshed. A budget spread over all surfaces needs every surface's least mesh, so then every
-/// surface is meshed. A surface's mesh is the same whichever others are meshed. Refinement aims
-/// for angles of at least `min_angle_deg` where the constraints allow (0: none; at most
-/// [`MAX_MIN_ANGLE_DEG`](crate::MAX_MIN_ANGLE_DEG)).
+/// [`mesh_scene_discontinuity`] as `options` say: of the surfaces `options.on` holds (all when
+/// `None`), when each surface's share of the budget depends on it alone
+/// ([`ElementBudget::shared_extra`]): the others get an empty mesh, and the budget, counts and
+/// least mesh are those of the surfaces meshed. A budget spread over all surfaces needs every
+/// surface's least mesh, so then every surface is meshed. A surface's mesh is the same
+/// whichever others are meshed.
 pub fn mesh_scene_discontinuity_on(
     scene: &Scene,
     visibility: &Visibility,
     found: Discontinuities,
     budget: impl Into<ElementBudget>,
-    penumbra_density: f64,
-    min_angle_deg: f64,
-    on: Option<&[bool]>,
+    options: &DiscontinuityMeshing,
 ) -> Result<SceneMesh, MeshError> {
+    let (on, min_angle_deg) = (options.on, options.min_angle_deg);
     let budget = budget.into();
     let join = JOIN_CONTACT_DISTANCES * visibility.contact_distance();
     let alone = budget.shared_extra(polygon_minimum(scene), scene.surfaces.len());
@@ -233,6 +265,7 @@ pub fn mesh_scene_discontinuity_on(
             if !meshed[id] {
                 return Ok(None);
             }
+            options.go_on()?;
             let segments = found.segments.get(id).map(Vec::as_slice).unwrap_or(&[]);
             constrained_surface(id, s, segments, join, min_angle_deg).map(Some)
         })
@@ -250,19 +283,27 @@ pub fn mesh_scene_discontinuity_on(
         Some(extra) => share_alone(&areas, &minimum, &meshed, extra),
         None => spread_with_quality(&areas, &minimum, &mut constrained, budget)?,
     };
+    options.go_on()?;
     let minimum_triangles = minimum.iter().sum();
     let grading = Grading {
         scene,
         visibility,
         segments: &found.segments,
-        penumbra_density,
+        penumbra_density: options.penumbra_density,
+        interrupt: options.interrupt,
     };
     let refinable: Vec<Option<RefinableSurface>> = constrained
         .into_par_iter()
         .zip(targets)
         .enumerate()
-        .map(|(id, (c, target))| Some(grading.refinable(id, c?, target)))
-        .collect();
+        .map(|(id, (c, target))| match c {
+            Some(c) => options
+                .go_on()
+                .map(|()| Some(grading.refinable(id, c, target))),
+            None => Ok(None),
+        })
+        .collect::<Result<_, _>>()?;
+    options.go_on()?;
     let (surfaces, refinable) = meshes_of(scene, refinable)?;
     let mut discontinuities = found.segments;
     discontinuities.resize(scene.surfaces.len(), Vec::new());
@@ -336,6 +377,8 @@ struct Grading<'a> {
     /// Each surface's discontinuity segments, which name the emitters that shade it.
     segments: &'a [Vec<DiscontinuitySegment>],
     penumbra_density: f64,
+    /// Refinement is given up once this is set.
+    interrupt: Option<&'a Interrupt>,
 }
 
 impl Grading<'_> {
@@ -344,7 +387,7 @@ impl Grading<'_> {
     fn refinable(&self, id: SurfaceId, c: ConstrainedSurface, target: usize) -> RefinableSurface {
         let surface = &self.scene.surfaces[id];
         let Some(frame) = PlaneFrame::of_polygon(&surface.polygon) else {
-            return c.into_refinable(target, 1.0, &|_| false);
+            return c.into_refinable(target, 1.0, &|_| false, self.interrupt);
         };
         let emitters: BTreeSet<SurfaceId> = self
             .segments
@@ -366,7 +409,7 @@ impl Grading<'_> {
                 hi > 0.0 && lo < 1.0
             })
         };
-        c.into_refinable(target, self.penumbra_density, &varies)
+        c.into_refinable(target, self.penumbra_density, &varies, self.interrupt)
     }
 }
 

@@ -37,15 +37,25 @@ def test_an_interrupt_from_another_thread_returns_a_partial_solution():
     _assert_partial(solution)
 
 
-def test_an_interrupt_before_any_solution_cancels_the_run():
+def test_an_interrupt_before_any_mesh_keeps_the_least_mesh_lit():
     interrupt = penumbra.Interrupt()
     interrupt.set()
     scene = penumbra.Scene.builtin("cornell")
-    with pytest.raises(penumbra.RunCancelled):
-        penumbra.run(scene, interrupt=interrupt, max_elements=2000)
+    stopped = penumbra.run(scene, interrupt=interrupt, max_elements=2000)
+    assert stopped.partial
+    assert stopped.report["stopped"] == {
+        "stage": "discontinuities",
+        "reason": "interrupted",
+        "kept": "least_mesh_direct",
+    }
+    # The scene's least mesh, its polygons' own triangles, with the direct light only.
+    assert stopped.report["counts"]["triangles"] < 2 * len(scene) + 8
+    assert np.isfinite(stopped.radiosity).all() and (stopped.radiosity >= 0).all()
+    assert stopped.direct.any() and not stopped.indirect.any()
     interrupt.clear()
     assert not interrupt.is_set
-    assert not penumbra.run(scene, interrupt=interrupt, max_elements=2000).partial
+    whole = penumbra.run(scene, interrupt=interrupt, max_elements=2000)
+    assert not whole.partial and "stopped" not in whole.report
 
 
 @pytest.mark.skipif(threading.current_thread() is not threading.main_thread(), reason="signals reach the main thread")
@@ -67,16 +77,17 @@ MAIN_THREAD = pytest.mark.skipif(
 
 @MAIN_THREAD
 def test_a_second_ctrl_c_returns_at_once():
-    # Meshing 150,000 triangles by discontinuities takes seconds and looks at no interrupt: the
-    # first Ctrl-C waits for it, the second does not (the run ends on its own in the background).
+    # Meshing one surface into 1.5 million triangles takes seconds, and one surface's refinement
+    # is not cut: the first Ctrl-C waits for it, the second does not (the run ends on its own in
+    # the background).
     for delay in (0.3, 0.6):
         threading.Timer(delay, os.kill, (os.getpid(), signal.SIGINT)).start()
     started = time.perf_counter()
     with pytest.raises(KeyboardInterrupt) as raised:
         penumbra.run(
-            penumbra.Scene.builtin("boxworld"),
-            mesh="discontinuity",
-            max_elements=150000,
+            penumbra.Scene.builtin("textbook"),
+            mesh="uniform",
+            max_elements=1_500_000,
             direct_only=True,
         )
     assert time.perf_counter() - started < 0.6 + PROMPT

@@ -22,9 +22,7 @@ use penumbra_meshing::discontinuity::Boundary;
 use penumbra_scenes::{Camera, Rgb};
 use serde::Deserialize;
 
-use crate::outputs::{
-    SOLUTION_FORMAT, SurfaceSolution, SvgSelection, surface_solution,
-};
+use crate::outputs::{SOLUTION_FORMAT, SurfaceSolution, SvgSelection, surface_solution};
 use crate::pipeline::RunResult;
 use crate::report::Report;
 
@@ -246,10 +244,9 @@ impl ExportSource {
             );
             return Err(malformed("solution.json", "solution", reason));
         }
-        let report = Report::parse(report)
-            .map_err(|e| malformed("report.json", "report", e.to_string()))?;
-        if report.scene.name != solution.scene || report.scene.surfaces != solution.surfaces.len()
-        {
+        let report =
+            Report::parse(report).map_err(|e| malformed("report.json", "report", e.to_string()))?;
+        if report.scene.name != solution.scene || report.scene.surfaces != solution.surfaces.len() {
             let reason = format!(
                 "it is not the report of solution.json's run (scene {:?} of {} surfaces)",
                 solution.scene,

@@ -4,7 +4,7 @@
 use penumbra_meshing::{ElementBudget, MeshError, SceneMesh, polygon_minimum};
 use penumbra_scenes::Scene;
 
-use crate::memory::{self, MeshCounts, MemoryEstimate};
+use crate::memory::{self, MemoryEstimate, MeshCounts};
 use crate::options::RunOptions;
 use crate::run_error::RunError;
 
@@ -89,12 +89,19 @@ impl Plan {
         if options.refine.is_none() {
             return Ok(built);
         }
-        let grown = self.check(scene, options, MeshCounts::predicted(scene, budget, per_patch))?;
+        let grown = self.check(
+            scene,
+            options,
+            MeshCounts::predicted(scene, budget, per_patch),
+        )?;
         Ok([self.estimate.clone(), grown]
             .into_iter()
-            .fold(built, |most, e| {
-                if e.total() > most.total() { e } else { most }
-            }))
+            .fold(
+                built,
+                |most, e| {
+                    if e.total() > most.total() { e } else { most }
+                },
+            ))
     }
 
     /// The whole run's budget, resolved now that the first mesh and the scene's least mesh
@@ -122,7 +129,11 @@ impl Plan {
 /// the final budget refuses what does not fit); adaptive refinement starts from its own
 /// initial budget, or the scene's least mesh when that is more.
 fn initial_budget(options: &RunOptions) -> ElementBudget {
-    let share = if options.solver.direct_only { 0.0 } else { BASE_SHARE };
+    let share = if options.solver.direct_only {
+        0.0
+    } else {
+        BASE_SHARE
+    };
     match (&options.refine, options.max_elements) {
         (None, budget) if options.error_driven() => ElementBudget::Fit {
             at_least: (budget_floor(budget) as f64 * share) as usize,

@@ -7,8 +7,8 @@ use penumbra_meshing::{ElementBudget, SceneMesh, mesh_scene_uniform, polygon_min
 use penumbra_scenes::{Scene, Visibility};
 use penumbra_solver::photon_map::solve_photon_map;
 use penumbra_solver::{
-    NoProgress, Progress, Solution, SolverMethod, SolverOptions, solve_direct_on,
-    solve_gathering, solve_hierarchical, solve_progressive,
+    NoProgress, Progress, Solution, SolverMethod, SolverOptions, solve_direct_on, solve_gathering,
+    solve_hierarchical, solve_progressive,
 };
 
 use crate::adaptive::{RefineReport, refine_adaptively, refine_hierarchically};
@@ -56,8 +56,15 @@ pub(crate) fn solve_with(
             true => refine_hierarchically,
             false => refine_adaptively,
         };
-        let (report, solution) =
-            refine_with(scene, visibility, mesh, meshed.budget, refine, solver, progress)?;
+        let (report, solution) = refine_with(
+            scene,
+            visibility,
+            mesh,
+            meshed.budget,
+            refine,
+            solver,
+            progress,
+        )?;
         return Ok(Solved {
             solution,
             refinement: Some(report),
@@ -90,7 +97,9 @@ pub(crate) fn solve_with(
             }
             solution
         }
-        SolverMethod::Hierarchical => solve_hierarchical(scene, mesh, visibility, solver, progress)?,
+        SolverMethod::Hierarchical => {
+            solve_hierarchical(scene, mesh, visibility, solver, progress)?
+        }
         SolverMethod::PhotonMap => solve_photon_map(scene, mesh, visibility, solver, progress)?,
         method => solve_gathering(scene, mesh, visibility, solver, method, progress)?,
     };

@@ -4,9 +4,9 @@ use std::process::ExitCode;
 
 use crate::progress_bar::Bars;
 use anyhow::Context;
+use penumbra::RunResult;
 use penumbra::export::{ExportFormat, export_run};
 use penumbra::outputs::{Invocation, SvgSelection, write_outputs};
-use penumbra::RunResult;
 use penumbra::pipeline::{Kept, Stage};
 use penumbra_solver::Interrupt;
 
