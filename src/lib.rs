@@ -131,7 +131,7 @@ pub mod shard;
 
 pub use options::{
     DEFAULT_BUDGET, DEFAULT_FF_SAMPLES, DEFAULT_HEMICUBE_RESOLUTION, DEFAULT_MAX_ELEMENTS,
-    DEFAULT_MIN_ANGLE_DEG, HIERARCHICAL_MAX_ELEMENTS, InvalidOption, MeshMethod, RunOptions,
-    default_budget, default_initial_elements, default_penumbra_density,
+    DEFAULT_MIN_ANGLE_DEG, HIERARCHICAL_MAX_ELEMENTS, InvalidOption, MeshMethod, OptionId,
+    RunOptions, default_budget, default_initial_elements, default_penumbra_density,
 };
 pub use pipeline::{RunError, RunResult, run};

@@ -6,6 +6,7 @@ use penumbra_meshing::ElementBudget;
 use penumbra_meshing::discontinuity::DiscontinuityOptions;
 use penumbra_meshing::polygon_minimum;
 use penumbra_scenes::{Scene, SurfaceId};
+pub use penumbra_solver::OptionId;
 use penumbra_solver::estimate::IndirectEstimate;
 use penumbra_solver::{SolveError, SolverMethod, SolverOptions};
 use penumbra_viz::RenderOptions;
@@ -160,14 +161,14 @@ impl Default for RunOptions {
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 #[error("invalid {option}: {reason}")]
 pub struct InvalidOption {
-    /// The option, in words.
-    pub option: &'static str,
+    /// The option.
+    pub option: OptionId,
     /// What is wrong with its value, and what it may be.
     pub reason: String,
 }
 
 impl InvalidOption {
-    fn new(option: &'static str, reason: impl Into<String>) -> InvalidOption {
+    fn new(option: OptionId, reason: impl Into<String>) -> InvalidOption {
         InvalidOption {
             option,
             reason: reason.into(),
@@ -180,7 +181,7 @@ impl From<SolveError> for InvalidOption {
     fn from(e: SolveError) -> InvalidOption {
         match e {
             SolveError::InvalidOption { option, reason } => InvalidOption::new(option, reason),
-            e => InvalidOption::new("solver", e.to_string()),
+            e => InvalidOption::new(OptionId::Solver, e.to_string()),
         }
     }
 }
@@ -197,13 +198,13 @@ impl RunOptions {
         self.solver.validate()?;
         if self.max_elements == ElementBudget::AtMost(0) {
             return Err(InvalidOption::new(
-                "max elements",
+                OptionId::MaxElements,
                 "must be at least 1 triangle",
             ));
         }
         if !(1.0..=MAX_PENUMBRA_DENSITY).contains(&self.penumbra_density) {
             return Err(InvalidOption::new(
-                "penumbra density",
+                OptionId::PenumbraDensity,
                 format!(
                     "must be between 1 and {MAX_PENUMBRA_DENSITY:e}, not {}",
                     self.penumbra_density
@@ -212,7 +213,7 @@ impl RunOptions {
         }
         if !(self.tolerance >= 0.0 && self.tolerance <= 1.0) {
             return Err(InvalidOption::new(
-                "tolerance",
+                OptionId::Tolerance,
                 format!(
                     "must be a fraction in [0, 1] of the mean reflected direct light, not {}",
                     self.tolerance
@@ -221,7 +222,7 @@ impl RunOptions {
         }
         if !(0.0..=penumbra_meshing::MAX_MIN_ANGLE_DEG).contains(&self.min_angle) {
             return Err(InvalidOption::new(
-                "min angle",
+                OptionId::MinAngle,
                 format!(
                     "must be between 0 and {} degrees, not {}",
                     penumbra_meshing::MAX_MIN_ANGLE_DEG,
@@ -232,7 +233,7 @@ impl RunOptions {
         let event_tolerance = self.discontinuity.event_tolerance;
         if !(0.0..=1.0).contains(&event_tolerance) {
             return Err(InvalidOption::new(
-                "event tolerance",
+                OptionId::EventTolerance,
                 format!("must be a fraction between 0 and 1, not {event_tolerance}"),
             ));
         }
@@ -240,12 +241,15 @@ impl RunOptions {
             && !(t > 0.0 && t.is_finite())
         {
             return Err(InvalidOption::new(
-                "time budget",
+                OptionId::TimeBudget,
                 format!("must be a positive number of seconds, not {t}"),
             ));
         }
         if self.memory_limit == Some(0) {
-            return Err(InvalidOption::new("memory limit", "must be positive"));
+            return Err(InvalidOption::new(
+                OptionId::MemoryLimit,
+                "must be positive",
+            ));
         }
         let (width, height) = (self.render.width, self.render.height);
         let pixels = u64::from(width) * u64::from(height);
@@ -254,7 +258,7 @@ impl RunOptions {
             || pixels > penumbra_viz::MAX_PIXELS
         {
             return Err(InvalidOption::new(
-                "render size",
+                OptionId::RenderSize,
                 format!(
                     "must be from 1 to {MAX_RENDER_SIZE} pixels a side and {} pixels in all, \
                      not {width} x {height}",
@@ -271,7 +275,7 @@ impl RunOptions {
     fn validate_refinement(&self, refine: &RefineOptions) -> Result<(), InvalidOption> {
         if !(refine.tolerance > 0.0 && refine.tolerance <= 1.0) {
             return Err(InvalidOption::new(
-                "refine tolerance",
+                OptionId::RefineTolerance,
                 format!(
                     "must be a fraction in (0, 1] of the mean reflected radiosity, not {}",
                     refine.tolerance
@@ -280,13 +284,13 @@ impl RunOptions {
         }
         if refine.initial_elements == 0 {
             return Err(InvalidOption::new(
-                "initial elements",
+                OptionId::InitialElements,
                 "must be at least 1 triangle",
             ));
         }
         if !(1..=MAX_REFINE_ROUNDS).contains(&refine.max_rounds) {
             return Err(InvalidOption::new(
-                "refine rounds",
+                OptionId::RefineRounds,
                 format!(
                     "must be from 1 to {MAX_REFINE_ROUNDS}, not {}",
                     refine.max_rounds
@@ -299,7 +303,7 @@ impl RunOptions {
             SolverMethod::Progressive | SolverMethod::Hierarchical
         ) {
             return Err(InvalidOption::new(
-                "solver",
+                OptionId::Solver,
                 "adaptive refinement feeds the progressive or the hierarchical solver",
             ));
         }
@@ -308,14 +312,14 @@ impl RunOptions {
             && !direct_only
         {
             return Err(InvalidOption::new(
-                "refine indirect",
+                OptionId::RefineIndirect,
                 "the hierarchical solver estimates the indirect light's error from its \
                  gradient's jumps; use gradient",
             ));
         }
         if self.solver.form_factors.by_rows() && !direct_only {
             return Err(InvalidOption::new(
-                "form factors",
+                OptionId::FormFactors,
                 "the hemicube gives the rows of a fixed mesh; adaptive refinement needs analytic \
                  or monte-carlo",
             ));

@@ -138,7 +138,7 @@ fn library_options_are_checked_without_flags() {
             ..RunOptions::default()
         };
         let e = options.validate().expect_err("refused");
-        assert_eq!(e.option, "penumbra density");
+        assert_eq!(e.option, penumbra::OptionId::PenumbraDensity);
         let loaded = penumbra_scenes::load_scene("textbook").expect("built-in");
         let run = penumbra::run(loaded, &options, &penumbra_solver::NoProgress);
         let Err(RunError::InvalidOption(e)) = run else {
@@ -150,7 +150,7 @@ fn library_options_are_checked_without_flags() {
     options.solver.visibility_rays = usize::MAX;
     assert_eq!(
         options.validate().expect_err("refused").option,
-        "visibility rays"
+        penumbra::OptionId::VisibilityRays
     );
     assert!(RunOptions::default().validate().is_ok());
 }

@@ -52,42 +52,11 @@ fn with_details(
     }
 }
 
-/// The Python argument that sets an option the library names in words.
-fn argument(option: &str) -> &str {
-    match option {
-        "max elements" => "max_elements",
-        "initial elements" => "initial_elements",
-        "epsilon" => "epsilon",
-        "link tolerance" => "link_tol",
-        "photons" => "photons",
-        "gather photons" => "gather_photons",
-        "final gather" => "final_gather",
-        "visibility rays" => "rays",
-        "elements per patch" => "elements_per_patch",
-        "form-factor samples" => "ff_samples",
-        "hemicube resolution" => "hemicube_resolution",
-        "form factors" => "form_factors",
-        "solver" => "solver",
-        "direct only" => "direct_only",
-        "refine indirect" => "refine_indirect",
-        "refine tolerance" => "refine_tol",
-        "tolerance" => "tol",
-        "min angle" => "min_angle",
-        "refine rounds" => "refine_rounds",
-        "penumbra density" => "penumbra_density",
-        "event tolerance" => "event_tol",
-        "time budget" => "time_budget",
-        "memory limit" => "memory_limit",
-        "render size" => "width/height",
-        other => other,
-    }
-}
-
 /// An option the library refused, as a `ValueError` naming the argument.
 pub(crate) fn invalid_option(e: &InvalidOption) -> PyErr {
     PyValueError::new_err(format!(
         "invalid {} ({}): {}",
-        argument(e.option),
+        e.option.argument(),
         e.option,
         e.reason
     ))

@@ -7,8 +7,8 @@ pub enum SolveError {
     /// An option is out of its range ([`crate::SolverOptions::validate`]).
     #[error("invalid {option}: {reason}")]
     InvalidOption {
-        /// The option, in words.
-        option: &'static str,
+        /// The option.
+        option: crate::OptionId,
         /// Its allowed range.
         reason: &'static str,
     },

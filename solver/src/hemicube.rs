@@ -13,6 +13,7 @@ use std::f64::consts::PI;
 use glam::DVec3;
 
 use crate::error::SolveError;
+use crate::option_id::OptionId;
 
 /// The id of a triangle that hides what is behind it but receives no form factor (a patch seen
 /// from behind).
@@ -52,7 +53,7 @@ impl Hemicube {
     pub fn new(resolution: usize) -> Result<Hemicube, SolveError> {
         if resolution < 2 || !resolution.is_multiple_of(2) || resolution > MAX_RESOLUTION {
             return Err(SolveError::InvalidOption {
-                option: "hemicube resolution",
+                option: OptionId::HemicubeResolution,
                 reason: "must be an even number from 2 to 2048",
             });
         }

@@ -4,6 +4,7 @@
 use std::time::Instant;
 
 use crate::error::SolveError;
+use crate::option_id::OptionId;
 use crate::progress::Interrupt;
 use crate::solution::StopReason;
 
@@ -82,35 +83,35 @@ impl SolverOptions {
 
     /// Checks every field's range; the error names the option in words.
     pub fn validate(&self) -> Result<(), SolveError> {
-        let bad = |option: &'static str, reason: &'static str| {
+        let bad = |option: OptionId, reason: &'static str| {
             Err(SolveError::InvalidOption { option, reason })
         };
         if !(self.epsilon > 0.0 && self.epsilon < 1.0) {
-            return bad("epsilon", "must be in (0, 1)");
+            return bad(OptionId::Epsilon, "must be in (0, 1)");
         }
         if !(self.link_tol > 0.0 && self.link_tol < 1.0) {
-            return bad("link tolerance", "must be in (0, 1)");
+            return bad(OptionId::LinkTolerance, "must be in (0, 1)");
         }
         let photons = &self.photon_map;
         if !(1..=MAX_PHOTONS).contains(&photons.photons) {
-            return bad("photons", "must be from 1 to 200,000,000");
+            return bad(OptionId::Photons, "must be from 1 to 200,000,000");
         }
         if !(1..=MAX_GATHER_PHOTONS).contains(&photons.gather_photons) {
-            return bad("gather photons", "must be from 1 to 100,000");
+            return bad(OptionId::GatherPhotons, "must be from 1 to 100,000");
         }
         if photons.final_gather > MAX_FORM_FACTOR_SAMPLES {
-            return bad("final gather", "must be from 0 to 65,536 rays");
+            return bad(OptionId::FinalGather, "must be from 0 to 65,536 rays");
         }
         if !(1..=MAX_VISIBILITY_RAYS).contains(&self.visibility_rays) {
-            return bad("visibility rays", "must be from 1 to 4096");
+            return bad(OptionId::VisibilityRays, "must be from 1 to 4096");
         }
         if self.elements_per_patch == 0 {
-            return bad("elements per patch", "must be at least 1");
+            return bad(OptionId::ElementsPerPatch, "must be at least 1");
         }
         if let FormFactorMethod::MonteCarlo { samples } = self.form_factors
             && !(1..=MAX_FORM_FACTOR_SAMPLES).contains(&samples)
         {
-            return bad("form-factor samples", "must be from 1 to 65536");
+            return bad(OptionId::FormFactorSamples, "must be from 1 to 65536");
         }
         if let FormFactorMethod::Hemicube { resolution } = self.form_factors {
             crate::hemicube::Hemicube::new(resolution)?;

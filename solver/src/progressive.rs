@@ -34,6 +34,7 @@ use crate::direct_pass::{
 use crate::elements::{Discretization, Patch};
 use crate::error::SolveError;
 use crate::lambert::ReceivingPoint;
+use crate::option_id::OptionId;
 use crate::options::SolverOptions;
 use crate::progress::Progress;
 use crate::solution::{ConvergencePoint, Solution, SolveStats, StopReason, ambient_term};
@@ -65,7 +66,7 @@ pub fn solve_direct_on(
 ) -> Result<Solution, SolveError> {
     if !options.direct_only {
         return Err(SolveError::InvalidOption {
-            option: "direct only",
+            option: OptionId::DirectOnly,
             reason: "the light of some surfaces alone is exact only without interreflection",
         });
     }
@@ -389,7 +390,7 @@ impl<'a> ProgressiveSolver<'a> {
         if self.options.form_factors.by_rows() {
             // New vertices gather from shooters of older meshes, one pair at a time.
             return Err(SolveError::InvalidOption {
-                option: "form factors",
+                option: OptionId::FormFactors,
                 reason: "the hemicube gives the rows of a fixed mesh; refining needs analytic or monte-carlo",
             });
         }

@@ -10,6 +10,7 @@ use std::time::Instant;
 use glam::DVec3;
 use penumbra_meshing::{SceneMesh, mesh_scene_uniform};
 use penumbra_scenes::{Rgb, Scene, Surface, SurfaceId, Visibility, builtin};
+use penumbra_solver::OptionId;
 use penumbra_solver::coupling::{Coupler, FormFactorMethod, PatchCoupling, hemicube_row};
 use penumbra_solver::hemicube::Hemicube;
 use penumbra_solver::{
@@ -60,13 +61,13 @@ impl StudyOptions {
         let bad = |option, reason: String| Err(crate::InvalidOption { option, reason });
         if !(1..=MAX_STREAMS).contains(&self.streams) {
             return bad(
-                "streams",
+                OptionId::Streams,
                 format!("must be from 1 to {MAX_STREAMS}, not {}", self.streams),
             );
         }
         if !(12..=MAX_CUBE_ELEMENTS).contains(&self.cube_elements) {
             return bad(
-                "cube elements",
+                OptionId::CubeElements,
                 format!(
                     "must be from 12 (two per face) to {MAX_CUBE_ELEMENTS}, not {}",
                     self.cube_elements

@@ -13,7 +13,9 @@ use penumbra_meshing::{DEFAULT_PENUMBRA_DENSITY, TriangleLocator};
 use penumbra_scenes::{AreaSampler, SplitMix64};
 use penumbra_scenes::{LoadedScene, Scene, SurfaceId, Visibility};
 use penumbra_solver::path_trace::ReferenceValue;
-use penumbra_solver::{DirectLight, Progress, ReceivingPoint, SolverMethod, SolverOptions};
+use penumbra_solver::{
+    DirectLight, OptionId, Progress, ReceivingPoint, SolverMethod, SolverOptions,
+};
 use penumbra_viz::{LogLogChart, Series};
 use serde::Serialize;
 
@@ -150,25 +152,25 @@ impl SweepOptions {
         let bad = |option, reason: String| Err(InvalidOption { option, reason });
         if self.budgets.is_empty() || self.budgets.contains(&0) {
             return bad(
-                "max elements",
+                OptionId::MaxElements,
                 "every budget must be at least 1 triangle".into(),
             );
         }
         if !(1..=MAX_SAMPLES).contains(&self.samples) {
             return bad(
-                "samples",
+                OptionId::Samples,
                 format!("must be from 1 to {MAX_SAMPLES}, not {}", self.samples),
             );
         }
         if !(self.refine_tol > 0.0 && self.refine_tol <= 1.0) {
             return bad(
-                "refine tolerance",
+                OptionId::RefineTolerance,
                 format!("must be a fraction in (0, 1], not {}", self.refine_tol),
             );
         }
         if !(self.initial_fraction > 0.0 && self.initial_fraction <= 1.0) {
             return bad(
-                "initial elements",
+                OptionId::InitialElements,
                 format!(
                     "the fraction must be in (0, 1], not {}",
                     self.initial_fraction
@@ -181,7 +183,7 @@ impl SweepOptions {
         self.solver.validate()?;
         if jobs(self).is_empty() {
             return bad(
-                "solver",
+                OptionId::Solver,
                 "photon mapping runs only on meshes that are not refined: add a method without \
                  +adaptive"
                     .into(),
@@ -199,13 +201,13 @@ impl SweepOptions {
             })
         };
         if self.photon_elements == 0 {
-            return bad("photon elements", "must be at least 1 triangle");
+            return bad(OptionId::PhotonElements, "must be at least 1 triangle");
         }
         if self.photons.is_empty() {
-            return bad("photons", "give at least one photon budget");
+            return bad(OptionId::Photons, "give at least one photon budget");
         }
         if self.final_gathers.is_empty() {
-            return bad("final gather", "give at least one count of rays");
+            return bad(OptionId::FinalGather, "give at least one count of rays");
         }
         let mut solver = self.solver.clone();
         for &photons in &self.photons {

@@ -1,7 +1,7 @@
 //! Failures, the exit code each gets, and their messages in terms of the flags that set them:
 //! the library's errors describe the data; only here do they learn the command line's spelling.
 
-use penumbra::{InvalidOption, RunError};
+use penumbra::{InvalidOption, OptionId, RunError};
 use penumbra_meshing::MeshError;
 
 /// A failure, and whether it was the user's input (exit 2) or the run (exit 1).
@@ -52,44 +52,18 @@ pub(crate) enum Command {
     FormFactors,
 }
 
-/// The flag that sets an option the library names in words, in `command`.
-fn flag(option: &str, command: Command) -> Option<&'static str> {
+/// The flag that sets `option` in `command`: `run`'s ([`OptionId::flag`]), but for the options
+/// `sweep` and `form-factors` spell their own way (none for the solver a study chooses itself).
+fn flag(option: OptionId, command: Command) -> Option<&'static str> {
+    use OptionId as O;
     Some(match (option, command) {
-        ("max elements", Command::Sweep) => "--budgets",
-        ("initial elements", Command::Sweep) => "--initial-fraction",
-        ("max elements", Command::Run) => "--max-elements",
-        ("initial elements", Command::Run) => "--initial-elements",
-        ("form-factor samples", Command::FormFactors) => "--samples",
-        ("hemicube resolution", Command::FormFactors) => "--resolutions",
-        ("streams", _) => "--streams",
-        ("cube elements", _) => "--cube-elements",
-        ("epsilon", _) => "--epsilon",
-        ("link tolerance", _) => "--link-tol",
-        ("photons", _) => "--photons",
-        ("photon elements", _) => "--photon-elements",
-        ("gather photons", _) => "--gather-photons",
-        ("final gather", _) => "--final-gather",
-        ("visibility rays", _) => "--rays",
-        ("elements per patch", _) => "--elements-per-patch",
-        ("form-factor samples", _) => "--ff-samples",
-        ("hemicube resolution", _) => "--hemicube-resolution",
-        ("form factors", _) => "--form-factors",
-        ("solver", Command::Run) => "--solver",
-        ("solver", Command::Sweep) => "--solvers",
-        ("solver", Command::FormFactors) => return None,
-        ("direct only", _) => "--direct-only",
-        ("refine indirect", _) => "--refine-indirect",
-        ("refine tolerance", _) => "--refine-tol",
-        ("tolerance", _) => "--tol",
-        ("min angle", _) => "--min-angle",
-        ("refine rounds", _) => "--refine-rounds",
-        ("penumbra density", _) => "--penumbra-density",
-        ("event tolerance", _) => "--event-tol",
-        ("time budget", _) => "--time-budget",
-        ("memory limit", _) => "--memory-limit",
-        ("render size", _) => "--width/--height",
-        ("samples", _) => "--samples",
-        _ => return None,
+        (O::MaxElements, Command::Sweep) => "--budgets",
+        (O::InitialElements, Command::Sweep) => "--initial-fraction",
+        (O::Solver, Command::Sweep) => "--solvers",
+        (O::FormFactorSamples, Command::FormFactors) => "--samples",
+        (O::HemicubeResolution, Command::FormFactors) => "--resolutions",
+        (O::Solver, Command::FormFactors) => return None,
+        (option, _) => option.flag(),
     })
 }
 

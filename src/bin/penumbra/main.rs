@@ -185,3 +185,29 @@ fn dump(name: &str) -> Result<(), Failure> {
     print!("{}", penumbra_scenes::to_json(&scene));
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every option's flag ([`penumbra::OptionId::flag`]) is one some command takes, so a
+    /// refused value is told by a flag the user can find.
+    #[test]
+    fn every_option_flag_is_a_flag_of_the_command_line() {
+        use clap::CommandFactory;
+        let cli = Cli::command();
+        let flags: Vec<String> = cli
+            .get_subcommands()
+            .flat_map(|c| c.get_arguments())
+            .filter_map(|a| a.get_long().map(|l| format!("--{l}")))
+            .collect();
+        for option in penumbra::OptionId::ALL {
+            for flag in option.flag().split('/') {
+                assert!(
+                    flags.iter().any(|f| f == flag),
+                    "{option}: {flag} is no flag"
+                );
+            }
+        }
+    }
+}
