@@ -332,7 +332,7 @@ pub fn convergence_files(result: &RunResult) -> anyhow::Result<Vec<(String, Vec<
                 points,
             }],
         };
-        files.push((format!("{stem}.svg"), chart.svg().into_bytes()));
+        files.push((format!("{stem}.svg"), chart.svg()?.into_bytes()));
         files.push((format!("{stem}.png"), chart.png()?));
     }
     Ok(files)

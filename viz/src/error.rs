@@ -87,4 +87,7 @@ pub enum VizError {
     /// The image encoder failed.
     #[error("PNG encoding failed: {0}")]
     Png(#[from] image::ImageError),
+    /// The chart library could not draw a chart (its font did not load, or a backend failed).
+    #[error("chart drawing failed: {0}")]
+    Chart(String),
 }

@@ -52,7 +52,7 @@
 //!         points: (1..=10).map(|n| (f64::from(n), 1.0 / f64::from(n))).collect(),
 //!     }],
 //! };
-//! assert!(chart.svg().contains("one over n"));
+//! assert!(chart.svg().unwrap().contains("one over n"));
 //! ```
 
 #![warn(missing_docs)]

@@ -198,7 +198,7 @@ pub(crate) fn sweep(args: &SweepArgs) -> Result<(), Failure> {
     for (stem, chart) in penumbra::experiments::sweep::sweep_charts(&result) {
         penumbra::outputs::write_atomic(
             &args.out.join(format!("{stem}.svg")),
-            chart.svg().as_bytes(),
+            chart.svg()?.as_bytes(),
         )?;
         penumbra::outputs::write_atomic(&args.out.join(format!("{stem}.png")), &chart.png()?)?;
     }
