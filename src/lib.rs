@@ -119,6 +119,7 @@ pub mod export;
 mod fingerprint;
 #[doc(hidden)] // Support for the fuzz targets and their tests, not an API.
 pub mod fuzzing;
+mod json_text;
 pub mod memory;
 pub mod options;
 pub mod outputs;
@@ -128,6 +129,7 @@ pub mod report;
 pub mod run_error;
 pub mod run_result;
 pub mod shard;
+pub mod svg_selection;
 
 pub use options::{
     DEFAULT_BUDGET, DEFAULT_FF_SAMPLES, DEFAULT_HEMICUBE_RESOLUTION, DEFAULT_MAX_ELEMENTS,

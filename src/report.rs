@@ -15,8 +15,8 @@ use crate::adaptive::RefineReport;
 use crate::energy::EnergyBalance;
 use crate::error_mesh::{ErrorStop, MeshErrorReport};
 use crate::options::{Invocation, MeshMethod};
-use crate::outputs::{SVG_DIR, SvgSelection, svg_name};
 use crate::run_result::{MemoryReport, RunResult, StagePeaks, StageTimes, Stopped};
+use crate::svg_selection::{SVG_DIR, SvgSelection, svg_name};
 
 /// The `format` of `report.json`, and its version (`docs/schemas/report.schema.json`).
 pub const REPORT_FORMAT: &str = "penumbra-report/1";
@@ -333,7 +333,7 @@ impl Report {
 
     /// The text of `report.json`: pretty-printed, with a final newline.
     pub fn to_json(&self) -> String {
-        crate::outputs::to_json(self)
+        crate::json_text::to_json(self)
     }
 }
 
