@@ -114,8 +114,9 @@ def run(
     :class:`RunInterrupted` carrying the partial solution (a second Ctrl-C raises at once,
     leaving the run to end in the background); an exception from another signal handler is
     raised as it is, with the partial solution as its ``solution`` attribute; ``interrupt.set()`` from another
-    thread stops it and ``run`` returns the partial solution (``solution.partial``), or raises
-    :class:`RunCancelled` if none existed yet; ``interrupt.clear()`` lets it start runs again.
+    thread stops it and ``run`` returns the partial solution (``solution.partial``; the scene's
+    least mesh with its direct light if no mesh had values yet, ``solution.report["stopped"]``
+    says where it stopped); ``interrupt.clear()`` lets it start runs again.
 
     Raises ``ValueError`` for an option out of range (naming it), ``TypeError`` for a value of
     the wrong kind, ``MemoryError`` when the run would not fit in memory (saying what would)."""
