@@ -234,22 +234,7 @@ pub fn mesh_scene_discontinuity_on(
                 return Ok(None);
             }
             let segments = found.segments.get(id).map(Vec::as_slice).unwrap_or(&[]);
-            let constraints: Vec<Constraint> = match PlaneFrame::of_polygon(&s.polygon) {
-                Some(frame) => segments
-                    .iter()
-                    .map(|g| Constraint {
-                        from: frame.to_2d(g.from),
-                        to: frame.to_2d(g.to),
-                        splits: g.event == Event::Contact,
-                    })
-                    .collect(),
-                None => Vec::new(),
-            };
-            // Joined ends can leave two lines of nearly one direction from one point, which
-            // spade's constraint insertion does not survive; those surfaces keep the ends apart.
-            ConstrainedSurface::joining(id, s, &constraints, join)
-                .or_else(|_| ConstrainedSurface::new(id, s, &constraints))
-                .map(|c| Some(c.with_min_angle(min_angle_deg)))
+            constrained_surface(id, s, segments, join, min_angle_deg).map(Some)
         })
         .collect::<Result<Vec<_>, _>>()?;
     let areas: Vec<f64> = scene
@@ -263,52 +248,134 @@ pub fn mesh_scene_discontinuity_on(
         .collect();
     let (budget, targets) = match alone {
         Some(extra) => share_alone(&areas, &minimum, &meshed, extra),
-        None => {
-            let (budget, shares) = spread_by_area(&areas, &minimum, budget, true)?;
-            let room = (QUALITY_EXTRA_SHARE * budget as f64) as usize;
-            let quality: Vec<Option<usize>> = constrained
-                .par_iter_mut()
-                .zip(&shares)
-                .map(|(c, &t)| c.as_mut().and_then(|c| c.quality_triangles(t + room)))
-                .collect();
-            let minima = quality_minima(&minimum, &shares, &quality, budget);
-            spread_by_area(&areas, &minima, budget, true)?
-        }
+        None => spread_with_quality(&areas, &minimum, &mut constrained, budget)?,
     };
     let minimum_triangles = minimum.iter().sum();
+    let grading = Grading {
+        scene,
+        visibility,
+        segments: &found.segments,
+        penumbra_density,
+    };
     let refinable: Vec<Option<RefinableSurface>> = constrained
         .into_par_iter()
         .zip(targets)
         .enumerate()
-        .map(|(id, (c, target))| {
-            let c = c?;
-            let surface = &scene.surfaces[id];
-            let Some(frame) = PlaneFrame::of_polygon(&surface.polygon) else {
-                return Some(c.into_refinable(target, 1.0, &|_| false));
-            };
-            let emitters: BTreeSet<SurfaceId> = found
-                .segments
-                .get(id)
-                .into_iter()
-                .flatten()
-                .map(|g| g.emitter)
-                .collect();
-            let probes: Vec<EmitterProbe> = emitters
-                .into_iter()
-                .map(|e| EmitterProbe::new(scene, e))
-                .collect();
-            let varies = |points: &[DVec3]| {
-                probes.iter().any(|probe| {
-                    let (lo, hi) = points.iter().fold((1.0f64, 0.0f64), |(lo, hi), &x| {
-                        let f = probe.visible_fraction(visibility, x, frame.normal, id);
-                        (lo.min(f), hi.max(f))
-                    });
-                    hi > 0.0 && lo < 1.0
-                })
-            };
-            Some(c.into_refinable(target, penumbra_density, &varies))
-        })
+        .map(|(id, (c, target))| Some(grading.refinable(id, c?, target)))
         .collect();
+    let (surfaces, refinable) = meshes_of(scene, refinable)?;
+    let mut discontinuities = found.segments;
+    discontinuities.resize(scene.surfaces.len(), Vec::new());
+    let mut hovering = found.hovering;
+    hovering.resize(scene.surfaces.len(), Vec::new());
+    Ok(SceneMesh {
+        surfaces,
+        refinable,
+        discontinuities,
+        hovering,
+        discontinuity_stats: Some(found.stats),
+        budget,
+        minimum_triangles,
+        measured_direct: Vec::new(),
+    })
+}
+
+/// Surface `id`'s triangulation with its discontinuity `segments` as constraints (contact lines
+/// among them split it), their ends within `join` of each other joined where spade allows,
+/// refined later to angles of at least `min_angle_deg`.
+fn constrained_surface(
+    id: SurfaceId,
+    surface: &penumbra_scenes::Surface,
+    segments: &[DiscontinuitySegment],
+    join: f64,
+    min_angle_deg: f64,
+) -> Result<ConstrainedSurface, MeshError> {
+    let constraints: Vec<Constraint> = match PlaneFrame::of_polygon(&surface.polygon) {
+        Some(frame) => segments
+            .iter()
+            .map(|g| Constraint {
+                from: frame.to_2d(g.from),
+                to: frame.to_2d(g.to),
+                splits: g.event == Event::Contact,
+            })
+            .collect(),
+        None => Vec::new(),
+    };
+    // Joined ends can leave two lines of nearly one direction from one point, which spade's
+    // constraint insertion does not survive; those surfaces keep the ends apart.
+    ConstrainedSurface::joining(id, surface, &constraints, join)
+        .or_else(|_| ConstrainedSurface::new(id, surface, &constraints))
+        .map(|c| c.with_min_angle(min_angle_deg))
+}
+
+/// `budget` spread over every surface by area, resolved ([`spread_by_area`]), with the least
+/// meshes grown to least quality meshes where [`quality_minima`] finds room for them: the
+/// resolved budget and the targets.
+fn spread_with_quality(
+    areas: &[f64],
+    minimum: &[usize],
+    constrained: &mut [Option<ConstrainedSurface>],
+    budget: ElementBudget,
+) -> Result<(usize, Vec<usize>), MeshError> {
+    let (budget, shares) = spread_by_area(areas, minimum, budget, true)?;
+    let room = (QUALITY_EXTRA_SHARE * budget as f64) as usize;
+    let quality: Vec<Option<usize>> = constrained
+        .par_iter_mut()
+        .zip(&shares)
+        .map(|(c, &t)| c.as_mut().and_then(|c| c.quality_triangles(t + room)))
+        .collect();
+    let minima = quality_minima(minimum, &shares, &quality, budget);
+    spread_by_area(areas, &minima, budget, true)
+}
+
+/// How refinement grades a surface: triangles `penumbra_density` times smaller in area where
+/// the light of an emitter whose discontinuities cross the surface varies.
+struct Grading<'a> {
+    scene: &'a Scene,
+    visibility: &'a Visibility,
+    /// Each surface's discontinuity segments, which name the emitters that shade it.
+    segments: &'a [Vec<DiscontinuitySegment>],
+    penumbra_density: f64,
+}
+
+impl Grading<'_> {
+    /// Surface `id`'s triangulation `c` refined to about `target` triangles, graded where the
+    /// light varies (not at all on a surface without a plane).
+    fn refinable(&self, id: SurfaceId, c: ConstrainedSurface, target: usize) -> RefinableSurface {
+        let surface = &self.scene.surfaces[id];
+        let Some(frame) = PlaneFrame::of_polygon(&surface.polygon) else {
+            return c.into_refinable(target, 1.0, &|_| false);
+        };
+        let emitters: BTreeSet<SurfaceId> = self
+            .segments
+            .get(id)
+            .into_iter()
+            .flatten()
+            .map(|g| g.emitter)
+            .collect();
+        let probes: Vec<EmitterProbe> = emitters
+            .into_iter()
+            .map(|e| EmitterProbe::new(self.scene, e))
+            .collect();
+        let varies = |points: &[DVec3]| {
+            probes.iter().any(|probe| {
+                let (lo, hi) = points.iter().fold((1.0f64, 0.0f64), |(lo, hi), &x| {
+                    let f = probe.visible_fraction(self.visibility, x, frame.normal, id);
+                    (lo.min(f), hi.max(f))
+                });
+                hi > 0.0 && lo < 1.0
+            })
+        };
+        c.into_refinable(target, self.penumbra_density, &varies)
+    }
+}
+
+/// Each surface's mesh and its triangulation, kept for adaptive refinement; a surface not meshed
+/// (`None`) gets an empty mesh and an unrefined triangulation.
+fn meshes_of(
+    scene: &Scene,
+    refinable: Vec<Option<RefinableSurface>>,
+) -> Result<(Vec<SurfaceMesh>, Vec<RefinableSurface>), MeshError> {
     let surfaces = refinable
         .par_iter()
         .zip(&scene.surfaces)
@@ -327,20 +394,7 @@ pub fn mesh_scene_discontinuity_on(
             None => RefinableSurface::uniform(id, s, 0),
         })
         .collect::<Result<Vec<_>, _>>()?;
-    let mut discontinuities = found.segments;
-    discontinuities.resize(scene.surfaces.len(), Vec::new());
-    let mut hovering = found.hovering;
-    hovering.resize(scene.surfaces.len(), Vec::new());
-    Ok(SceneMesh {
-        surfaces,
-        refinable,
-        discontinuities,
-        hovering,
-        discontinuity_stats: Some(found.stats),
-        budget,
-        minimum_triangles,
-        measured_direct: Vec::new(),
-    })
+    Ok((surfaces, refinable))
 }
 
 /// At most this share of a budget goes to surfaces beyond their share by area, so that their

@@ -203,20 +203,29 @@ impl NearBlockers {
     }
 }
 
-impl EeeSearch<'_> {
-    /// The EEE curves of emitter edges `emitter_edges` with the blocker edges `edges` (welded
-    /// vertex pairs) of the surfaces `blockers`, and what it took.
-    pub(super) fn curves(
-        &self,
-        emitter_edges: &[(usize, usize)],
+/// The blocker edges of one search, indexed to find each edge's partners: the edges that share
+/// a vertex with it, and those along the blockers near the region beyond it.
+struct BlockerEdges {
+    /// The edges (welded vertex pairs), in order; an edge's index is its place here.
+    list: Vec<(usize, usize)>,
+    /// The edges at each vertex.
+    at_vertex: HashMap<usize, Vec<usize>>,
+    /// Along each blocker (by its place in the search's blockers): its edges and its polygon.
+    along_blocker: Vec<Vec<usize>>,
+    polygons: Vec<Vec<DVec3>>,
+    /// Each edge's faces ([`Topology::edge_faces`]).
+    faces: Vec<Vec<DVec3>>,
+    near: NearBlockers,
+}
+
+impl BlockerEdges {
+    /// The edges `edges` of the surfaces `blockers`, in `search`'s pair.
+    fn new(
+        search: &EeeSearch,
         edges: &BTreeSet<(usize, usize)>,
         blockers: &[SurfaceId],
-    ) -> (Vec<EeeCurve>, EeeCount) {
-        let mut count = EeeCount::default();
-        let mut curves = Vec::new();
-        let t = self.pair.topology;
-        // Blocker edges by index, at each vertex (for the pairs that share one) and along each
-        // surface (for the pairs found by region).
+    ) -> BlockerEdges {
+        let t = search.pair.topology;
         let list: Vec<(usize, usize)> = edges.iter().copied().collect();
         let index: HashMap<(usize, usize), usize> =
             list.iter().enumerate().map(|(i, &e)| (e, i)).collect();
@@ -225,7 +234,6 @@ impl EeeSearch<'_> {
             at_vertex.entry(u).or_default().push(i);
             at_vertex.entry(w).or_default().push(i);
         }
-        // Along each blocker (by its place in `blockers`): its edges and its polygon.
         let along_blocker: Vec<Vec<usize>> = blockers
             .iter()
             .map(|&s| {
@@ -242,101 +250,193 @@ impl EeeSearch<'_> {
             .iter()
             .map(|&s| t.loops[s].iter().map(|&v| t.points[v]).collect())
             .collect();
-        let not_pair = self.pair.not_pair();
+        let not_pair = search.pair.not_pair();
         let faces: Vec<Vec<DVec3>> = list
             .iter()
             .map(|&(u, w)| t.edge_faces(u, w, &not_pair))
             .collect();
-        let near_finder = NearBlockers::new(t, blockers, self.surface_leaves);
-        let mut near: Vec<usize> = Vec::new();
-        // Blockers and edges already taken for the current first edge, stamped to skip repeats.
-        let mut blocker_stamp = vec![usize::MAX; blockers.len()];
-        let mut edge_stamp = vec![usize::MAX; list.len()];
-        let mut partners: Vec<usize> = Vec::new();
-        let mut round = 0usize;
+        BlockerEdges {
+            list,
+            at_vertex,
+            along_blocker,
+            polygons,
+            faces,
+            near: NearBlockers::new(t, blockers, search.surface_leaves),
+        }
+    }
+}
+
+/// The partners of one first edge after another. Blockers and edges already taken for the
+/// current first edge are stamped with its round, to skip repeats without clearing the stamps.
+struct Partners {
+    round: usize,
+    blocker_stamp: Vec<usize>,
+    edge_stamp: Vec<usize>,
+    /// The blockers near the current first edge's region.
+    near: Vec<usize>,
+    /// The current first edge's partners, in order.
+    found: Vec<usize>,
+}
+
+impl Partners {
+    /// Stamps for the blockers and the edges of `edges`, none taken yet.
+    fn new(edges: &BlockerEdges) -> Partners {
+        Partners {
+            round: 0,
+            blocker_stamp: vec![usize::MAX; edges.polygons.len()],
+            edge_stamp: vec![usize::MAX; edges.list.len()],
+            near: Vec::new(),
+            found: Vec::new(),
+        }
+    }
+
+    /// The usable edges (those with a region in `regions`) that may make a triple with edge
+    /// `i1`, whose region has the corners `corners`: the edges that share a vertex with it, and
+    /// those along the blockers near its region and not `outside` it.
+    fn of(
+        &mut self,
+        search: &EeeSearch,
+        edges: &BlockerEdges,
+        i1: usize,
+        corners: &[DVec3; 6],
+        regions: &[Option<[DVec3; 6]>],
+        outside: impl Fn(&[DVec3]) -> bool,
+    ) -> &[usize] {
+        let Partners {
+            round,
+            blocker_stamp,
+            edge_stamp,
+            near,
+            found,
+        } = self;
+        *round += 1;
+        let round = *round;
+        found.clear();
+        let mut take = |i: usize| {
+            if edge_stamp[i] != round && i != i1 && regions[i].is_some() {
+                edge_stamp[i] = round;
+                found.push(i);
+            }
+        };
+        let first = edges.list[i1];
+        for v in [first.0, first.1] {
+            for &i in edges.at_vertex.get(&v).into_iter().flatten() {
+                take(i);
+            }
+        }
+        near.clear();
+        let region = Bounds::from_points(corners.iter());
+        edges
+            .near
+            .find(search.pair.visibility, region, search.pair.tol, |b| {
+                if blocker_stamp[b] != round {
+                    blocker_stamp[b] = round;
+                    near.push(b);
+                }
+            });
+        for &b in near.iter() {
+            if outside(&edges.polygons[b]) {
+                continue;
+            }
+            for &i in &edges.along_blocker[b] {
+                take(i);
+            }
+        }
+        found.sort_unstable();
+        found
+    }
+}
+
+impl EeeSearch<'_> {
+    /// The EEE curves of emitter edges `emitter_edges` with the blocker edges `edges` (welded
+    /// vertex pairs) of the surfaces `blockers`, and what it took.
+    pub(super) fn curves(
+        &self,
+        emitter_edges: &[(usize, usize)],
+        edges: &BTreeSet<(usize, usize)>,
+        blockers: &[SurfaceId],
+    ) -> (Vec<EeeCurve>, EeeCount) {
+        let mut count = EeeCount::default();
+        let mut curves = Vec::new();
+        let t = self.pair.topology;
+        let edges = BlockerEdges::new(self, edges, blockers);
+        let mut partners = Partners::new(&edges);
         for &(ia, ib) in emitter_edges {
             let source = [t.points[ia], t.points[ib]];
-            // Edges lying on the receiver are contact lines, not blockers of its light; edges
-            // whose shadow from the emitter edge misses the receiver cannot cast an event on it.
-            // Each usable edge keeps the corners of the region beyond it.
-            let regions: Vec<Option<[DVec3; 6]>> = list
-                .iter()
-                .map(|&(u, w)| {
-                    let b = [t.points[u], t.points[w]];
-                    if !(b
-                        .iter()
-                        .any(|&p| self.pair.receiver_frame.height(p) > self.pair.tol)
-                        && self.can_be_silhouette(u, w, source))
-                    {
-                        return None;
-                    }
-                    let corners = self.beyond(source, b);
-                    self.shadow_meets_receiver(&corners[2..]).then_some(corners)
-                })
-                .collect();
-            for (i1, &first) in list.iter().enumerate() {
-                let Some(corners) = regions[i1] else {
+            let regions = self.regions_beyond(source, &edges.list);
+            for (i1, region) in regions.iter().enumerate() {
+                let Some(corners) = region else {
                     continue;
                 };
-                round += 1;
-                let b1 = [t.points[first.0], t.points[first.1]];
-                let hull = super::hull::hull_planes(&corners, self.pair.tol);
+                let hull = super::hull::hull_planes(corners, self.pair.tol);
                 let outside =
                     |points: &[DVec3]| super::hull::beyond_a_face(&hull, points, self.pair.tol);
-                partners.clear();
-                let mut take = |i: usize, partners: &mut Vec<usize>| {
-                    if edge_stamp[i] != round && i != i1 && regions[i].is_some() {
-                        edge_stamp[i] = round;
-                        partners.push(i);
-                    }
-                };
-                for v in [first.0, first.1] {
-                    for &i in at_vertex.get(&v).into_iter().flatten() {
-                        take(i, &mut partners);
-                    }
-                }
-                near.clear();
-                near_finder.find(
-                    self.pair.visibility,
-                    Bounds::from_points(corners.iter()),
-                    self.pair.tol,
-                    |b| {
-                        if blocker_stamp[b] != round {
-                            blocker_stamp[b] = round;
-                            near.push(b);
-                        }
-                    },
-                );
-                for &b in &near {
-                    if outside(&polygons[b]) {
-                        continue;
-                    }
-                    for &i in &along_blocker[b] {
-                        take(i, &mut partners);
-                    }
-                }
-                partners.sort_unstable();
-                let planes = OnceCell::new();
-                for &i2 in &partners {
-                    let second = list[i2];
-                    let b2 = [t.points[second.0], t.points[second.1]];
-                    if outside(&b2)
-                        || !sweeps_across(source, b1, b2)
-                        || !sweeps_across(source, b2, b1)
-                    {
-                        continue;
-                    }
-                    count.considered += 1;
-                    let found =
-                        self.triple(source, [first, second], [&faces[i1], &faces[i2]], &planes);
-                    if !found.is_empty() {
-                        count.events += 1;
-                        curves.extend(found);
-                    }
-                }
+                let found = partners.of(self, &edges, i1, corners, &regions, outside);
+                curves.extend(self.curves_with(source, &edges, i1, found, outside, &mut count));
             }
         }
         (curves, count)
+    }
+
+    /// For each blocker edge, when it can make an event on the receiver with the emitter edge
+    /// `source`, the corners of the region beyond it ([`Self::beyond`]). Edges lying on the
+    /// receiver are contact lines, not blockers of its light; edges whose shadow from the
+    /// emitter edge misses the receiver cannot cast an event on it.
+    fn regions_beyond(
+        &self,
+        source: [DVec3; 2],
+        edges: &[(usize, usize)],
+    ) -> Vec<Option<[DVec3; 6]>> {
+        let t = self.pair.topology;
+        edges
+            .iter()
+            .map(|&(u, w)| {
+                let b = [t.points[u], t.points[w]];
+                if !(b
+                    .iter()
+                    .any(|&p| self.pair.receiver_frame.height(p) > self.pair.tol)
+                    && self.can_be_silhouette(u, w, source))
+                {
+                    return None;
+                }
+                let corners = self.beyond(source, b);
+                self.shadow_meets_receiver(&corners[2..]).then_some(corners)
+            })
+            .collect()
+    }
+
+    /// The curves of the triples of emitter edge `source`, first edge `i1` and each of its
+    /// `partners` that is not `outside` the region beyond the first edge and that each of the
+    /// two blocker edges sweeps across as seen from the emitter edge; `count` counts them.
+    fn curves_with(
+        &self,
+        source: [DVec3; 2],
+        edges: &BlockerEdges,
+        i1: usize,
+        partners: &[usize],
+        outside: impl Fn(&[DVec3]) -> bool,
+        count: &mut EeeCount,
+    ) -> Vec<EeeCurve> {
+        let t = self.pair.topology;
+        let first = edges.list[i1];
+        let b1 = [t.points[first.0], t.points[first.1]];
+        let planes = OnceCell::new();
+        let mut curves = Vec::new();
+        for &i2 in partners {
+            let second = edges.list[i2];
+            let b2 = [t.points[second.0], t.points[second.1]];
+            if outside(&b2) || !sweeps_across(source, b1, b2) || !sweeps_across(source, b2, b1) {
+                continue;
+            }
+            count.considered += 1;
+            let faces = [&edges.faces[i1][..], &edges.faces[i2][..]];
+            let found = self.triple(source, [first, second], faces, &planes);
+            if !found.is_empty() {
+                count.events += 1;
+                curves.extend(found);
+            }
+        }
+        curves
     }
 
     /// Whether blocker edge `(u, w)` is on the silhouette of its faces as seen from some point of

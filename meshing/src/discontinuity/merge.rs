@@ -1,6 +1,8 @@
 //! Coincident critical lines merged into one: in the parallel case the EV wedges of both ends of a
 //! blocker edge and the VE wedges of its emitter vertices all lie in one plane.
 
+use std::collections::{BTreeMap, HashMap};
+
 use glam::DVec2;
 use penumbra_scenes::UnionFind;
 
@@ -27,116 +29,167 @@ pub(super) fn merge_collinear<T: Copy>(
         .iter()
         .filter(|s| s.from.distance(s.to) > tol)
         .collect();
-    let n = segments.len();
-    // Bucket lines by the doubled angle of their direction (the same for both orientations, so
-    // no sign to canonicalize) and by their distance from the origin along the canonical normal.
-    let angle_cell = 1e-6;
-    let offset_cell = 4.0 * tol.max(f64::MIN_POSITIVE);
-    let key = |s: &FlatSegment<T>| {
+    let mut out = Vec::new();
+    for (root, members) in collinear_groups(&segments, tol) {
+        let members = members.iter().map(|&m| segments[m]);
+        out.extend(merge_line(segments[root], members, tol, &combine, &joins));
+    }
+    out
+}
+
+/// Cells of lines, by the doubled angle of their direction (the same for both orientations, so
+/// no sign to canonicalize) and by their distance from the origin along the canonical normal:
+/// segments on one line fall in one cell or in neighbouring ones.
+struct LineCells {
+    /// The width of a cell in the doubled angle (radians), and in the offset.
+    angle: f64,
+    offset: f64,
+    /// The greatest angle cell.
+    wrap: i64,
+}
+
+impl LineCells {
+    /// Cells for lines that are one within `tol`.
+    fn new(tol: f64) -> LineCells {
+        let angle = 1e-6;
+        LineCells {
+            angle,
+            offset: 4.0 * tol.max(f64::MIN_POSITIVE),
+            wrap: (std::f64::consts::PI / angle).floor() as i64,
+        }
+    }
+
+    /// The cell of the line through `s`.
+    fn key<T>(&self, s: &FlatSegment<T>) -> (i64, i64) {
         let d = (s.to - s.from).normalize();
         let phi = (2.0 * d.x * d.y).atan2(d.x * d.x - d.y * d.y);
         let half = DVec2::new((phi / 2.0).cos(), (phi / 2.0).sin());
         let offset = half.perp_dot(s.from);
         (
-            (phi / angle_cell).floor() as i64,
-            (offset / offset_cell).floor() as i64,
+            (phi / self.angle).floor() as i64,
+            (offset / self.offset).floor() as i64,
         )
-    };
-    let keys: Vec<(i64, i64)> = segments.iter().map(|s| key(s)).collect();
-    let wrap = (std::f64::consts::PI / angle_cell).floor() as i64;
-    let mut buckets: std::collections::HashMap<(i64, i64), Vec<usize>> = Default::default();
+    }
+
+    /// The cell `key` and its eight neighbours, by angle and then by offset.
+    fn around(&self, (ka, ko): (i64, i64)) -> [(i64, i64); 9] {
+        std::array::from_fn(|k| {
+            let (da, doff) = (k as i64 / 3 - 1, k as i64 % 3 - 1);
+            let mut a = ka + da;
+            let mut o = ko + doff;
+            // Across the doubled angle's wrap the canonical normal flips, and so does the offset.
+            if a > self.wrap {
+                a -= 2 * self.wrap + 2;
+                o = -o - 1;
+            } else if a < -self.wrap - 1 {
+                a += 2 * self.wrap + 2;
+                o = -o - 1;
+            }
+            (a, o)
+        })
+    }
+}
+
+/// The segments by line: each group of segments on one line under the index of its union–find
+/// root, the groups in the order of their roots.
+fn collinear_groups<T>(segments: &[&FlatSegment<T>], tol: f64) -> BTreeMap<usize, Vec<usize>> {
+    let n = segments.len();
+    let cells = LineCells::new(tol);
+    let keys: Vec<(i64, i64)> = segments.iter().map(|s| cells.key(s)).collect();
+    let mut buckets: HashMap<(i64, i64), Vec<usize>> = HashMap::default();
     for (i, &k) in keys.iter().enumerate() {
         buckets.entry(k).or_default().push(i);
     }
-    let collinear = |a: &FlatSegment<T>, b: &FlatSegment<T>| {
-        let on = |s: &FlatSegment<T>, p: DVec2| {
-            let d = s.to - s.from;
-            d.perp_dot(p - s.from).abs() <= tol * d.length()
-        };
-        on(a, b.from) && on(a, b.to) && on(b, a.from) && on(b, a.to)
-    };
     let mut sets = UnionFind::new(n);
     for i in 0..n {
-        let (ka, ko) = keys[i];
-        for da in -1..=1 {
-            for doff in -1..=1 {
-                let mut a = ka + da;
-                let mut o = ko + doff;
-                // Across the doubled angle's wrap the canonical normal flips, and so does the offset.
-                if a > wrap {
-                    a -= 2 * wrap + 2;
-                    o = -o - 1;
-                } else if a < -wrap - 1 {
-                    a += 2 * wrap + 2;
-                    o = -o - 1;
-                }
-                let Some(others) = buckets.get(&(a, o)) else {
-                    continue;
-                };
-                for &j in others {
-                    if j > i && collinear(segments[i], segments[j]) {
-                        sets.join(i, j);
-                    }
+        for cell in cells.around(keys[i]) {
+            let Some(others) = buckets.get(&cell) else {
+                continue;
+            };
+            for &j in others {
+                if j > i && collinear(segments[i], segments[j], tol) {
+                    sets.join(i, j);
                 }
             }
         }
     }
-    let mut groups: std::collections::BTreeMap<usize, Vec<usize>> = Default::default();
+    let mut groups: BTreeMap<usize, Vec<usize>> = BTreeMap::default();
     for i in 0..n {
         let r = sets.find(i);
         groups.entry(r).or_default().push(i);
     }
+    groups
+}
 
-    let mut out = Vec::new();
-    for (root, members) in groups {
-        let reference = segments[root];
-        let origin = reference.from;
-        let dir = (reference.to - reference.from).normalize();
-        let intervals: Vec<(f64, f64, T)> = members
+/// Whether every endpoint of each of `a` and `b` is within `tol` of the other's line.
+fn collinear<T>(a: &FlatSegment<T>, b: &FlatSegment<T>, tol: f64) -> bool {
+    let on = |s: &FlatSegment<T>, p: DVec2| {
+        let d = s.to - s.from;
+        d.perp_dot(p - s.from).abs() <= tol * d.length()
+    };
+    on(a, b.from) && on(a, b.to) && on(b, a.from) && on(b, a.to)
+}
+
+/// The union of `members`, segments on the line of `reference`, as [`merge_collinear`] merges
+/// it, in order along that line.
+fn merge_line<'s, T: Copy + 's>(
+    reference: &FlatSegment<T>,
+    members: impl Iterator<Item = &'s FlatSegment<T>>,
+    tol: f64,
+    combine: &impl Fn(T, T) -> T,
+    joins: &impl Fn(&T, &T) -> bool,
+) -> Vec<FlatSegment<T>> {
+    let origin = reference.from;
+    let dir = (reference.to - reference.from).normalize();
+    let intervals: Vec<(f64, f64, T)> = members
+        .map(|s| {
+            let (a, b) = (dir.dot(s.from - origin), dir.dot(s.to - origin));
+            (a.min(b), a.max(b), s.tag)
+        })
+        .collect();
+    joined_pieces(&intervals, tol, combine, joins)
+        .into_iter()
+        .map(|(lo, hi, tag)| FlatSegment {
+            from: origin + dir * lo,
+            to: origin + dir * hi,
+            tag,
+        })
+        .collect()
+}
+
+/// The line cut at every end of `intervals`: each piece takes the combined tag of the intervals
+/// over it, and neighbouring pieces whose tags join are one again. Pieces under no interval are
+/// left out.
+fn joined_pieces<T: Copy>(
+    intervals: &[(f64, f64, T)],
+    tol: f64,
+    combine: &impl Fn(T, T) -> T,
+    joins: &impl Fn(&T, &T) -> bool,
+) -> Vec<(f64, f64, T)> {
+    let mut cuts: Vec<f64> = intervals.iter().flat_map(|&(lo, hi, _)| [lo, hi]).collect();
+    cuts.sort_by(f64::total_cmp);
+    cuts.dedup_by(|b, a| *b - *a <= tol);
+    let mut pieces = Vec::new();
+    let mut current: Option<(f64, f64, T)> = None;
+    for w in cuts.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        let tag = intervals
             .iter()
-            .map(|&m| {
-                let s = segments[m];
-                let (a, b) = (dir.dot(s.from - origin), dir.dot(s.to - origin));
-                (a.min(b), a.max(b), s.tag)
-            })
-            .collect();
-        let emit = |(lo, hi, tag): (f64, f64, T), out: &mut Vec<FlatSegment<T>>| {
-            out.push(FlatSegment {
-                from: origin + dir * lo,
-                to: origin + dir * hi,
-                tag,
-            });
+            .filter(|&&(lo, hi, _)| lo <= a + tol && hi >= b - tol)
+            .map(|&(_, _, t)| t)
+            .reduce(combine);
+        current = match (current, tag) {
+            (Some((clo, chi, ctag)), Some(tag)) if joins(&ctag, &tag) && a <= chi + tol => {
+                Some((clo, b, combine(ctag, tag)))
+            }
+            (done, tag) => {
+                pieces.extend(done);
+                tag.map(|tag| (a, b, tag))
+            }
         };
-        // The line cut at every end: each piece takes the combined tag of the segments over it,
-        // and neighbouring pieces with one tag join again.
-        let mut cuts: Vec<f64> = intervals.iter().flat_map(|&(lo, hi, _)| [lo, hi]).collect();
-        cuts.sort_by(f64::total_cmp);
-        cuts.dedup_by(|b, a| *b - *a <= tol);
-        let mut current: Option<(f64, f64, T)> = None;
-        for w in cuts.windows(2) {
-            let (a, b) = (w[0], w[1]);
-            let tag = intervals
-                .iter()
-                .filter(|&&(lo, hi, _)| lo <= a + tol && hi >= b - tol)
-                .map(|&(_, _, t)| t)
-                .reduce(&combine);
-            current = match (current, tag) {
-                (Some((clo, chi, ctag)), Some(tag)) if joins(&ctag, &tag) && a <= chi + tol => {
-                    Some((clo, b, combine(ctag, tag)))
-                }
-                (done, tag) => {
-                    if let Some(done) = done {
-                        emit(done, &mut out);
-                    }
-                    tag.map(|tag| (a, b, tag))
-                }
-            };
-        }
-        if let Some(done) = current {
-            emit(done, &mut out);
-        }
     }
-    out
+    pieces.extend(current);
+    pieces
 }
 
 #[cfg(test)]
