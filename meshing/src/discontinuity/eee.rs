@@ -279,6 +279,7 @@ struct Partners {
 }
 
 impl Partners {
+    /// Stamps for the blockers and the edges of `edges`, none taken yet.
     fn new(edges: &BlockerEdges) -> Partners {
         Partners {
             round: 0,

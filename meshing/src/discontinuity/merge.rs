@@ -41,6 +41,7 @@ pub(super) fn merge_collinear<T: Copy>(
 /// no sign to canonicalize) and by their distance from the origin along the canonical normal:
 /// segments on one line fall in one cell or in neighbouring ones.
 struct LineCells {
+    /// The width of a cell in the doubled angle (radians), and in the offset.
     angle: f64,
     offset: f64,
     /// The greatest angle cell.

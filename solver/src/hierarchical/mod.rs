@@ -129,37 +129,138 @@ pub fn solve_hierarchical_refining(
 ) -> Result<(SceneMesh, Solution), SolveError> {
     options.validate()?;
     check_mesh(scene, mesh)?;
+    let run = Run {
+        scene,
+        visibility,
+        options,
+        progress,
+    };
     let started = Instant::now();
     let first = Discretization::new(scene, mesh, options.elements_per_patch);
     let (direct, direct_beyond_cap) =
         direct_irradiance(scene, &first, visibility, options, progress)?;
-    let mut direct_seconds = started.elapsed().as_secs_f64();
+    let mut figures = Figures {
+        direct_seconds: started.elapsed().as_secs_f64(),
+        direct_beyond_cap,
+        gathered: first.receiver_count(),
+        ..Figures::default()
+    };
 
     let started = Instant::now();
     let hierarchy = Hierarchy::build(&first, |s| scene.surfaces[s].reflectance);
     let enclosures = Enclosures::new(scene, visibility);
+    let (mut system, enclosed) = new_system(run, &first, &hierarchy, &direct, &enclosures);
+    let clock = || figures.direct_seconds + started.elapsed().as_secs_f64();
+    let (mut solved, mut stats) = solve_system(run, &mut system, &clock);
+    figures.solve_seconds = started.elapsed().as_secs_f64();
+
+    // The final gather, unless the run must stop: then each vertex keeps its leaf's value.
+    let t = Instant::now();
+    let gathering = Gathering::new(run, &system, &solved.field, &first);
+    let (light, display_gain, stop) =
+        gathering.first_mesh(&first, &direct, &enclosed, solved.stop, &mut stats);
+    let PointLight {
+        reflected,
+        totals,
+        first_b,
+        ..
+    } = light;
+    figures.gather_seconds = t.elapsed().as_secs_f64();
+    let mut current = Current {
+        mesh: mesh.clone(),
+        disc: first.clone(),
+        direct,
+        reflected,
+        totals,
+    };
+
+    // Rounds of refinement: new vertices gather through the links of the first mesh's leaves.
+    if !first_b.is_empty() {
+        let rounds = Rounds {
+            gathering: &gathering,
+            exact: DirectLight::new(scene, visibility).with_overlay_cap(OVERLAY_CAP),
+            locate: LeafLocator::new(mesh, &first, &hierarchy),
+            enclosures: &enclosures,
+            first_b: &first_b,
+            display_gain,
+        };
+        current = rounds.run(current, refine, &mut figures, &mut stats)?;
+    }
+    solved.stop = stop;
+    let closed = enclosed.iter().all(|&e| e);
+    Ok(into_solution(
+        scene, current, closed, solved, stats, &figures,
+    ))
+}
+
+/// What a hierarchical solve works from, borrowed.
+#[derive(Clone, Copy)]
+struct Run<'a> {
+    scene: &'a Scene,
+    visibility: &'a Visibility,
+    options: &'a SolverOptions,
+    progress: &'a dyn Progress,
+}
+
+/// What the run did beside the hierarchy's own figures ([`HierarchyStats`]), for its
+/// statistics: the time of each part, the direct light's estimates, the rounds of refinement.
+#[derive(Debug, Default)]
+struct Figures {
+    direct_seconds: f64,
+    /// Vertices of the first mesh whose direct light was estimated by rays: their view of a
+    /// light needed a polygon difference beyond the evaluator's cap.
+    direct_beyond_cap: usize,
+    /// Building, linking and sweeping the hierarchy.
+    solve_seconds: f64,
+    gather_seconds: f64,
+    remeshes: usize,
+    /// Vertices that gathered: all of the first mesh's, and those each round added.
+    gathered: usize,
+}
+
+/// The system of `hierarchy` over the first mesh `first`, whose leaves reflect their share of
+/// the `direct` irradiance at its vertices, and whether each of those vertices lies inside a
+/// closed solid.
+fn new_system<'h>(
+    run: Run,
+    first: &Discretization,
+    hierarchy: &'h Hierarchy,
+    direct: &[Rgb],
+    enclosures: &Enclosures,
+) -> (System<'h>, Vec<bool>) {
     let (enclosed_leaves, enclosed) = totals::enclosed_leaves(
-        &first,
+        first,
         &hierarchy.leaf_of_element,
         hierarchy.nodes.len(),
-        &enclosures,
+        enclosures,
     );
-    let closed = enclosed.iter().all(|&e| e);
-    let tol = visibility.contact_distance();
-    let mut system = System::new(
-        &hierarchy,
-        leaf_direct(scene, &first, &hierarchy, &direct),
+    let system = System::new(
+        hierarchy,
+        leaf_direct(run.scene, first, hierarchy, direct),
         enclosed_leaves,
-        tol,
+        run.visibility.contact_distance(),
     );
-    let shafts = Shafts::new(scene, visibility);
+    (system, enclosed)
+}
+
+/// Links the hierarchy of `system` and sweeps it to its solution ([`link_and_sweep`]), with
+/// visibility from shafts; returns the solution and the hierarchy's figures. `clock` gives the
+/// seconds since the run began.
+fn solve_system(
+    run: Run,
+    system: &mut System,
+    clock: &dyn Fn() -> f64,
+) -> (Solved, HierarchyStats) {
+    let options = run.options;
+    let hierarchy = system.hierarchy;
+    let shafts = Shafts::new(run.scene, run.visibility);
     let refiner = Refiner {
-        hierarchy: &hierarchy,
+        hierarchy,
         shafts: &shafts,
-        tolerance: options.link_tol * reflected_power(&system),
+        tolerance: options.link_tol * reflected_power(system),
         rays: options.visibility_rays,
         seed: options.seed,
-        tol,
+        tol: system.tol,
         stop: Some(options),
     };
     let mut stats = HierarchyStats {
@@ -169,115 +270,197 @@ pub fn solve_hierarchical_refining(
         clusters: system.clusters,
         ..HierarchyStats::default()
     };
-    let clock = || direct_seconds + started.elapsed().as_secs_f64();
-    let solved = link_and_sweep(&mut system, &refiner, options, &mut stats, &clock, progress);
-    link_figures(&mut stats, &system);
-    let solve_seconds = started.elapsed().as_secs_f64();
+    let solved = link_and_sweep(system, &refiner, options, &mut stats, clock, run.progress);
+    link_figures(&mut stats, system);
+    (solved, stats)
+}
 
-    // The final gather, unless the run must stop: then each vertex keeps its leaf's value.
-    let t = Instant::now();
-    let gather = FinalGather {
-        system: &system,
-        field: &solved.field,
-        visibility,
-        elements: &first.elements,
-        rays: options.visibility_rays,
-        seed: options.seed,
-    };
-    let all: Vec<usize> = (0..first.receiver_count()).collect();
-    let leaves = vertex_leaves(&first, &hierarchy);
-    let mut stop = solved.stop;
-    let mut light = final_gather_at(
-        &first, &all, &leaves, &direct, &enclosed, &gather, None, options, progress,
-    )
-    .unwrap_or_else(|| {
-        stop = options.stop_now().unwrap_or(stop);
-        leaf_values(&leaves, &solved.field, &system)
-    });
-    stats.gather_rays += light.rays;
-    let display_gain = if light.first_b.is_empty() {
-        Rgb::ZERO
-    } else {
-        let (gain, lost) = balance::display_gain(
-            &system,
-            &solved.field,
-            &first,
-            &light.reflected,
-            &light.totals,
-        );
-        stats.gather_lost = lost;
-        gain
-    };
-    light.add_ambient(&first, &all, display_gain);
-    let first_b = light.first_b;
-    let mut gather_seconds = t.elapsed().as_secs_f64();
-    let mut current = Current {
-        mesh: mesh.clone(),
-        disc: first.clone(),
-        direct,
-        reflected: light.reflected,
-        totals: light.totals,
-    };
+/// The final gather along the links of the solved hierarchy.
+struct Gathering<'a> {
+    run: Run<'a>,
+    gather: FinalGather<'a>,
+}
 
-    // Rounds of refinement: new vertices gather through the links of the first mesh's leaves.
-    let exact = DirectLight::new(scene, visibility).with_overlay_cap(OVERLAY_CAP);
-    let (mut remeshes, mut gathered) = (0, first.receiver_count());
-    if !first_b.is_empty() {
-        let locate = LeafLocator::new(mesh, &first, &hierarchy);
-        while let Some(next) = refine(&current.round(&exact))? {
-            check_mesh(scene, &next)?;
-            let disc = Discretization::new(scene, &next, options.elements_per_patch);
-            let matching = disc.matching_receivers(&current.disc);
-            let fresh = matching.fresh();
-            let mut direct = matching.carry(&current.direct);
-            let mut reflected = matching.carry(&current.reflected);
-            let mut totals = matching.carry(&current.totals);
-            let t = Instant::now();
-            let new_direct = direct_at_new(&exact, &disc, &fresh, options, progress)?;
-            direct_seconds += t.elapsed().as_secs_f64();
-            let t = Instant::now();
-            let leaves: Vec<u32> = fresh.iter().map(|&v| locate.leaf(&disc, v)).collect();
-            let new_enclosed: Vec<bool> = fresh
-                .par_iter()
-                .map(|&v| enclosures.encloses(&disc.receivers[v], disc.receiver_surface[v]))
-                .collect();
-            let unstoppable = SolverOptions {
-                deadline: None,
-                interrupt: None,
-                ..options.clone()
-            };
-            let mut light = final_gather_at(
-                &disc,
-                &fresh,
-                &leaves,
-                &new_direct,
-                &new_enclosed,
-                &gather,
-                Some(&first_b),
-                &unstoppable,
-                progress,
-            )
-            .unwrap_or_default();
-            light.add_ambient(&disc, &fresh, display_gain);
-            stats.gather_rays += light.rays;
-            gather_seconds += t.elapsed().as_secs_f64();
-            for (k, &v) in fresh.iter().enumerate() {
-                direct[v] = new_direct[k];
-                reflected[v] = light.reflected[k];
-                totals[v] = light.totals[k];
-            }
-            gathered += fresh.len();
-            remeshes += 1;
-            current = Current {
-                mesh: next,
-                disc,
-                direct,
-                reflected,
-                totals,
-            };
-        }
+impl<'a> Gathering<'a> {
+    /// The final gather along the links of `system`, solved to `field`, at vertices of meshes
+    /// over the first mesh `first`.
+    fn new(
+        run: Run<'a>,
+        system: &'a System<'a>,
+        field: &'a Field,
+        first: &'a Discretization,
+    ) -> Gathering<'a> {
+        let gather = FinalGather {
+            system,
+            field,
+            visibility: run.visibility,
+            elements: &first.elements,
+            rays: run.options.visibility_rays,
+            seed: run.options.seed,
+        };
+        Gathering { run, gather }
     }
 
+    /// The final gather at every vertex of the first mesh `disc` (their `direct` irradiance,
+    /// whether each is `enclosed`), with the ambient light that balances what the gather loses
+    /// (returned too), and the reason the run stops, `stop` unless the gather must stop first:
+    /// then each vertex keeps its leaf's value, with no ambient light.
+    fn first_mesh(
+        &self,
+        disc: &Discretization,
+        direct: &[Rgb],
+        enclosed: &[bool],
+        stop: StopReason,
+        stats: &mut HierarchyStats,
+    ) -> (PointLight, Rgb, StopReason) {
+        let (system, field, options) = (self.gather.system, self.gather.field, self.run.options);
+        let all: Vec<usize> = (0..disc.receiver_count()).collect();
+        let leaves = vertex_leaves(disc, system.hierarchy);
+        let mut stop = stop;
+        let gathered = final_gather_at(
+            disc,
+            &all,
+            &leaves,
+            direct,
+            enclosed,
+            &self.gather,
+            None,
+            options,
+            self.run.progress,
+        );
+        let mut light = gathered.unwrap_or_else(|| {
+            stop = options.stop_now().unwrap_or(stop);
+            leaf_values(&leaves, field, system)
+        });
+        stats.gather_rays += light.rays;
+        let display_gain = if light.first_b.is_empty() {
+            Rgb::ZERO
+        } else {
+            let (gain, lost) =
+                balance::display_gain(system, field, disc, &light.reflected, &light.totals);
+            stats.gather_lost = lost;
+            gain
+        };
+        light.add_ambient(disc, &all, display_gain);
+        (light, display_gain, stop)
+    }
+}
+
+/// Rounds of refinement of the display mesh over the first mesh's hierarchy: a new vertex gets
+/// the exact direct light and gathers along the links of the first mesh's leaf it lies in.
+struct Rounds<'a> {
+    gathering: &'a Gathering<'a>,
+    exact: DirectLight<'a>,
+    locate: LeafLocator<'a>,
+    enclosures: &'a Enclosures<'a>,
+    /// The reflected radiosity at the first mesh's vertices, for the gathers' near leaves.
+    first_b: &'a [Rgb],
+    /// The ambient light of the first mesh's gather, added at new vertices alike.
+    display_gain: Rgb,
+}
+
+impl Rounds<'_> {
+    /// The meshes `refine` gives after `current`, each with the light at its vertices, until it
+    /// gives none; returns the last.
+    fn run(
+        &self,
+        mut current: Current,
+        refine: &mut dyn FnMut(&Round) -> Result<Option<SceneMesh>, SolveError>,
+        figures: &mut Figures,
+        stats: &mut HierarchyStats,
+    ) -> Result<Current, SolveError> {
+        while let Some(next) = refine(&current.round(&self.exact))? {
+            check_mesh(self.gathering.run.scene, &next)?;
+            current = self.refined(&current, next, figures, stats)?;
+        }
+        Ok(current)
+    }
+
+    /// The mesh `next`, a refinement of `current`'s, with the light at its vertices: carried
+    /// over where a vertex matches one of `current`, found for the others.
+    fn refined(
+        &self,
+        current: &Current,
+        next: SceneMesh,
+        figures: &mut Figures,
+        stats: &mut HierarchyStats,
+    ) -> Result<Current, SolveError> {
+        let run = self.gathering.run;
+        let disc = Discretization::new(run.scene, &next, run.options.elements_per_patch);
+        let matching = disc.matching_receivers(&current.disc);
+        let fresh = matching.fresh();
+        let mut direct = matching.carry(&current.direct);
+        let mut reflected = matching.carry(&current.reflected);
+        let mut totals = matching.carry(&current.totals);
+        let t = Instant::now();
+        let new_direct = direct_at_new(&self.exact, &disc, &fresh, run.options, run.progress)?;
+        figures.direct_seconds += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let light = self.gather_at(&disc, &fresh, &new_direct);
+        stats.gather_rays += light.rays;
+        figures.gather_seconds += t.elapsed().as_secs_f64();
+        for (k, &v) in fresh.iter().enumerate() {
+            direct[v] = new_direct[k];
+            reflected[v] = light.reflected[k];
+            totals[v] = light.totals[k];
+        }
+        figures.gathered += fresh.len();
+        figures.remeshes += 1;
+        Ok(Current {
+            mesh: next,
+            disc,
+            direct,
+            reflected,
+            totals,
+        })
+    }
+
+    /// The final gather at the `fresh` vertices of `disc` (their `direct` irradiance), with the
+    /// ambient light. It does not stop for the deadline or an interrupt: every vertex of the
+    /// mesh must have its light.
+    fn gather_at(&self, disc: &Discretization, fresh: &[usize], direct: &[Rgb]) -> PointLight {
+        let run = self.gathering.run;
+        let leaves: Vec<u32> = fresh.iter().map(|&v| self.locate.leaf(disc, v)).collect();
+        let enclosed: Vec<bool> = fresh
+            .par_iter()
+            .map(|&v| {
+                self.enclosures
+                    .encloses(&disc.receivers[v], disc.receiver_surface[v])
+            })
+            .collect();
+        let unstoppable = SolverOptions {
+            deadline: None,
+            interrupt: None,
+            ..run.options.clone()
+        };
+        let mut light = final_gather_at(
+            disc,
+            fresh,
+            &leaves,
+            direct,
+            &enclosed,
+            &self.gathering.gather,
+            Some(self.first_b),
+            &unstoppable,
+            run.progress,
+        )
+        .unwrap_or_default();
+        light.add_ambient(disc, fresh, self.display_gain);
+        light
+    }
+}
+
+/// The solution at the vertices of `current`, the last mesh, with the run's statistics and its
+/// energy account ([`Account`]); `closed` says whether every vertex of the first mesh lies
+/// inside a room.
+fn into_solution(
+    scene: &Scene,
+    current: Current,
+    closed: bool,
+    solved: Solved,
+    stats: HierarchyStats,
+    figures: &Figures,
+) -> (SceneMesh, Solution) {
     let disc = &current.disc;
     // A vertex in the dark gathers what its links carry to rounding, which may leave it a
     // few ulps below zero; no irradiance is negative.
@@ -295,16 +478,16 @@ pub fn solve_hierarchical_refining(
         closed,
     };
     let solve_stats = SolveStats {
-        stop,
+        stop: solved.stop,
         iterations: stats.sweeps,
         residual: solved.residual,
-        direct_seconds,
-        direct_estimated: direct_beyond_cap,
-        direct_beyond_cap,
-        shooting_seconds: solve_seconds,
-        remeshes,
-        gathered,
-        gather_seconds,
+        direct_seconds: figures.direct_seconds,
+        direct_estimated: figures.direct_beyond_cap,
+        direct_beyond_cap: figures.direct_beyond_cap,
+        shooting_seconds: figures.solve_seconds,
+        remeshes: figures.remeshes,
+        gathered: figures.gathered,
+        gather_seconds: figures.gather_seconds,
         ..account.stats(solved.unshot, &stats)
     };
     let radiosity: Vec<Rgb> = (0..disc.receiver_count())
@@ -321,7 +504,7 @@ pub fn solve_hierarchical_refining(
         },
         convergence: solved.history,
     };
-    Ok((current.mesh, solution))
+    (current.mesh, solution)
 }
 
 /// The display mesh of the latest round and the light at its vertices, with each vertex's total.

@@ -1,10 +1,11 @@
 //! `penumbra sweep`: error against elements and time, over methods and budgets.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use crate::progress_bar::Bars;
 use anyhow::Context;
-use penumbra_scenes::ObjOptions;
+use penumbra::experiments::sweep::{Sweep, SweepOptions};
+use penumbra_scenes::{ObjOptions, Scene, SurfaceId};
 use penumbra_solver::SolverOptions;
 use penumbra_solver::path_trace::MAX_PATHS;
 
@@ -102,43 +103,10 @@ pub(crate) struct SweepArgs {
     quiet: bool,
 }
 
+/// Runs the sweep the arguments ask for, scored against the exact direct light or a path-traced
+/// reference, writes its files and prints its table.
 pub(crate) fn sweep(args: &SweepArgs) -> Result<(), Failure> {
-    let sample_count = args
-        .samples
-        .unwrap_or(if args.direct_only { 4000 } else { 1000 });
-    let methods = match args.methods.is_empty() {
-        true => penumbra::experiments::sweep::SweepMethod::DEFAULT.to_vec(),
-        false => penumbra::experiments::sweep::SweepMethod::ALL
-            .into_iter()
-            .filter(|m| args.methods.iter().any(|n| n == m.name()))
-            .collect(),
-    };
-    let options = penumbra::experiments::sweep::SweepOptions {
-        budgets: args.budgets.clone(),
-        methods,
-        surfaces: args.surfaces.clone(),
-        refine_tol: args.refine_tol,
-        tolerance: args.tol,
-        min_angle: args.min_angle,
-        initial_fraction: args.initial_fraction,
-        samples: sample_count,
-        seed: args.seed,
-        solver: SolverOptions {
-            direct_only: args.direct_only,
-            epsilon: args.epsilon,
-            visibility_rays: args.rays,
-            link_tol: args.link_tol,
-            photon_map: penumbra_solver::photon_map::PhotonMapOptions {
-                gather_photons: args.gather_photons,
-                ..Default::default()
-            },
-            ..SolverOptions::default()
-        },
-        solvers: args.solvers.iter().map(|&s| s.into()).collect(),
-        photons: distinct(&args.photons),
-        final_gathers: distinct(&args.final_gather),
-        photon_elements: args.photon_elements,
-    };
+    let options = sweep_options(args);
     options
         .validate()
         .map_err(|e| invalid_option(&e, Command::Sweep))?;
@@ -149,14 +117,7 @@ pub(crate) fn sweep(args: &SweepArgs) -> Result<(), Failure> {
         )));
     }
     let loaded = load(&args.scene, ObjOptions::default())?;
-    let mut surfaces = Vec::new();
-    for name in &args.surfaces {
-        surfaces.push(loaded.scene.surface_id(name).ok_or_else(|| {
-            usage(anyhow::anyhow!(
-                "--surfaces: the scene has no surface named {name:?}"
-            ))
-        })?);
-    }
+    let surfaces = scored_surfaces(&loaded.scene, &args.surfaces)?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
     let scene = &loaded.scene;
@@ -165,7 +126,7 @@ pub(crate) fn sweep(args: &SweepArgs) -> Result<(), Failure> {
         scene,
         &visibility,
         &surfaces,
-        sample_count,
+        options.samples,
         args.seed,
     );
     if samples.is_empty() {
@@ -189,56 +150,115 @@ pub(crate) fn sweep(args: &SweepArgs) -> Result<(), Failure> {
             .map_err(|e| {
                 photon_budget_failure(&e, args).unwrap_or_else(|| run_failure(e, Command::Sweep))
             })?;
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("cannot create {}", args.out.display()))?;
-    let csv = penumbra::experiments::sweep::sweep_csv(&result);
-    penumbra::outputs::write_atomic(&args.out.join("sweep.csv"), csv.as_bytes())?;
-    let json = serde_json::to_string_pretty(&result)?;
-    penumbra::outputs::write_atomic(&args.out.join("sweep.json"), json.as_bytes())?;
-    for (stem, chart) in penumbra::experiments::sweep::sweep_charts(&result) {
-        penumbra::outputs::write_atomic(
-            &args.out.join(format!("{stem}.svg")),
-            chart.svg()?.as_bytes(),
-        )?;
-        penumbra::outputs::write_atomic(&args.out.join(format!("{stem}.png")), &chart.png()?)?;
-    }
+    write_sweep(&args.out, &result)?;
     if !args.quiet {
-        println!(
-            "{}: {} samples ({} in penumbrae), reference ({}) mean {:.4e}, standard error {:.3}%",
-            result.scene,
-            result.samples,
-            result.penumbra_samples,
-            result.reference,
-            result.reference_mean,
-            100.0 * result.reference_standard_error
-        );
-        println!(
-            "{:<24} {:<13} {:>16} {:>9} {:>9} {:>10} {:>10} {:>12}",
-            "method", "solver", "budget", "triangles", "seconds", "rms", "max", "penumbra rms"
-        );
-        for r in &result.rows {
-            let budget = match (r.photons, r.final_gather) {
-                (Some(p), Some(rays)) => format!("{p}ph/{rays}r"),
-                _ => r.max_elements.to_string(),
-            };
-            println!(
-                "{:<24} {:<13} {:>16} {:>9} {:>9.3} {:>9.4}% {:>9.3}% {:>11.4}%",
-                r.method,
-                r.solver,
-                budget,
-                r.triangles,
-                r.seconds,
-                100.0 * r.rms,
-                100.0 * r.max,
-                100.0 * r.penumbra_rms
-            );
-        }
-        println!(
-            "wrote sweep.csv, sweep.json and the charts error-vs-elements and error-vs-time (SVG, PNG) to {}",
-            args.out.display()
-        );
+        print_sweep(&result, &args.out);
     }
     Ok(())
+}
+
+/// The sweep the arguments ask for, not yet validated.
+fn sweep_options(args: &SweepArgs) -> SweepOptions {
+    let methods = match args.methods.is_empty() {
+        true => penumbra::experiments::sweep::SweepMethod::DEFAULT.to_vec(),
+        false => penumbra::experiments::sweep::SweepMethod::ALL
+            .into_iter()
+            .filter(|m| args.methods.iter().any(|n| n == m.name()))
+            .collect(),
+    };
+    SweepOptions {
+        budgets: args.budgets.clone(),
+        methods,
+        surfaces: args.surfaces.clone(),
+        refine_tol: args.refine_tol,
+        tolerance: args.tol,
+        min_angle: args.min_angle,
+        initial_fraction: args.initial_fraction,
+        samples: args
+            .samples
+            .unwrap_or(if args.direct_only { 4000 } else { 1000 }),
+        seed: args.seed,
+        solver: SolverOptions {
+            direct_only: args.direct_only,
+            epsilon: args.epsilon,
+            visibility_rays: args.rays,
+            link_tol: args.link_tol,
+            photon_map: penumbra_solver::photon_map::PhotonMapOptions {
+                gather_photons: args.gather_photons,
+                ..Default::default()
+            },
+            ..SolverOptions::default()
+        },
+        solvers: args.solvers.iter().map(|&s| s.into()).collect(),
+        photons: distinct(&args.photons),
+        final_gathers: distinct(&args.final_gather),
+        photon_elements: args.photon_elements,
+    }
+}
+
+/// The surfaces `--surfaces` names, or a usage error naming one the scene does not have.
+fn scored_surfaces(scene: &Scene, names: &[String]) -> Result<Vec<SurfaceId>, Failure> {
+    let mut surfaces = Vec::new();
+    for name in names {
+        surfaces.push(scene.surface_id(name).ok_or_else(|| {
+            usage(anyhow::anyhow!(
+                "--surfaces: the scene has no surface named {name:?}"
+            ))
+        })?);
+    }
+    Ok(surfaces)
+}
+
+/// Writes `sweep.csv`, `sweep.json` and the charts (SVG and PNG) to `out`.
+fn write_sweep(out: &Path, result: &Sweep) -> Result<(), Failure> {
+    std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
+    let csv = penumbra::experiments::sweep::sweep_csv(result);
+    penumbra::outputs::write_atomic(&out.join("sweep.csv"), csv.as_bytes())?;
+    let json = serde_json::to_string_pretty(result)?;
+    penumbra::outputs::write_atomic(&out.join("sweep.json"), json.as_bytes())?;
+    for (stem, chart) in penumbra::experiments::sweep::sweep_charts(result) {
+        penumbra::outputs::write_atomic(&out.join(format!("{stem}.svg")), chart.svg()?.as_bytes())?;
+        penumbra::outputs::write_atomic(&out.join(format!("{stem}.png")), &chart.png()?)?;
+    }
+    Ok(())
+}
+
+/// Prints the sweep's reference, a table of its rows and where it was written (`out`).
+fn print_sweep(result: &Sweep, out: &Path) {
+    println!(
+        "{}: {} samples ({} in penumbrae), reference ({}) mean {:.4e}, standard error {:.3}%",
+        result.scene,
+        result.samples,
+        result.penumbra_samples,
+        result.reference,
+        result.reference_mean,
+        100.0 * result.reference_standard_error
+    );
+    println!(
+        "{:<24} {:<13} {:>16} {:>9} {:>9} {:>10} {:>10} {:>12}",
+        "method", "solver", "budget", "triangles", "seconds", "rms", "max", "penumbra rms"
+    );
+    for r in &result.rows {
+        let budget = match (r.photons, r.final_gather) {
+            (Some(p), Some(rays)) => format!("{p}ph/{rays}r"),
+            _ => r.max_elements.to_string(),
+        };
+        println!(
+            "{:<24} {:<13} {:>16} {:>9} {:>9.3} {:>9.4}% {:>9.3}% {:>11.4}%",
+            r.method,
+            r.solver,
+            budget,
+            r.triangles,
+            r.seconds,
+            100.0 * r.rms,
+            100.0 * r.max,
+            100.0 * r.penumbra_rms
+        );
+    }
+    println!(
+        "wrote sweep.csv, sweep.json and the charts error-vs-elements and error-vs-time (SVG, PNG) to {}",
+        out.display()
+    );
 }
 
 /// The path-traced reference at the sweep's samples: read from `reference.json` in the output
