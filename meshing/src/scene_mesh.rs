@@ -281,7 +281,7 @@ pub fn mesh_scene_discontinuity_on(
         .collect();
     let (budget, targets) = match alone {
         Some(extra) => share_alone(&areas, &minimum, &meshed, extra),
-        None => spread_with_quality(&areas, &minimum, &mut constrained, budget)?,
+        None => spread_with_quality(&areas, &minimum, &mut constrained, budget, options)?,
     };
     options.go_on()?;
     let minimum_triangles = minimum.iter().sum();
@@ -357,14 +357,18 @@ fn spread_with_quality(
     minimum: &[usize],
     constrained: &mut [Option<ConstrainedSurface>],
     budget: ElementBudget,
+    options: &DiscontinuityMeshing,
 ) -> Result<(usize, Vec<usize>), MeshError> {
     let (budget, shares) = spread_by_area(areas, minimum, budget, true)?;
     let room = (QUALITY_EXTRA_SHARE * budget as f64) as usize;
     let quality: Vec<Option<usize>> = constrained
         .par_iter_mut()
         .zip(&shares)
-        .map(|(c, &t)| c.as_mut().and_then(|c| c.quality_triangles(t + room)))
-        .collect();
+        .map(|(c, &t)| {
+            options.go_on()?;
+            Ok(c.as_mut().and_then(|c| c.quality_triangles(t + room)))
+        })
+        .collect::<Result<_, MeshError>>()?;
     let minima = quality_minima(minimum, &shares, &quality, budget);
     spread_by_area(areas, &minima, budget, true)
 }
