@@ -934,7 +934,9 @@ fn one_signal_stops_a_run_promptly() {
 fn runs_interrupted_before_a_solution_keep_the_least_mesh_lit() {
     let dir = tempfile::tempdir().expect("temp dir");
     // Meshing 400,000 triangles by discontinuities takes seconds (the boxes' many surfaces
-    // tens of seconds); the signal comes within it.
+    // tens of seconds); the signal comes within it, or within the boxes' discontinuity search
+    // on a busy machine. (One surface's constraint insertion or trial refinement is not cut:
+    // the signal comes where those are short.)
     let cases: [(&str, &[&str], f64, &[&str]); 2] = [
         (
             "cornell",
@@ -945,7 +947,7 @@ fn runs_interrupted_before_a_solution_keep_the_least_mesh_lit() {
         (
             "boxworld-300",
             &["--max-elements", "400000", "--mesh", "discontinuity"],
-            1.0,
+            0.3,
             &["discontinuities", "mesh"],
         ),
     ];
