@@ -12,7 +12,8 @@ use penumbra_meshing::discontinuity::{
     Boundary, Discontinuities, DiscontinuityOptions, find_discontinuities_reporting,
 };
 use penumbra_meshing::{
-    DiscontinuityMeshing, MeshError, SceneMesh, mesh_scene_discontinuity_on, mesh_scene_uniform,
+    DiscontinuityMeshing, MeshError, SceneMesh, mesh_scene_discontinuity_on,
+    mesh_scene_uniform_until,
 };
 use penumbra_scenes::{LoadedScene, Rgb, Scene, Visibility};
 use penumbra_solver::{Progress, SolveError, SolverOptions, StopReason};
@@ -281,7 +282,10 @@ impl<'a> Stages<'a> {
                 let budget = plan.initial_budget;
                 mesh_scene_discontinuity_on(self.scene, visibility, found, budget, &meshing)
             }
-            _ => mesh_scene_uniform(self.scene, plan.initial_budget),
+            _ => {
+                let interrupt = options.solver.interrupt.as_ref();
+                mesh_scene_uniform_until(self.scene, plan.initial_budget, interrupt)
+            }
         };
         meshed.map_err(|e| match initial_budget_too_small(options, &e) {
             true => RunError::InitialBudget(e),

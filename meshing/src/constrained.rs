@@ -310,10 +310,24 @@ impl RefinableSurface {
         surface: &Surface,
         target: usize,
     ) -> Result<RefinableSurface, MeshError> {
+        RefinableSurface::uniform_until(id, surface, target, None)
+    }
+
+    /// [`Self::uniform`], given up between its trial refinements once `stop` is set (the
+    /// caller then lets the surface go).
+    pub fn uniform_until(
+        id: SurfaceId,
+        surface: &Surface,
+        target: usize,
+        stop: Option<&Interrupt>,
+    ) -> Result<RefinableSurface, MeshError> {
         Ok(RefinableSurface {
             id,
-            triangulation: SurfaceTriangulation::of_surface(id, surface)?
-                .refined(target, crate::tolerances::MIN_ANGLE_DEG),
+            triangulation: SurfaceTriangulation::of_surface(id, surface)?.refined_until(
+                target,
+                crate::tolerances::MIN_ANGLE_DEG,
+                stop,
+            ),
             segments: Vec::new(),
             min_angle_deg: crate::tolerances::MIN_ANGLE_DEG,
         })

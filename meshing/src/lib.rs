@@ -100,7 +100,7 @@ pub use progress::{Interrupt, NoProgress, Progress};
 pub use quality::{MeshQuality, quality_of};
 pub use scene_mesh::{
     DiscontinuityMeshing, SceneMesh, mesh_scene_discontinuity, mesh_scene_discontinuity_on,
-    mesh_scene_uniform,
+    mesh_scene_uniform, mesh_scene_uniform_until,
 };
 pub use tolerances::{
     CONSTRAINED_MIN_ANGLE_DEG, FORCING_WEDGE_DEG, MAX_MIN_ANGLE_DEG, SPLIT_MIN_ANGLE_DEG,

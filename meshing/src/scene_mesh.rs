@@ -141,6 +141,21 @@ pub fn mesh_scene_uniform(
     scene: &Scene,
     budget: impl Into<ElementBudget>,
 ) -> Result<SceneMesh, MeshError> {
+    mesh_scene_uniform_until(scene, budget, None)
+}
+
+/// [`mesh_scene_uniform`], the surfaces meshed in parallel, stopped with
+/// [`MeshError::Interrupted`] once `interrupt` is set (between surfaces, and between one
+/// surface's trial refinements).
+pub fn mesh_scene_uniform_until(
+    scene: &Scene,
+    budget: impl Into<ElementBudget>,
+    interrupt: Option<&Interrupt>,
+) -> Result<SceneMesh, MeshError> {
+    let options = DiscontinuityMeshing {
+        interrupt,
+        ..DiscontinuityMeshing::default()
+    };
     let areas: Vec<f64> = scene
         .surfaces
         .iter()
@@ -155,13 +170,17 @@ pub fn mesh_scene_uniform(
     let (budget, targets) = spread_by_area(&areas, &minimum, budget, false)?;
     let refinable = scene
         .surfaces
-        .iter()
+        .par_iter()
         .zip(targets)
         .enumerate()
-        .map(|(id, (s, target))| RefinableSurface::uniform(id, s, target))
+        .map(|(id, (s, target))| {
+            options.go_on()?;
+            RefinableSurface::uniform_until(id, s, target, interrupt)
+        })
         .collect::<Result<Vec<_>, _>>()?;
+    options.go_on()?;
     let surfaces = refinable
-        .iter()
+        .par_iter()
         .zip(&scene.surfaces)
         .map(|(r, s)| r.mesh(s))
         .collect();
