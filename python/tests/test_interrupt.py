@@ -77,9 +77,9 @@ MAIN_THREAD = pytest.mark.skipif(
 
 @MAIN_THREAD
 def test_a_second_ctrl_c_returns_at_once():
-    # Meshing one surface into 1.5 million triangles takes seconds, and one surface's refinement
-    # is not cut: the first Ctrl-C waits for it, the second does not (the run ends on its own in
-    # the background).
+    # Meshing one surface into 1.5 million triangles takes seconds, and its first trial
+    # refinement (over a second) is not cut: the first Ctrl-C waits for it, the second does not
+    # (the run ends on its own in the background).
     for delay in (0.3, 0.6):
         threading.Timer(delay, os.kill, (os.getpid(), signal.SIGINT)).start()
     started = time.perf_counter()
