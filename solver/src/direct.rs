@@ -757,7 +757,7 @@ impl<'a> DirectLight<'a> {
         let (mut candidates, mut outlines) = self.reached(point, viewer, e, &sides, reach);
         let mut start = None;
         if narrow && candidates.len() > self.window_faces {
-            match self.window(point, viewer, e, h_x, reach, piece, &candidates) {
+            match self.window(point, viewer, e, h_x, reach, piece, &candidates, &outlines) {
                 Window::Covered => return None,
                 Window::Narrowed { visible, hull } => {
                     let corners: Vec<DVec3> = hull.iter().map(|&q| e.frame.to_3d(q)).collect();
@@ -948,10 +948,9 @@ impl<'a> DirectLight<'a> {
         (candidates, outlines)
     }
 
-    /// What the faces filling the largest solid angles from x leave visible of `piece`, when
-    /// its hull is much smaller than the piece: no other face matters outside that hull. The
-    /// outline sheets in the shaft wait for the full pass: fusing and subtracting them here too
-    /// cost more than the narrowing saved (1,500 of Sponza's vertices took 1.7 times as long).
+    /// What the tree's outline sheets in the shaft and the faces filling the largest solid
+    /// angles from x leave visible of `piece`, when its hull is much smaller than the piece: no
+    /// other face matters outside that hull.
     #[allow(clippy::too_many_arguments)]
     fn window(
         &self,
@@ -962,6 +961,7 @@ impl<'a> DirectLight<'a> {
         reach: f64,
         piece: &[DVec2],
         candidates: &[usize],
+        outlines: &[(usize, bool)],
     ) -> Window {
         let solid_angle = |index: usize| {
             let occ = &self.occluders[index];
@@ -978,6 +978,9 @@ impl<'a> DirectLight<'a> {
         ranked.select_nth_unstable_by(count - 1, |a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
         let project = |p: DVec3| project_onto(e, point, h_x, p);
         let mut union = ShadowUnion::default();
+        for &(sheet, reversed) in outlines {
+            union.add_edges(&self.outline_edges(sheet, reversed, project));
+        }
         for &(_, index) in &ranked[..count] {
             let occ = &self.occluders[index];
             // Faces through x, or not wholly between the planes within reach, wait for the
@@ -1567,9 +1570,9 @@ mod tests {
         let sides = shaft_sides(x.point, &e.pieces[0]);
         // A viewer that leaves no surface out.
         let anyone = Viewer::Group(&[]);
-        let (all, _) = narrow.reached(x.point, anyone, e, &sides, reach);
+        let (all, nodes) = narrow.reached(x.point, anyone, e, &sides, reach);
         let Window::Narrowed { hull, .. } =
-            narrow.window(x.point, anyone, e, h_x, reach, &piece, &all)
+            narrow.window(x.point, anyone, e, h_x, reach, &piece, &all, &nodes)
         else {
             panic!("the tiles narrow the shaft");
         };
