@@ -27,7 +27,7 @@ pub use crate::run_result::{
     Kept, MemoryReport, RunResult, Stage, StagePeaks, StageTimes, Stopped,
 };
 pub use plan::BASE_SHARE;
-use plan::{Plan, initial_budget_too_small, planned_budget};
+use plan::{Plan, initial_budget_too_small};
 pub use solve::LEAST_MESH_SECONDS;
 use solve::{Meshed, Solved, least_mesh_lit, solve_with};
 
@@ -167,7 +167,7 @@ impl<'a> Stages<'a> {
 
     /// The stages from the discontinuities to the solve.
     fn mesh_and_solve(&mut self, visibility: &Visibility, plan: &Plan) -> Result<Lit, RunError> {
-        let found = self.discontinuities(visibility);
+        let found = self.discontinuities(visibility, plan);
         self.check_interrupt()?;
         let mut meshed = self.mesh(visibility, found, plan)?;
         self.check_interrupt()?;
@@ -190,7 +190,7 @@ impl<'a> Stages<'a> {
     /// The discontinuity stage (none for uniform meshes). A shard of a large scene finds the
     /// discontinuities of its own surfaces only (it meshes them alone); error-driven meshes keep
     /// the lines that carry a real jump, and refinement finds the rest.
-    fn discontinuities(&mut self, visibility: &Visibility) -> Option<Discontinuities> {
+    fn discontinuities(&mut self, visibility: &Visibility, plan: &Plan) -> Option<Discontinuities> {
         if self.options.mesh == MeshMethod::Uniform {
             return None;
         }
@@ -198,7 +198,7 @@ impl<'a> Stages<'a> {
         let t = Instant::now();
         let (scene, options) = (self.scene, self.options);
         let search = DiscontinuityOptions {
-            element_area: Some(scene.total_area() / planned_budget(scene, options) as f64),
+            element_area: Some(scene.total_area() / plan.planned_elements.max(1) as f64),
             deadline: self.solver.deadline,
             interrupt: options.solver.interrupt.clone(),
             receivers: self.shard_surfaces().as_deref().map(Into::into),

@@ -152,10 +152,6 @@ pub fn mesh_scene_uniform_until(
     budget: impl Into<ElementBudget>,
     interrupt: Option<&Interrupt>,
 ) -> Result<SceneMesh, MeshError> {
-    let options = DiscontinuityMeshing {
-        interrupt,
-        ..DiscontinuityMeshing::default()
-    };
     let areas: Vec<f64> = scene
         .surfaces
         .iter()
@@ -174,11 +170,11 @@ pub fn mesh_scene_uniform_until(
         .zip(targets)
         .enumerate()
         .map(|(id, (s, target))| {
-            options.go_on()?;
+            go_on(interrupt)?;
             RefinableSurface::uniform_until(id, s, target, interrupt)
         })
         .collect::<Result<Vec<_>, _>>()?;
-    options.go_on()?;
+    go_on(interrupt)?;
     let surfaces = refinable
         .par_iter()
         .zip(&scene.surfaces)
@@ -244,10 +240,15 @@ impl Default for DiscontinuityMeshing<'_> {
 impl DiscontinuityMeshing<'_> {
     /// [`MeshError::Interrupted`] once the interrupt is set.
     fn go_on(&self) -> Result<(), MeshError> {
-        match self.interrupt {
-            Some(i) if i.is_set() => Err(MeshError::Interrupted),
-            _ => Ok(()),
-        }
+        go_on(self.interrupt)
+    }
+}
+
+/// [`MeshError::Interrupted`] once `interrupt` is set.
+fn go_on(interrupt: Option<&Interrupt>) -> Result<(), MeshError> {
+    match interrupt {
+        Some(i) if i.is_set() => Err(MeshError::Interrupted),
+        _ => Ok(()),
     }
 }
 

@@ -155,16 +155,6 @@ fn budget_floor(budget: ElementBudget) -> usize {
     }
 }
 
-/// The budget the mesh will have, as far as the polygons alone tell (at least one triangle).
-pub(crate) fn planned_budget(scene: &Scene, options: &RunOptions) -> usize {
-    let least = polygon_minimum(scene);
-    options
-        .max_elements
-        .resolve(least, scene.surfaces.len())
-        .unwrap_or(least)
-        .max(1)
-}
-
 /// Whether meshing failed because the starting mesh of adaptive refinement does not fit its
 /// budget, though the scene fits the run's.
 pub(crate) fn initial_budget_too_small(options: &RunOptions, error: &MeshError) -> bool {
