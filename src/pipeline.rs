@@ -3,18 +3,18 @@
 //! own time and progress and honours the interrupt and the time budget. Pure computation;
 //! writing the results is [`crate::outputs`]' job.
 
+mod abandon;
+mod first_mesh;
 mod plan;
 mod solve;
 
+use std::sync::Arc;
 use std::time::Instant;
 
 use penumbra_meshing::discontinuity::{
     Boundary, Discontinuities, DiscontinuityOptions, find_discontinuities_reporting,
 };
-use penumbra_meshing::{
-    DiscontinuityMeshing, MeshError, SceneMesh, mesh_scene_discontinuity_on,
-    mesh_scene_uniform_until,
-};
+use penumbra_meshing::{MeshError, SceneMesh};
 use penumbra_scenes::{LoadedScene, Rgb, Scene, Visibility};
 use penumbra_solver::{Progress, SolveError, SolverOptions, StopReason};
 use penumbra_viz::Render;
@@ -26,6 +26,8 @@ pub use crate::run_error::RunError;
 pub use crate::run_result::{
     Kept, MemoryReport, RunResult, Stage, StagePeaks, StageTimes, Stopped,
 };
+use abandon::abandoned_on;
+use first_mesh::FirstMesh;
 pub use plan::BASE_SHARE;
 use plan::{Plan, initial_budget_too_small};
 pub use solve::LEAST_MESH_SECONDS;
@@ -48,15 +50,28 @@ pub fn run(
     options: &RunOptions,
     progress: &dyn Progress,
 ) -> Result<RunResult, RunError> {
-    let mut stages = Stages::new(&loaded.scene, options, progress)?;
-    let plan = Plan::of(&loaded.scene, options)?;
-    let visibility = stages.visibility();
+    let LoadedScene {
+        scene,
+        source,
+        warnings,
+    } = loaded;
+    let scene = Arc::new(scene);
+    let mut stages = Stages::new(&scene, options, progress)?;
+    let plan = Plan::of(&scene, options)?;
+    let visibility = Arc::new(stages.visibility());
     let lit = match stages.mesh_and_solve(&visibility, &plan) {
         Err(e) if is_interrupt(&e) => stages.least_mesh(&visibility, &plan)?,
         lit => lit?,
     };
     let render = stages.render(&lit)?;
     let figures = stages.figures();
+    // Abandoned meshing may hold the scene a moment longer.
+    let scene = Arc::try_unwrap(scene).unwrap_or_else(|shared| Scene::clone(&shared));
+    let loaded = LoadedScene {
+        scene,
+        source,
+        warnings,
+    };
     Ok(assemble(loaded, options, lit, render, &plan, figures))
 }
 
@@ -81,7 +96,7 @@ struct Lit {
 
 /// A run in progress: what every stage reads, and the figures each leaves behind.
 struct Stages<'a> {
-    scene: &'a Scene,
+    scene: &'a Arc<Scene>,
     options: &'a RunOptions,
     progress: &'a dyn Progress,
     /// The solver's options, with the run's deadline.
@@ -97,7 +112,7 @@ struct Stages<'a> {
 impl<'a> Stages<'a> {
     /// A run of `options` on `scene`, which are checked first.
     fn new(
-        scene: &'a Scene,
+        scene: &'a Arc<Scene>,
         options: &'a RunOptions,
         progress: &'a dyn Progress,
     ) -> Result<Self, RunError> {
@@ -166,7 +181,11 @@ impl<'a> Stages<'a> {
     }
 
     /// The stages from the discontinuities to the solve.
-    fn mesh_and_solve(&mut self, visibility: &Visibility, plan: &Plan) -> Result<Lit, RunError> {
+    fn mesh_and_solve(
+        &mut self,
+        visibility: &Arc<Visibility>,
+        plan: &Plan,
+    ) -> Result<Lit, RunError> {
         let found = self.discontinuities(visibility, plan);
         self.check_interrupt()?;
         let mut meshed = self.mesh(visibility, found, plan)?;
@@ -228,7 +247,7 @@ impl<'a> Stages<'a> {
     /// direct light's interpolation error is largest.
     fn mesh(
         &mut self,
-        visibility: &Visibility,
+        visibility: &Arc<Visibility>,
         found: Option<Discontinuities>,
         plan: &Plan,
     ) -> Result<Meshed, RunError> {
@@ -252,40 +271,36 @@ impl<'a> Stages<'a> {
     }
 
     /// The mesh of the plan's first budget: by discontinuities where there are any (or they
-    /// were asked for), else uniform.
+    /// were asked for), else uniform. An interrupt abandons it at once ([`abandoned_on`]).
     fn first_mesh(
         &self,
-        visibility: &Visibility,
+        visibility: &Arc<Visibility>,
         found: Option<Discontinuities>,
         plan: &Plan,
     ) -> Result<SceneMesh, RunError> {
         let options = self.options;
         let error_driven = options.error_driven();
-        let meshed = match found {
-            Some(found)
-                if options.mesh == MeshMethod::Discontinuity
-                    || error_driven
-                    || found.stats.segments > 0
-                    || found.stats.pairs_skipped > 0 =>
-            {
-                let on = self.shard_surfaces();
-                let meshing = DiscontinuityMeshing {
-                    penumbra_density: if error_driven {
-                        1.0
-                    } else {
-                        options.penumbra_density
-                    },
-                    min_angle_deg: options.min_angle,
-                    on: on.as_deref(),
-                    interrupt: options.solver.interrupt.as_ref(),
-                };
-                let budget = plan.initial_budget;
-                mesh_scene_discontinuity_on(self.scene, visibility, found, budget, &meshing)
-            }
-            _ => {
-                let interrupt = options.solver.interrupt.as_ref();
-                mesh_scene_uniform_until(self.scene, plan.initial_budget, interrupt)
-            }
+        let found = found.filter(|found| {
+            options.mesh == MeshMethod::Discontinuity
+                || error_driven
+                || found.stats.segments > 0
+                || found.stats.pairs_skipped > 0
+        });
+        let first = FirstMesh {
+            scene: Arc::clone(self.scene),
+            visibility: Arc::clone(visibility),
+            found,
+            budget: plan.initial_budget,
+            penumbra_density: match error_driven {
+                true => 1.0,
+                false => options.penumbra_density,
+            },
+            min_angle_deg: options.min_angle,
+            on: self.shard_surfaces(),
+        };
+        let meshed = match &options.solver.interrupt {
+            Some(interrupt) => abandoned_on(interrupt, move |own| first.make(Some(own))),
+            None => first.make(None),
         };
         meshed.map_err(|e| match initial_budget_too_small(options, &e) {
             true => RunError::InitialBudget(e),

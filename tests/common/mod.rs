@@ -46,3 +46,24 @@ pub fn json(path: &Path) -> serde_json::Value {
 pub fn path(p: &Path) -> &str {
     p.to_str().expect("utf-8")
 }
+
+/// Every radiosity in a solution is finite and non-negative; returns how many there are.
+pub fn check_radiosity(solution: &serde_json::Value) -> usize {
+    let mut n = 0;
+    for s in solution["surfaces"].as_array().expect("surfaces") {
+        let vertices = s["vertices"].as_array().expect("vertices").len();
+        let radiosity = s["radiosity"].as_array().expect("radiosity");
+        assert_eq!(radiosity.len(), vertices);
+        for c in radiosity.iter().flat_map(|c| c.as_array().expect("rgb")) {
+            let v = c.as_f64().expect("a number, not null (NaN)");
+            assert!(v.is_finite() && v >= 0.0, "radiosity {v}");
+            n += 1;
+        }
+        for t in s["triangles"].as_array().expect("triangles") {
+            for i in t.as_array().expect("index triple") {
+                assert!((i.as_u64().expect("index") as usize) < vertices);
+            }
+        }
+    }
+    n
+}

@@ -131,8 +131,11 @@ pub struct DiscontinuityOptions {
 
 impl DiscontinuityOptions {
     fn should_stop(&self) -> bool {
+        self.interrupted() || self.deadline.is_some_and(|d| Instant::now() >= d)
+    }
+
+    fn interrupted(&self) -> bool {
         self.interrupt.as_ref().is_some_and(Interrupt::is_set)
-            || self.deadline.is_some_and(|d| Instant::now() >= d)
     }
 
     /// Whether receiver `r` is searched.
@@ -316,7 +319,8 @@ pub fn find_discontinuities(
 /// [`find_discontinuities`], reporting each emitter–receiver pair done to `progress`. Pairs run
 /// in parallel and are collected in order, so the result does not depend on the thread count.
 /// Once `options.deadline` passes or `options.interrupt` is set, the pairs not yet started are
-/// skipped (counted in [`DiscontinuityStats::pairs_skipped`]).
+/// skipped (counted in [`DiscontinuityStats::pairs_skipped`]); an interrupted search also lets
+/// go of the segments it found, without their contact lines and merging (no segments).
 pub fn find_discontinuities_reporting(
     scene: &Scene,
     visibility: &Visibility,
@@ -354,9 +358,18 @@ pub fn find_discontinuities_reporting(
         }
     }
     stats.pairs = pairs.len();
+    let receivers = scene.surfaces.len();
+    if options.interrupted() {
+        stats.seconds = started.elapsed().as_secs_f64();
+        return Discontinuities {
+            segments: vec![Vec::new(); receivers],
+            hovering: vec![Vec::new(); receivers],
+            stats,
+        };
+    }
 
     // Contact lines, for every receiver that something touches.
-    let mut hovering = vec![Vec::new(); scene.surfaces.len()];
+    let mut hovering = vec![Vec::new(); receivers];
     let emitters: Vec<SurfaceId> = scene.emitters().map(|(e, _)| e).collect();
     let searched = |r: SurfaceId| options.searches(r);
     for (r, contacts) in contact::contact_lines(scene, &context.frames, visibility, &searched) {

@@ -163,6 +163,11 @@ impl<'a> SearchContext<'a> {
             }
         }
         for candidate in wedges {
+            // A pair with thousands of blockers takes a large share of a second; an interrupted
+            // search lets go of its segments anyway.
+            if self.options.interrupted() {
+                break;
+            }
             shaft.wedge_segments(&candidate, &mut out);
         }
         out
