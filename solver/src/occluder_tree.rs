@@ -75,6 +75,8 @@ struct Sheet {
     radius: f64,
     /// The least and greatest of `axis . v` over the corners.
     heights: (f64, f64),
+    /// The faces' area seen along `axis`.
+    area: f64,
     closed: bool,
     outline: Vec<OutlineEdge>,
     faces: Members,
@@ -277,6 +279,15 @@ impl OccluderTree {
         faces
             .all(|&i| self.turns[i].turns_away(point, margin) == Some(first))
             .then_some(first)
+    }
+
+    /// About the solid angle sheet `sheet` fills seen from `point` (from its area along its axis
+    /// and its centre): for ranking sheets, not for measuring.
+    pub(crate) fn solid_angle(&self, sheet: usize, point: DVec3) -> f64 {
+        let s = &self.sheets[sheet];
+        let d = s.center - point;
+        let r2 = d.length_squared();
+        s.area * s.axis.dot(d).abs() / (r2 * r2.sqrt())
     }
 
     /// The outline of sheet `sheet`.
@@ -496,12 +507,14 @@ fn sheet_of<'a>(
     let mut edges = Vec::new();
     let mut count = 0;
     let mut closed = true;
+    let mut area = 0.0;
     for f in faces {
         count += 1;
         closed &= f.closed;
         let n = f.polygon.len();
         // The listed order turns the face's own normal; the facing normal may be its opposite.
         let listed = newell_normal(f.polygon);
+        area += listed.dot(axis).abs() / 2.0;
         let reversed = listed.dot(f.facing) < 0.0;
         for i in 0..n {
             let (a, b) = if reversed {
@@ -528,6 +541,7 @@ fn sheet_of<'a>(
         center,
         radius,
         heights,
+        area,
         closed,
         outline,
         faces: members,

@@ -1,0 +1,61 @@
+//! Times the exact direct light at random vertices of a scene's uniform mesh, one point at a
+//! time, and writes the values for comparison between builds.
+//!
+//! `cargo run --release --example direct_profile -- SCENE [TRIANGLES] [POINTS] [VALUES_FILE]`
+//! (defaults: 100,000 triangles, 1,500 points). `RAYON_NUM_THREADS=1` times one core.
+
+use std::time::Instant;
+
+use penumbra_meshing::{ElementBudget, mesh_scene_uniform};
+use penumbra_scenes::{SplitMix64, Visibility, load_scene};
+use penumbra_solver::{DirectLight, Discretization, OVERLAY_CAP};
+use rayon::prelude::*;
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let spec = args.first().ok_or("usage: direct_profile SCENE [TRIANGLES] [POINTS] [FILE]")?;
+    let triangles: usize = args.get(1).map_or(Ok(100_000), |a| a.parse())?;
+    let points: usize = args.get(2).map_or(Ok(1_500), |a| a.parse())?;
+    let scene = load_scene(spec)?.scene;
+    let visibility = Visibility::build(&scene);
+    let mesh = mesh_scene_uniform(&scene, ElementBudget::AtMost(triangles))?;
+    let disc = Discretization::new(&scene, &mesh, 1);
+    let direct = DirectLight::new(&scene, &visibility).with_overlay_cap(OVERLAY_CAP);
+    let mut rng = SplitMix64::new(35);
+    let count = disc.receiver_count();
+    let chosen: Vec<usize> = (0..points)
+        .map(|_| (rng.next_f64() * count as f64) as usize % count)
+        .collect();
+    let started = Instant::now();
+    let timed: Vec<(f64, f64)> = chosen
+        .par_iter()
+        .map(|&v| {
+            let t = Instant::now();
+            let h = direct.irradiance(&disc.receivers[v], disc.receiver_surface[v]);
+            (t.elapsed().as_secs_f64(), h.r + h.g + h.b)
+        })
+        .collect();
+    let wall = started.elapsed().as_secs_f64();
+    let mut times: Vec<f64> = timed.iter().map(|t| t.0).collect();
+    times.sort_by(f64::total_cmp);
+    let total: f64 = times.iter().sum();
+    let at = |q: f64| times[((times.len() - 1) as f64 * q) as usize] * 1e3;
+    let dark = timed.iter().filter(|t| t.1 == 0.0).count();
+    println!(
+        "{points} of {count} vertices: {wall:.2} s wall, {total:.2} s of work; \
+         per point median {:.2} ms, p90 {:.2} ms, p99 {:.2} ms, max {:.1} ms; {dark} dark",
+        at(0.5),
+        at(0.9),
+        at(0.99),
+        at(1.0)
+    );
+    if let Some(file) = args.get(3) {
+        let text: String = chosen
+            .iter()
+            .zip(&timed)
+            .map(|(v, t)| format!("{v} {:e}\n", t.1))
+            .collect();
+        std::fs::write(file, text)?;
+    }
+    Ok(())
+}
