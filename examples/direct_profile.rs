@@ -4,16 +4,19 @@
 //! `cargo run --release --example direct_profile -- SCENE [TRIANGLES] [POINTS] [VALUES_FILE]`
 //! (defaults: 100,000 triangles, 1,500 points). `RAYON_NUM_THREADS=1` times one core.
 
+use std::io::Write;
 use std::time::Instant;
 
 use penumbra_meshing::{ElementBudget, mesh_scene_uniform};
 use penumbra_scenes::{SplitMix64, Visibility, load_scene};
-use penumbra_solver::{DirectLight, Discretization, OVERLAY_CAP};
+use penumbra_solver::{DirectLight, Discretization, OVERLAY_CAP, form_factor};
 use rayon::prelude::*;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let spec = args.first().ok_or("usage: direct_profile SCENE [TRIANGLES] [POINTS] [FILE]")?;
+    let spec = args
+        .first()
+        .ok_or("usage: direct_profile SCENE [TRIANGLES] [POINTS] [FILE]")?;
     let triangles: usize = args.get(1).map_or(Ok(100_000), |a| a.parse())?;
     let points: usize = args.get(2).map_or(Ok(1_500), |a| a.parse())?;
     let scene = load_scene(spec)?.scene;
@@ -40,15 +43,51 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     times.sort_by(f64::total_cmp);
     let total: f64 = times.iter().sum();
     let at = |q: f64| times[((times.len() - 1) as f64 * q) as usize] * 1e3;
-    let dark = timed.iter().filter(|t| t.1 == 0.0).count();
-    println!(
+    // Each point as dark, fully lit (its value the unoccluded one) or partly lit: count, seconds.
+    let tol = 1e-9 * direct.scene_diagonal();
+    let unoccluded = |v: usize| -> f64 {
+        scene
+            .emitters()
+            .map(|(e, s)| {
+                let f = form_factor(&disc.receivers[v], &s.polygon, tol);
+                let h = s.emission * f;
+                if e == disc.receiver_surface[v] {
+                    0.0
+                } else {
+                    h.r + h.g + h.b
+                }
+            })
+            .sum()
+    };
+    let mut kinds = [(0usize, 0.0f64); 3];
+    for (&v, &(t, h)) in chosen.iter().zip(&timed) {
+        let full = unoccluded(v);
+        let kind = match h {
+            0.0 => 0,
+            _ if (h - full).abs() <= 1e-9 * full.abs() => 1,
+            _ => 2,
+        };
+        kinds[kind].0 += 1;
+        kinds[kind].1 += t;
+    }
+    let dark = kinds[0].0;
+    let mut out = std::io::stdout().lock();
+    writeln!(
+        out,
         "{points} of {count} vertices: {wall:.2} s wall, {total:.2} s of work; \
          per point median {:.2} ms, p90 {:.2} ms, p99 {:.2} ms, max {:.1} ms; {dark} dark",
         at(0.5),
         at(0.9),
         at(0.99),
         at(1.0)
-    );
+    )?;
+    for (name, (n, t)) in ["dark", "fully lit", "partly lit"].iter().zip(kinds) {
+        writeln!(
+            out,
+            "  {name}: {n} points, {t:.2} s ({:.0} %)",
+            100.0 * t / total
+        )?;
+    }
     if let Some(file) = args.get(3) {
         let text: String = chosen
             .iter()

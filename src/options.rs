@@ -4,15 +4,16 @@
 use penumbra_meshing::DEFAULT_PENUMBRA_DENSITY;
 use penumbra_meshing::ElementBudget;
 use penumbra_meshing::discontinuity::DiscontinuityOptions;
-use penumbra_meshing::polygon_minimum;
-use penumbra_scenes::{Scene, SurfaceId};
 pub use penumbra_solver::OptionId;
 use penumbra_solver::estimate::IndirectEstimate;
 use penumbra_solver::{SolveError, SolverMethod, SolverOptions};
 use penumbra_viz::RenderOptions;
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
 use crate::adaptive::RefineOptions;
+
+mod shard;
+pub use shard::{Shard, ShardError, meshed_alone, surface_costs};
 
 /// How surfaces are meshed (`--mesh`; `method.mesh_requested` in `report.json`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, serde::Deserialize)]
@@ -325,120 +326,6 @@ impl RunOptions {
             ));
         }
         Ok(())
-    }
-}
-
-/// One of `count` parts of a scene's surfaces: those whose index is `index` modulo `count`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub struct Shard {
-    /// Which part, from 0 to `count - 1`.
-    pub index: usize,
-    /// How many parts the scene is split into, at least 1.
-    pub count: usize,
-}
-
-/// Why a shard cannot be run as asked.
-#[derive(Debug, thiserror::Error, PartialEq, Eq)]
-#[non_exhaustive]
-pub enum ShardError {
-    /// The text given to [`Shard::parse`] is not `I/N`.
-    #[error("a shard is written I/N with whole numbers I and N (I from 0 to N - 1), not {0:?}")]
-    Syntax(String),
-    /// A count of 0.
-    #[error("a scene cannot be split into 0 shards")]
-    NoShards,
-    /// An index not below the count.
-    #[error("there is no shard {index} of {count}: shards are numbered from 0 to {}", .count - 1)]
-    OutOfRange {
-        /// The index asked for.
-        index: usize,
-        /// The count of shards.
-        count: usize,
-    },
-    /// A full solution was asked for: only the direct light can be split.
-    #[error(
-        "a full solution cannot be split by surface: light bounces between all surfaces, so each \
-         one's radiosity depends on every other's; only the direct light can be split"
-    )]
-    NeedsDirectOnly,
-    /// Adaptive refinement was asked for.
-    #[error(
-        "adaptive refinement cannot be split by surface: it spends one element budget over the \
-         whole scene, against the scene's mean radiosity"
-    )]
-    Refinement,
-    /// A time budget was given.
-    #[error(
-        "a time budget cannot be split by surface: it would cut the shards short at different \
-         points, and their parts would not belong to one run"
-    )]
-    TimeBudget,
-}
-
-impl Shard {
-    /// Shard `index` of `count`.
-    pub fn new(index: usize, count: usize) -> Result<Shard, ShardError> {
-        if count == 0 {
-            return Err(ShardError::NoShards);
-        }
-        if index >= count {
-            return Err(ShardError::OutOfRange { index, count });
-        }
-        Ok(Shard { index, count })
-    }
-
-    /// `I/N`, as a scheduler's task number gives it (`0/8` to `7/8`).
-    pub fn parse(text: &str) -> Result<Shard, ShardError> {
-        let syntax = || ShardError::Syntax(text.to_owned());
-        let (i, n) = text.trim().split_once('/').ok_or_else(syntax)?;
-        let number = |s: &str| s.trim().parse::<usize>().map_err(|_| syntax());
-        Shard::new(number(i)?, number(n)?)
-    }
-
-    /// Whether surface `s` is this shard's.
-    pub fn contains(self, s: SurfaceId) -> bool {
-        s % self.count == self.index
-    }
-
-    /// For each of `surfaces` surfaces, whether it is this shard's.
-    pub fn surfaces(self, surfaces: usize) -> Vec<bool> {
-        (0..surfaces).map(|s| self.contains(s)).collect()
-    }
-
-    /// Refuses options whose results cannot be split by surface.
-    pub fn check(self, options: &RunOptions) -> Result<(), ShardError> {
-        Shard::new(self.index, self.count)?;
-        if !options.solver.direct_only {
-            return Err(ShardError::NeedsDirectOnly);
-        }
-        if options.refine.is_some() {
-            return Err(ShardError::Refinement);
-        }
-        if options.time_budget.is_some() {
-            return Err(ShardError::TimeBudget);
-        }
-        Ok(())
-    }
-}
-
-/// Whether a shard of a run with these options finds the discontinuities of its own surfaces and
-/// meshes them alone: a fitted budget of a scene whose polygons need more than the budget's
-/// floor ([`penumbra_meshing::ElementBudget::shared_extra`]) gives each surface a share that
-/// depends on nothing else, unless the mesh is error-driven. Otherwise each shard meshes the
-/// whole scene, as the run not split does.
-pub fn meshed_alone(scene: &Scene, options: &RunOptions) -> bool {
-    // An error-driven mesh spends one budget over all surfaces through one queue.
-    options.refine.is_none()
-        && !options.error_driven()
-        && options
-            .max_elements
-            .shared_extra(polygon_minimum(scene), scene.surfaces.len())
-            .is_some()
-}
-
-impl std::fmt::Display for Shard {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{}/{}", self.index, self.count)
     }
 }
 

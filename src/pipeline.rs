@@ -240,7 +240,7 @@ impl<'a> Stages<'a> {
         self.options
             .shard
             .filter(|_| crate::options::meshed_alone(self.scene, self.options))
-            .map(|shard| shard.surfaces(self.scene.surfaces.len()))
+            .map(|shard| shard.surfaces_of(self.scene, self.options))
     }
 
     /// The mesh stage: the first mesh, then, for error-driven meshes, refinement where the

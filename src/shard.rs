@@ -1,8 +1,9 @@
 //! Sharded runs: the direct light of one scene split over processes or machines by an existing
 //! scheduler (a Slurm job array, GNU parallel), then joined.
 //!
-//! Shard `I` of `N` (`0 <= I < N`) lights the surfaces whose index in the scene is `I` modulo
-//! `N`, so that each surface's mesh and values are those of the run not split, to the bit:
+//! Shard `I` of `N` (`0 <= I < N`) lights the `I`-th of `N` runs of consecutive surfaces of
+//! about equal estimated cost ([`Shard::surfaces`]), so that each surface's mesh and values are
+//! those of the run not split, to the bit:
 //!
 //! - a large scene (its polygons alone need more triangles than the fitted budget's floor;
 //!   [`meshed_alone`]) meshed by discontinuities (`--mesh discontinuity`): the shard finds the discontinuities of its own surfaces and meshes them
@@ -49,7 +50,7 @@ use crate::run_result::{RunResult, StageTimes};
 /// The file a shard writes into its output directory.
 pub const SHARD_FILE: &str = "shard.json";
 /// The format of [`SHARD_FILE`].
-pub const SHARD_FORMAT: &str = "penumbra-shard/1";
+pub const SHARD_FORMAT: &str = "penumbra-shard/2";
 
 /// How the scene was given, so that `merge` can load it again to render the joined solution.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -134,10 +135,11 @@ pub fn write_shard(
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let scene = &result.loaded.scene;
     let report = Report::of_run(result, svgs);
+    let on = shard.surfaces_of(scene, &result.options);
     let ours: Vec<SurfaceId> = svgs
         .surfaces(result)
         .into_iter()
-        .filter(|&s| shard.contains(s))
+        .filter(|&s| on[s])
         .collect();
     let svg_dir = dir.join(SVG_DIR);
     if !ours.is_empty() {
@@ -172,7 +174,7 @@ pub fn write_shard(
         report,
         svgs: written,
         surfaces: (0..scene.surfaces.len())
-            .filter(|&s| shard.contains(s))
+            .filter(|&s| on[s])
             .map(|s| SurfaceSolution {
                 index: Some(s),
                 ..surface_solution(result, s)
@@ -237,8 +239,14 @@ pub enum MergeError {
         /// The count of shards of the run.
         count: usize,
     },
-    /// A shard file holds a surface that is not its shard's, or not in the scene.
-    #[error("{}: surface {index} ({name:?}) is not this shard's, or not the scene's", .path.display())]
+    /// No shard holds this surface of the scene.
+    #[error("surface {index} is in none of the shards")]
+    Uncovered {
+        /// The surface's index in the scene.
+        index: usize,
+    },
+    /// A shard file holds a surface that another shard holds too, or that is not in the scene.
+    #[error("{}: surface {index} ({name:?}) is another shard's too, or not the scene's", .path.display())]
     StraySurface {
         /// The shard file.
         path: PathBuf,
@@ -360,14 +368,22 @@ pub fn check_shards(
     if !missing.is_empty() {
         return Err(MergeError::Missing { missing, count });
     }
+    // Each surface in one shard only.
+    let mut claimed = vec![false; shards[0].1.scene_surfaces];
     for (dir, file) in &shards {
         if file.report.partial {
             return Err(MergeError::Partial { dir: dir.clone() });
         }
-        if let Some(s) = file.surfaces.iter().find(|s| {
-            s.index
-                .is_none_or(|i| i >= file.scene_surfaces || !file.shard.contains(i))
-        }) {
+        let mut claim = |i: usize| {
+            claimed
+                .get_mut(i)
+                .is_some_and(|c| !std::mem::replace(c, true))
+        };
+        if let Some(s) = file
+            .surfaces
+            .iter()
+            .find(|s| s.index.is_none_or(|i| !claim(i)))
+        {
             return Err(MergeError::StraySurface {
                 path: dir.join(SHARD_FILE),
                 index: s.index.unwrap_or(usize::MAX),
@@ -443,7 +459,6 @@ fn join_parts(
     surfaces: usize,
     emitted: Rgb,
 ) -> Result<Parts, MergeError> {
-    let count = shards.first().map_or(1, |(_, f)| f.shard.count);
     let mut joined: Vec<Option<SurfaceSolution>> = vec![None; surfaces];
     let (mut svgs, mut parts, mut light) = (Vec::new(), Vec::new(), LightSums::default());
     for (dir, file) in shards {
@@ -467,12 +482,7 @@ fn join_parts(
     let surfaces = joined
         .into_iter()
         .enumerate()
-        .map(|(i, s)| {
-            s.ok_or_else(|| MergeError::Missing {
-                missing: vec![i % count],
-                count,
-            })
-        })
+        .map(|(i, s)| s.ok_or(MergeError::Uncovered { index: i }))
         .collect::<Result<_, _>>()?;
     svgs.sort_by(|a, b| a.1.cmp(&b.1));
     Ok(Parts {
@@ -776,10 +786,6 @@ mod tests {
             assert_eq!(Shard::parse(bad), Err(ShardError::Syntax(bad.to_owned())));
         }
         let s = Shard::new(1, 3).expect("valid");
-        assert_eq!(
-            s.surfaces(7),
-            [false, true, false, false, true, false, false]
-        );
         assert_eq!(s.to_string(), "1/3");
     }
 

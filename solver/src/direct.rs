@@ -971,7 +971,9 @@ impl<'a> DirectLight<'a> {
             let r2 = d.length_squared();
             occ.area * occ.normal.dot(d).abs() / (r2 * r2.sqrt())
         };
-        let faces = candidates.iter().map(|&i| (solid_angle(i), Narrowing::Face(i)));
+        let faces = candidates
+            .iter()
+            .map(|&i| (solid_angle(i), Narrowing::Face(i)));
         let sheets = outlines.iter().map(|&(sheet, reversed)| {
             let angle = self.tree.solid_angle(sheet, point);
             (angle, Narrowing::Sheet(sheet, reversed))

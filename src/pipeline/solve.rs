@@ -74,7 +74,7 @@ pub(crate) fn solve_with(
         // Every surface is meshed as in a whole run (each one's share of the budget depends on
         // all of them, and the direct light at a point shared by several surfaces is evaluated
         // once for all); only the shard's vertices are lit.
-        let on = shard.surfaces(scene.surfaces.len());
+        let on = shard.surfaces_of(scene, options);
         let solution = solve_direct_on(scene, mesh, visibility, solver, &on, progress)?;
         return Ok(plain(solution));
     }
