@@ -136,10 +136,13 @@ impl std::fmt::Display for Shard {
     }
 }
 
-/// Each surface's estimated share of a run's work: the triangles meshing will give it, about
-/// (its share of the planned budget by area, or its polygon's own triangles when that is more),
-/// which the vertices to light follow. The same for every shard of a run, from the scene and
-/// the options alone.
+/// Each surface's estimated share of a shard's work, the vertices whose direct light it
+/// evaluates: about the triangles meshing will give the surface (its share of the planned
+/// budget by area, or its polygon's own triangles when that is more). An error-driven mesh
+/// (which every shard makes whole) measures the light at the vertices of the surfaces it
+/// refines while it is made, so what is left to split is mostly the small faces that keep
+/// their polygon's own triangles: there a surface costs those. The same for every shard of a
+/// run, from the scene and the options alone.
 pub fn surface_costs(scene: &Scene, options: &RunOptions) -> Vec<f64> {
     let least = polygon_minimum(scene);
     let planned = options
@@ -147,12 +150,13 @@ pub fn surface_costs(scene: &Scene, options: &RunOptions) -> Vec<f64> {
         .resolve(least, scene.surfaces.len())
         .unwrap_or(least) as f64;
     let area = scene.total_area();
+    let spread = !options.error_driven() && area > 0.0;
     scene
         .surfaces
         .iter()
         .map(|s| {
             let own = s.polygon.len().saturating_sub(2).max(1) as f64;
-            let share = if area > 0.0 {
+            let share = if spread {
                 planned * s.area() / area
             } else {
                 0.0
@@ -218,13 +222,16 @@ mod tests {
     }
 
     /// The costs follow the triangles meshing spreads: about the planned budget in all, each
-    /// surface at least its polygon's own triangles.
+    /// surface at least its polygon's own triangles (only those, for an error-driven mesh).
     #[test]
     fn costs_follow_the_planned_triangles() {
         let scene = penumbra_scenes::load_scene("cornell")
             .expect("built in")
             .scene;
-        let options = RunOptions::default();
+        let options = RunOptions {
+            mesh: crate::options::MeshMethod::Discontinuity,
+            ..RunOptions::default()
+        };
         let costs = surface_costs(&scene, &options);
         let least = polygon_minimum(&scene);
         let planned = options
@@ -238,6 +245,11 @@ mod tests {
         );
         for (s, cost) in scene.surfaces.iter().zip(&costs) {
             assert!(*cost >= (s.polygon.len() - 2) as f64);
+        }
+        // An error-driven mesh leaves each surface its own triangles to split.
+        let error_driven = surface_costs(&scene, &RunOptions::default());
+        for (s, cost) in scene.surfaces.iter().zip(&error_driven) {
+            assert_eq!(*cost, (s.polygon.len() - 2) as f64);
         }
     }
 }
