@@ -1,13 +1,18 @@
-//! Times the exact direct light at random vertices of a scene's uniform mesh, one point at a
-//! time, and writes the values for comparison between builds.
+//! Times the exact direct light at random vertices of a scene's mesh, one point at a time, sorts
+//! the points into dark, fully lit and partly lit, and writes the values (vertex, sum of the
+//! channels) for comparison between builds.
 //!
 //! `cargo run --release --example direct_profile -- SCENE [TRIANGLES] [POINTS] [VALUES_FILE]`
-//! (defaults: 100,000 triangles, 1,500 points). `RAYON_NUM_THREADS=1` times one core.
+//! (defaults: 100,000 triangles, 1,500 points; 0 points: every vertex). The mesh is uniform, or
+//! with `DISCONTINUITIES=1` by discontinuities (vertices on shadow boundaries).
+//! `CHECK=v,v,...` prints those vertices' exact values (red channel) beside an estimate by a
+//! million rays instead. `RAYON_NUM_THREADS=1` times one core.
 
 use std::io::Write;
 use std::time::Instant;
 
-use penumbra_meshing::{ElementBudget, mesh_scene_uniform};
+use penumbra_meshing::discontinuity::{DiscontinuityOptions, find_discontinuities};
+use penumbra_meshing::{ElementBudget, mesh_scene_discontinuity, mesh_scene_uniform};
 use penumbra_scenes::{SplitMix64, Visibility, load_scene};
 use penumbra_solver::{DirectLight, Discretization, OVERLAY_CAP, form_factor};
 use rayon::prelude::*;
@@ -21,14 +26,44 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let points: usize = args.get(2).map_or(Ok(1_500), |a| a.parse())?;
     let scene = load_scene(spec)?.scene;
     let visibility = Visibility::build(&scene);
-    let mesh = mesh_scene_uniform(&scene, ElementBudget::AtMost(triangles))?;
+    // DISCONTINUITIES=1: the discontinuity mesh, whose vertices lie on shadow boundaries.
+    let mesh = if std::env::var_os("DISCONTINUITIES").is_some() {
+        let search = DiscontinuityOptions {
+            element_area: Some(scene.total_area() / triangles as f64),
+            ..DiscontinuityOptions::default()
+        };
+        let found = find_discontinuities(&scene, &visibility, &search);
+        mesh_scene_discontinuity(&scene, &visibility, found, triangles, 1.0)?
+    } else {
+        mesh_scene_uniform(&scene, ElementBudget::AtMost(triangles))?
+    };
     let disc = Discretization::new(&scene, &mesh, 1);
     let direct = DirectLight::new(&scene, &visibility).with_overlay_cap(OVERLAY_CAP);
     let mut rng = SplitMix64::new(35);
     let count = disc.receiver_count();
-    let chosen: Vec<usize> = (0..points)
-        .map(|_| (rng.next_f64() * count as f64) as usize % count)
-        .collect();
+    // CHECK=v,v,...: those vertices' values, against an estimate by a million rays.
+    if let Ok(list) = std::env::var("CHECK") {
+        let mut out = std::io::stdout().lock();
+        for v in list.split(',').filter_map(|v| v.parse::<usize>().ok()) {
+            let (x, r) = (&disc.receivers[v], disc.receiver_surface[v]);
+            let exact = direct.irradiance(x, r);
+            let rays = direct.irradiance_sampled(x, r, 1 << 20);
+            writeln!(
+                out,
+                "{v} on {r} ({}) at {:?} inward {:?}: exact {:e} rays {:e}",
+                scene.surfaces[r].name, x.point, x.inward, exact.r, rays.r
+            )?;
+        }
+        return Ok(());
+    }
+    // POINTS=0: every vertex.
+    let chosen: Vec<usize> = match points {
+        0 => (0..count).collect(),
+        _ => (0..points)
+            .map(|_| (rng.next_f64() * count as f64) as usize % count)
+            .collect(),
+    };
+    let points = chosen.len();
     let started = Instant::now();
     let timed: Vec<(f64, f64)> = chosen
         .par_iter()
@@ -71,6 +106,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         kinds[kind].1 += t;
     }
     let dark = kinds[0].0;
+    if let Some(file) = args.get(3) {
+        let text: String = chosen
+            .iter()
+            .zip(&timed)
+            .map(|(v, t)| format!("{v} {:e}\n", t.1))
+            .collect();
+        std::fs::write(file, text)?;
+    }
     let mut out = std::io::stdout().lock();
     writeln!(
         out,
@@ -87,14 +130,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "  {name}: {n} points, {t:.2} s ({:.0} %)",
             100.0 * t / total
         )?;
-    }
-    if let Some(file) = args.get(3) {
-        let text: String = chosen
-            .iter()
-            .zip(&timed)
-            .map(|(v, t)| format!("{v} {:e}\n", t.1))
-            .collect();
-        std::fs::write(file, text)?;
     }
     Ok(())
 }
