@@ -173,7 +173,7 @@ fn empty_shards_merge_too() {
     run("textbook", &whole, &[]);
     let dirs = shards("textbook", dir.path(), 5, &[]);
     // Fewer surfaces than shards: some shards light none, each surface is in one.
-    let lit = |d: &std::path::PathBuf| {
+    let lit = |d: &PathBuf| {
         json(&d.join("shard.json"))["surfaces"]
             .as_array()
             .map_or(0, Vec::len)
