@@ -4,6 +4,8 @@
 use penumbra_meshing::DEFAULT_PENUMBRA_DENSITY;
 use penumbra_meshing::ElementBudget;
 use penumbra_meshing::discontinuity::DiscontinuityOptions;
+use penumbra_meshing::polygon_minimum;
+use penumbra_scenes::Scene;
 pub use penumbra_solver::OptionId;
 use penumbra_solver::estimate::IndirectEstimate;
 use penumbra_solver::{SolveError, SolverMethod, SolverOptions};
@@ -188,6 +190,14 @@ impl From<SolveError> for InvalidOption {
 }
 
 impl RunOptions {
+    /// The triangles the element budget resolves to on `scene`, as far as its polygons alone
+    /// tell; [`MeshError::BudgetTooSmall`](penumbra_meshing::MeshError) for a cap below what
+    /// they need.
+    pub fn planned_elements(&self, scene: &Scene) -> Result<usize, penumbra_meshing::MeshError> {
+        self.max_elements
+            .resolve(polygon_minimum(scene), scene.surfaces.len())
+    }
+
     /// Whether the mesh is error-driven ([`MeshMethod::Auto`] without adaptive refinement).
     pub fn error_driven(&self) -> bool {
         self.mesh == MeshMethod::Auto && self.refine.is_none()

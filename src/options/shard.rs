@@ -144,11 +144,10 @@ impl std::fmt::Display for Shard {
 /// their polygon's own triangles: there a surface costs those. The same for every shard of a
 /// run, from the scene and the options alone.
 pub fn surface_costs(scene: &Scene, options: &RunOptions) -> Vec<f64> {
-    let least = polygon_minimum(scene);
+    // A cap below the polygons' needs is refused before any shard runs.
     let planned = options
-        .max_elements
-        .resolve(least, scene.surfaces.len())
-        .unwrap_or(least) as f64;
+        .planned_elements(scene)
+        .unwrap_or_else(|_| polygon_minimum(scene)) as f64;
     let area = scene.total_area();
     let spread = !options.error_driven() && area > 0.0;
     scene
@@ -233,11 +232,7 @@ mod tests {
             ..RunOptions::default()
         };
         let costs = surface_costs(&scene, &options);
-        let least = polygon_minimum(&scene);
-        let planned = options
-            .max_elements
-            .resolve(least, scene.surfaces.len())
-            .expect("resolves") as f64;
+        let planned = options.planned_elements(&scene).expect("resolves") as f64;
         let total: f64 = costs.iter().sum();
         assert!(
             total >= planned && total < 1.05 * planned,

@@ -33,7 +33,7 @@ impl Plan {
     pub(crate) fn of(scene: &Scene, options: &RunOptions) -> Result<Plan, RunError> {
         let at_least = polygon_minimum(scene);
         let surfaces = scene.surfaces.len();
-        let planned_elements = options.max_elements.resolve(at_least, surfaces)?;
+        let planned_elements = options.planned_elements(scene)?;
         let initial_budget = initial_budget(options);
         initial_budget
             .resolve(at_least, surfaces)

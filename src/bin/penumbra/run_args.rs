@@ -329,8 +329,8 @@ pub(crate) struct RunArgs {
     #[arg(help_heading = LIMITS, long)]
     pub(crate) memory_limit: Option<f64>,
     /// With --direct-only: light only shard I of N (I from 0 to N - 1), the I-th of N runs of
-    /// consecutive surfaces of about equal estimated cost (the triangles each is planned), and
-    /// write OUT/shard.json and their SVGs for `penumbra merge`. In a
+    /// consecutive surfaces of about equal estimated cost (the triangles each surface is
+    /// expected to have to light), and write OUT/shard.json and their SVGs for `penumbra merge`. In a
     /// scene whose polygons need more than the budget's floor, with the fitted budget, the shard
     /// also finds the discontinuities of its own surfaces and meshes them alone; otherwise it
     /// meshes the whole scene (each surface's share of the budget depends on all of them).
