@@ -6,7 +6,8 @@
 //! (defaults: 100,000 triangles, 1,500 points; 0 points: every vertex). The mesh is uniform, or
 //! with `DISCONTINUITIES=1` by discontinuities (vertices on shadow boundaries).
 //! `CHECK=v,v,...` prints those vertices' exact values (red channel) beside an estimate by a
-//! million rays instead. `RAYON_NUM_THREADS=1` times one core.
+//! million rays instead, and beside the value with no shaft narrowed. `NEVER_NARROW=1` times and
+//! writes the values with no shaft narrowed. `RAYON_NUM_THREADS=1` times one core.
 
 use std::io::Write;
 use std::time::Instant;
@@ -39,6 +40,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let disc = Discretization::new(&scene, &mesh, 1);
     let direct = DirectLight::new(&scene, &visibility).with_overlay_cap(OVERLAY_CAP);
+    let wide = DirectLight::new(&scene, &visibility)
+        .with_overlay_cap(OVERLAY_CAP)
+        .with_window_faces(usize::MAX);
+    // NEVER_NARROW=1: every shaft subtracted whole, for comparison with the narrowed ones.
+    let evaluator = match std::env::var_os("NEVER_NARROW") {
+        Some(_) => &wide,
+        None => &direct,
+    };
     let mut rng = SplitMix64::new(35);
     let count = disc.receiver_count();
     // CHECK=v,v,...: those vertices' values, against an estimate by a million rays.
@@ -48,10 +57,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let (x, r) = (&disc.receivers[v], disc.receiver_surface[v]);
             let exact = direct.irradiance(x, r);
             let rays = direct.irradiance_sampled(x, r, 1 << 20);
+            let plain = wide.irradiance(x, r);
             writeln!(
                 out,
-                "{v} on {r} ({}) at {:?} inward {:?}: exact {:e} rays {:e}",
-                scene.surfaces[r].name, x.point, x.inward, exact.r, rays.r
+                "{v} on {r} ({}) at {:?} inward {:?}: exact {:e} never narrowed {:e} rays {:e}",
+                scene.surfaces[r].name, x.point, x.inward, exact.r, plain.r, rays.r
             )?;
         }
         return Ok(());
@@ -69,7 +79,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .par_iter()
         .map(|&v| {
             let t = Instant::now();
-            let h = direct.irradiance(&disc.receivers[v], disc.receiver_surface[v]);
+            let h = evaluator.irradiance(&disc.receivers[v], disc.receiver_surface[v]);
             (t.elapsed().as_secs_f64(), h.r + h.g + h.b)
         })
         .collect();

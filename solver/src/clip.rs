@@ -50,7 +50,8 @@ pub(crate) fn clip_left_of(polygon: &[DVec2], a: DVec2, b: DVec2) -> Vec<DVec2> 
     out
 }
 
-fn bounds_2d(polygon: &[DVec2]) -> (DVec2, DVec2) {
+/// The lowest and highest corner of a polygon's bounding box.
+pub(crate) fn bounds_2d(polygon: &[DVec2]) -> (DVec2, DVec2) {
     polygon
         .iter()
         .fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), &p| {
@@ -187,43 +188,46 @@ pub(crate) fn clip_half_plane(polygon: &[DVec2], h: &HalfPlane) -> Vec<DVec2> {
     out
 }
 
-/// Edges of a convex polygon shorter than this fraction of its longest edge are rounding
-/// leftovers (a corner repeated a few ulps away): their direction means nothing, so they cut
-/// nothing.
-const DEGENERATE_EDGE: f64 = 1e-9;
-
-/// The part of a closed contour inside a convex counter-clockwise polygon (Sutherland–Hodgman,
-/// which keeps the contour's winding inside), or `None` when none is.
-pub(crate) fn clip_to_convex(contour: &[DVec2], convex: &[DVec2]) -> Option<Vec<DVec2>> {
-    let ((lo, hi), (convex_lo, convex_hi)) = (bounds_2d(contour), bounds_2d(convex));
-    if lo.cmpgt(convex_hi).any() || convex_lo.cmpgt(hi).any() {
+/// The part of a closed contour inside the box `[lo, hi]` (Sutherland–Hodgman, which keeps the
+/// contour's winding inside), or `None` when none is. A cut corner takes the side's coordinate
+/// exactly, so every corner on a side lies on one line whatever the rounding.
+pub(crate) fn clip_to_box(contour: Vec<DVec2>, lo: DVec2, hi: DVec2) -> Option<Vec<DVec2>> {
+    let (c_lo, c_hi) = bounds_2d(&contour);
+    if c_lo.cmpgt(hi).any() || lo.cmpgt(c_hi).any() {
         return None;
     }
-    let n = convex.len();
-    let edge = |i: usize| convex[(i + 1) % n] - convex[i];
-    let longest = (0..n).map(|i| edge(i).length()).fold(0.0, f64::max);
-    // Most contours lie inside most of the sides: those leave it as it is, uncopied.
-    let mut out = std::borrow::Cow::Borrowed(contour);
-    for i in 0..n {
-        let (a, d) = (convex[i], edge(i));
-        if d.length() <= DEGENERATE_EDGE * longest {
+    let mut out = contour;
+    // Each side: the axis, its coordinate, and whether the inside lies above it.
+    for (axis, at, above) in [
+        (0, lo.x, true),
+        (0, hi.x, false),
+        (1, lo.y, true),
+        (1, hi.y, false),
+    ] {
+        let inside = |p: DVec2| if above { p[axis] >= at } else { p[axis] <= at };
+        if out.iter().all(|&p| inside(p)) {
             continue;
         }
-        let normal = DVec2::new(-d.y, d.x);
-        let side = HalfPlane {
-            normal,
-            offset: -normal.dot(a),
-        };
-        if out.iter().all(|&p| side.value(p) >= 0.0) {
-            continue;
+        let n = out.len();
+        let mut cut = Vec::with_capacity(n + 4);
+        for i in 0..n {
+            let (p, q) = (out[i], out[(i + 1) % n]);
+            if inside(p) {
+                cut.push(p);
+            }
+            if inside(p) != inside(q) {
+                let t = (at - p[axis]) / (q[axis] - p[axis]);
+                let mut x = p.lerp(q, t);
+                x[axis] = at;
+                cut.push(x);
+            }
         }
-        let clipped = clip_half_plane(&out, &side);
-        if clipped.len() < 3 {
+        if cut.len() < 3 {
             return None;
         }
-        out = std::borrow::Cow::Owned(clipped);
+        out = cut;
     }
-    Some(out.into_owned())
+    Some(out)
 }
 
 /// `piece` minus the convex region where every half-plane holds, as convex pieces no narrower

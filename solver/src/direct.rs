@@ -364,6 +364,15 @@ impl<'a> DirectLight<'a> {
         }
     }
 
+    /// The same evaluator, narrowing only shafts that hold more than `faces` faces (4,096 by
+    /// default; `usize::MAX` never narrows): the two agree to rounding.
+    pub fn with_window_faces(self, faces: usize) -> Self {
+        DirectLight {
+            window_faces: faces,
+            ..self
+        }
+    }
+
     /// The diagonal of the scene's bounding box.
     pub fn scene_diagonal(&self) -> f64 {
         self.tol / penumbra_scenes::CONTACT_TOLERANCE
@@ -469,7 +478,7 @@ impl<'a> DirectLight<'a> {
                 &self.overlay_limit,
             ) {
                 Ok(visible) => visible,
-                Err(Refusal::NotFinite) => return Ok(None),
+                Err(Refusal::NotFinite | Refusal::Inconsistent) => return Ok(None),
                 Err(Refusal::TooComplex) => return Err(TooComplex),
             };
             views.push(PieceView {
@@ -722,10 +731,10 @@ impl<'a> DirectLight<'a> {
                 Ok(visible) => return Ok(visible),
                 Err(Refusal::TooComplex) => return Err(TooComplex),
                 // The narrowed shaft's blockings alone do not cover the rest of the piece.
-                Err(Refusal::NotFinite) if narrowed => {
+                Err(Refusal::NotFinite | Refusal::Inconsistent) if narrowed => {
                     return self.unblocked(x, receiver, e, front, h_x, false);
                 }
-                Err(Refusal::NotFinite) => {}
+                Err(Refusal::NotFinite | Refusal::Inconsistent) => {}
             }
         }
         let blockings = self.faces_of_outlines(blockings, x.point, e, h_x);
