@@ -6,8 +6,8 @@
 //! steps across the overlay's extent: a point moves by at most 2⁻⁴⁰ of that extent, and the
 //! result's area is exact to that scale. Clipper2 stays fast where edges of different shadows
 //! run a few rounding steps apart (shadows of faces sharing an edge, clipped in different ways),
-//! which made an earlier engine split segments without end; but it decides the order of such edges in
-//! f64 and now and then turns part of its result inside out. Each result is checked
+//! which made an earlier engine split segments without end; but it decides the order of such
+//! edges in f64 and now and then turns part of its result inside out. Each result is checked
 //! ([`Grid::consistent_shapes`]) and, where it contradicts itself, computed again on another
 //! grid. Shadows are cut only to an axis-aligned box around the region they are subtracted
 //! from, never to the region itself: that laid their edges along its slanted sides, collinear
