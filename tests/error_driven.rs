@@ -268,3 +268,80 @@ fn the_reflected_light_is_refined_where_it_bends() {
     let split = report.reflected_refinement.map_or(0, |r| r.split);
     assert!(split > 0, "{split}");
 }
+
+/// Two copies of a lit floor with a blocker, far apart, one under a light a quarter as bright:
+/// with a cap that stops refinement early, each floor gets the same share of it and keeps the
+/// same relative error. The queue weighs each surface's squared errors by its own light, so a
+/// dim surface's relative error counts as much as a bright one's.
+#[test]
+fn a_dim_surface_is_refined_like_a_bright_one() {
+    let shifted = |polygon: Vec<DVec3>, dx: f64| -> Vec<DVec3> {
+        polygon.into_iter().map(|p| p + DVec3::X * dx).collect()
+    };
+    let mut surfaces = Vec::new();
+    for (name, dx, emission) in [("bright", -50.0, 10.0), ("dim", 50.0, 2.5)] {
+        let mut light = quad(2.0, 0.25);
+        light.reverse();
+        surfaces.push(
+            Surface::new(format!("{name} light"), shifted(light, dx), Rgb::ZERO)
+                .with_emission(Rgb::splat(emission)),
+        );
+        surfaces.push(Surface::new(
+            format!("{name} floor"),
+            shifted(quad(0.0, 2.0), dx),
+            Rgb::splat(0.7),
+        ));
+        let mut blocker = quad(1.0, 0.3);
+        blocker.reverse();
+        surfaces.push(Surface::new(
+            format!("{name} blocker"),
+            shifted(blocker, dx + 0.4),
+            Rgb::splat(0.5),
+        ));
+    }
+    let scene = Scene {
+        name: "two-rooms".into(),
+        camera: None,
+        surfaces,
+    };
+    let options = RunOptions {
+        max_elements: 1_500.into(),
+        tolerance: 0.0,
+        solver: SolverOptions {
+            direct_only: true,
+            ..SolverOptions::default()
+        },
+        ..RunOptions::default()
+    };
+    let result = run_scene(scene.clone(), options);
+    let visibility = Visibility::build(&scene);
+    let direct = DirectLight::new(&scene, &visibility);
+    let [bright, dim] = ["bright floor", "dim floor"].map(|name| {
+        let id = scene.surface_id(name).expect("a floor");
+        let e = direct_interpolation_error(
+            &scene,
+            &direct,
+            &result.mesh.surfaces[id],
+            &result.solution.radiosity[id],
+            4_000,
+            11,
+        );
+        (
+            e.rms / e.mean_exact,
+            result.mesh.surfaces[id].triangle_count(),
+        )
+    });
+    eprintln!("bright floor {bright:?}, dim floor {dim:?}");
+    assert!(
+        dim.1 * 10 >= bright.1 * 9 && bright.1 * 10 >= dim.1 * 9,
+        "triangles: bright {}, dim {}",
+        bright.1,
+        dim.1
+    );
+    assert!(
+        dim.0 <= 1.2 * bright.0,
+        "relative errors: bright {:e}, dim {:e}",
+        bright.0,
+        dim.0
+    );
+}
