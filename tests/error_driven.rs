@@ -51,6 +51,19 @@ fn floor_scene(name: &str, solid: Vec<[DVec3; 3]>) -> Scene {
 /// The floor's RMS error of the direct light, relative to its mean, and the scene's triangles,
 /// for a direct-only run with `mesh` and a cap of `max_elements` (tolerance 0: the cap decides).
 fn floor_error(scene: &Scene, mesh: MeshMethod, max_elements: usize) -> (f64, usize) {
+    let (triangles, errors) = capped_errors(scene, mesh, max_elements, &["floor"]);
+    (errors[0].0, triangles)
+}
+
+/// A direct-only run with `mesh` and a cap of `max_elements` (tolerance 0: the cap decides):
+/// the scene's triangles, and for each of the named surfaces its RMS error of the direct light
+/// relative to its mean, at 4,000 random points, and its triangles.
+fn capped_errors(
+    scene: &Scene,
+    mesh: MeshMethod,
+    max_elements: usize,
+    surfaces: &[&str],
+) -> (usize, Vec<(f64, usize)>) {
     let options = RunOptions {
         mesh,
         max_elements: max_elements.into(),
@@ -64,16 +77,25 @@ fn floor_error(scene: &Scene, mesh: MeshMethod, max_elements: usize) -> (f64, us
     let result = run_scene(scene.clone(), options);
     let visibility = Visibility::build(scene);
     let direct = DirectLight::new(scene, &visibility);
-    let floor = scene.surface_id("floor").expect("a floor");
-    let e = direct_interpolation_error(
-        scene,
-        &direct,
-        &result.mesh.surfaces[floor],
-        &result.solution.radiosity[floor],
-        4_000,
-        11,
-    );
-    (e.rms / e.mean_exact, result.mesh.triangle_count())
+    let errors = surfaces
+        .iter()
+        .map(|name| {
+            let id = scene.surface_id(name).expect("a named surface");
+            let e = direct_interpolation_error(
+                scene,
+                &direct,
+                &result.mesh.surfaces[id],
+                &result.solution.radiosity[id],
+                4_000,
+                11,
+            );
+            (
+                e.rms / e.mean_exact,
+                result.mesh.surfaces[id].triangle_count(),
+            )
+        })
+        .collect();
+    (result.mesh.triangle_count(), errors)
 }
 
 /// At equal triangles the default (error-driven) mesh's RMS error of the direct light on the
@@ -304,33 +326,13 @@ fn a_dim_surface_is_refined_like_a_bright_one() {
         camera: None,
         surfaces,
     };
-    let options = RunOptions {
-        max_elements: 1_500.into(),
-        tolerance: 0.0,
-        solver: SolverOptions {
-            direct_only: true,
-            ..SolverOptions::default()
-        },
-        ..RunOptions::default()
-    };
-    let result = run_scene(scene.clone(), options);
-    let visibility = Visibility::build(&scene);
-    let direct = DirectLight::new(&scene, &visibility);
-    let [bright, dim] = ["bright floor", "dim floor"].map(|name| {
-        let id = scene.surface_id(name).expect("a floor");
-        let e = direct_interpolation_error(
-            &scene,
-            &direct,
-            &result.mesh.surfaces[id],
-            &result.solution.radiosity[id],
-            4_000,
-            11,
-        );
-        (
-            e.rms / e.mean_exact,
-            result.mesh.surfaces[id].triangle_count(),
-        )
-    });
+    let (_, errors) = capped_errors(
+        &scene,
+        MeshMethod::Auto,
+        1_500,
+        &["bright floor", "dim floor"],
+    );
+    let (bright, dim) = (errors[0], errors[1]);
     eprintln!("bright floor {bright:?}, dim floor {dim:?}");
     assert!(
         dim.1 * 10 >= bright.1 * 9 && bright.1 * 10 >= dim.1 * 9,
