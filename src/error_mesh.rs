@@ -28,6 +28,7 @@ use penumbra_meshing::{BisectionMesh, SceneMesh, Split, SurfaceMesh};
 use penumbra_scenes::{AreaSampler, Rgb, Scene, SplitMix64, Surface, SurfaceId, Visibility};
 use penumbra_solver::{
     DirectLight, Interrupt, OVERLAY_CAP, Progress, ReceivingPoint, Solution, form_factor,
+    hover_lift, hover_lifts, on_line_distance,
 };
 use rayon::prelude::*;
 use serde::Serialize;
@@ -259,16 +260,16 @@ pub fn refine_by_error(
     let report = refiner.report(scene, tolerance, mean, reason, triangles_before);
     mesh.measured_direct = vec![Vec::new(); mesh.surfaces.len()];
     for s in refiner.surfaces {
-        // Vertices on a hovering face's contact line are lifted off it by the solvers; they
-        // measure those surfaces themselves.
-        if mesh.hovering[s.id].is_empty() {
-            mesh.measured_direct[s.id] = s
-                .vertex
-                .iter()
-                .zip(&s.irradiance)
-                .map(|(v, &h)| v.is_finite().then_some(h))
-                .collect();
-        }
+        let m = s.mesh.mesh();
+        // The solvers lift a vertex on a hovering face's contact line by less where its edges
+        // are short; they measure those vertices themselves.
+        let lifts = hover_lifts(scene, m, &s.hovering);
+        mesh.measured_direct[s.id] = (s.vertex.iter().zip(&s.irradiance).enumerate())
+            .map(|(v, (x, &h))| {
+                let lifted = lifts[v] == hover_lift(&s.hovering, m.points3[v], refiner.on_line);
+                (x.is_finite() && lifted).then_some(h)
+            })
+            .collect();
         mesh.surfaces[s.id] = s.mesh.into_mesh();
     }
     mesh.refinable = Vec::new();
@@ -311,6 +312,9 @@ struct Refined {
     weight: f64,
     /// Bumped when a triangle changes, so that its old queue entries are passed over.
     version: Vec<u32>,
+    /// The contact lines of faces hovering over it (ends and gap): points on them are
+    /// evaluated a few gaps off them ([`hover_lift`]), as the solvers evaluate its vertices.
+    hovering: Vec<(DVec3, DVec3, f64)>,
 }
 
 /// A point to evaluate, on a surface being refined.
@@ -350,6 +354,8 @@ impl PartialOrd for Entry {
 
 struct Refiner<'a> {
     direct: &'a DirectLight<'a>,
+    /// Within this distance, a point lies on a hovering face's contact line.
+    on_line: f64,
     /// No triangle smaller than this (in the scene's units) is split.
     smallest: f64,
     surfaces: Vec<Refined>,
@@ -386,12 +392,14 @@ impl<'a> Refiner<'a> {
                     done: false,
                     weight: 1.0,
                     version: vec![0; n],
+                    hovering: mesh.hovering[m.surface].clone(),
                     mesh: BisectionMesh::new(m.clone()),
                 }
             })
             .collect();
         Refiner {
             direct,
+            on_line: on_line_distance(scene),
             smallest: 0.0,
             surfaces,
             queue: BinaryHeap::new(),
@@ -575,7 +583,7 @@ impl<'a> Refiner<'a> {
             .par_iter()
             .map(|&(i, c)| {
                 let s = &self.surfaces[i];
-                self.direct.irradiance(&s.point(c), s.id)
+                self.direct.irradiance(&s.point(c, self.on_line), s.id)
             })
             .collect();
         self.evaluations += checks.len();
@@ -733,14 +741,18 @@ impl Refined {
         }
     }
 
-    /// Where check `c` is, approached from the side it belongs to.
-    fn point(&self, c: Check) -> ReceivingPoint {
+    /// Where check `c` is, approached from the side it belongs to (and lifted off a hovering
+    /// face's contact line towards that side).
+    fn point(&self, c: Check, on_line: f64) -> ReceivingPoint {
         let m = self.mesh();
         let normal = m.frame.normal;
-        let towards = |p: DVec3, q: DVec3| ReceivingPoint {
-            point: p,
-            normal,
-            inward: (q - p).normalize_or_zero(),
+        let towards = |p: DVec3, q: DVec3| {
+            let inward = (q - p).normalize_or_zero();
+            ReceivingPoint {
+                point: p + inward * hover_lift(&self.hovering, p, on_line),
+                normal,
+                inward,
+            }
         };
         match c {
             Check::Vertex(v, centroid) => towards(m.points3[v as usize], centroid),

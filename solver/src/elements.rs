@@ -85,12 +85,11 @@ impl Discretization {
         let mut receiver_surface = Vec::new();
         let mut elements = Vec::new();
         let mut patches = Vec::new();
-        let lift_limit = 1e-9 * scene.diagonal();
         for m in &mesh.surfaces {
             let offset = receivers.len();
             offsets.push(offset);
             let normal = m.frame.normal;
-            let lifts = hover_lifts(m, &mesh.hovering[m.surface], lift_limit);
+            let lifts = hover_lifts(scene, m, &mesh.hovering[m.surface]);
             for ((p, inward), lift) in m.points3.iter().zip(m.interior_directions()).zip(lifts) {
                 receivers.push(ReceivingPoint {
                     point: *p + inward * lift,
@@ -309,15 +308,35 @@ impl Discretization {
 /// How many gaps off a hovering face's contact line its vertices are evaluated: the face's blur
 /// fades over a few gaps (to under 0.3 % of the light at 10 for light from all directions), so the
 /// value there stands for the element, where the value right at the line would not.
-pub(crate) const HOVER_LIFT: f64 = 10.0;
+pub const HOVER_LIFT: f64 = 10.0;
 
-/// Per vertex of `m`, how far to move it into its own triangles before evaluating it: a
-/// [`HOVER_LIFT`] of gaps for vertices on the contact line of a hovering face, at most a quarter
-/// of its shortest edge; zero elsewhere.
-fn hover_lifts(
+/// Points closer than this fraction of the scene's diagonal to a hovering face's contact line lie
+/// on it.
+const ON_LINE: f64 = 1e-9;
+
+/// The distance within which a point of `scene` lies on a hovering face's contact line.
+pub fn on_line_distance(scene: &Scene) -> f64 {
+    ON_LINE * scene.diagonal()
+}
+
+/// How far a point `p` of a surface whose hovering faces cast `lines` (ends and gap) is to move
+/// into the surface before it is evaluated: [`HOVER_LIFT`] times the largest gap of the lines it
+/// lies on (within `on_line`, [`on_line_distance`]), or zero.
+pub fn hover_lift(lines: &[(DVec3, DVec3, f64)], p: DVec3, on_line: f64) -> f64 {
+    let gap = lines
+        .iter()
+        .filter(|&&(a, b, _)| p.distance(closest_point_on_segment(p, a, b)) <= on_line)
+        .map(|l| l.2)
+        .fold(0.0, f64::max);
+    HOVER_LIFT * gap
+}
+
+/// Per vertex of `m`, how far to move it into its own triangles before evaluating it: its
+/// [`hover_lift`], at most a quarter of its shortest edge.
+pub fn hover_lifts(
+    scene: &Scene,
     m: &penumbra_meshing::SurfaceMesh,
     lines: &[(DVec3, DVec3, f64)],
-    tol: f64,
 ) -> Vec<f64> {
     let mut lifts = vec![0.0; m.vertex_count()];
     if lines.is_empty() {
@@ -332,14 +351,11 @@ fn hover_lifts(
             shortest[b] = shortest[b].min(length);
         }
     }
+    let on_line = on_line_distance(scene);
     for (v, p) in m.points3.iter().enumerate() {
-        let gap = lines
-            .iter()
-            .filter(|&&(a, b, _)| p.distance(closest_point_on_segment(*p, a, b)) <= tol)
-            .map(|l| l.2)
-            .fold(0.0, f64::max);
-        if gap > 0.0 && shortest[v].is_finite() {
-            lifts[v] = (HOVER_LIFT * gap).min(0.25 * shortest[v]);
+        let lift = hover_lift(lines, *p, on_line);
+        if lift > 0.0 && shortest[v].is_finite() {
+            lifts[v] = lift.min(0.25 * shortest[v]);
         }
     }
     lifts

@@ -5,6 +5,12 @@
 //! (a light panel hung just below a ceiling), casts a shadow that is sharp from every direction
 //! light comes from: under it the receiver sees almost nothing. Its outline, projected onto the
 //! receiver, counts as a contact line too.
+//!
+//! So does the foot of a face that stands on a receiver only to a file's rounding (within
+//! `Visibility::meeting_distance`): a pillar of a model written to six decimals stands up to
+//! that far above or below its floor. Standing above, its foot is a hovering line with that gap,
+//! whose vertices are evaluated a few gaps off it: right at the line, the side under the pillar
+//! would see the light through the gap.
 
 use glam::DVec3;
 use penumbra_scenes::{Bounds, PlaneFrame, Scene, SurfaceId, Visibility};
@@ -42,6 +48,9 @@ fn receiver_contacts(
     visibility: &Visibility,
 ) -> Vec<ContactLine> {
     let tol = visibility.contact_distance();
+    // Files rounded to six decimals stand a pillar up to this far above or below the floor it
+    // stands on: its foot casts a contact line too, with the gap it stands above the floor.
+    let meeting = visibility.meeting_distance();
     let receiver = &scene.surfaces[r];
     let mut candidates = std::collections::BTreeSet::new();
     // Grown by the largest gap a face of the receiver's size may hover at.
@@ -86,10 +95,20 @@ fn receiver_contacts(
             }
             continue;
         }
-        for (p, q) in plane_section(poly, &h) {
+        let standing: Vec<f64> = h
+            .iter()
+            .map(|&x| if x.abs() <= meeting { 0.0 } else { x })
+            .collect();
+        // A face reaching no further up than that stands on nothing.
+        if !standing.iter().any(|&x| x > 0.0) {
+            continue;
+        }
+        for (p, q, gap) in plane_section(poly, &standing, &h) {
+            // Onto the plane: a foot standing near it stands that far off it.
+            let (p, q) = (p - rf.normal * rf.height(p), q - rf.normal * rf.height(q));
             for [a, c] in clip_to_polygon(&rf, &receiver.polygon, p, q) {
                 if a.distance(c) > tol {
-                    lines.push((a, c, 0.0));
+                    lines.push((a, c, gap));
                 }
             }
         }
@@ -118,15 +137,17 @@ fn hovering(poly: &[DVec3], h: &[f64], tol: f64) -> Option<f64> {
 }
 
 /// Where a planar polygon meets a plane, given its vertices' heights above it (zero: on it):
-/// its edges lying in the plane, and the segments where it crosses the plane.
-fn plane_section(poly: &[DVec3], h: &[f64]) -> Vec<(DVec3, DVec3)> {
+/// its edges lying in the plane, each with the gap it stands above the plane (from `raw`, the
+/// heights before those near it were taken as on it), and the segments where it crosses the
+/// plane (no gap).
+fn plane_section(poly: &[DVec3], h: &[f64], raw: &[f64]) -> Vec<(DVec3, DVec3, f64)> {
     let n = poly.len();
     let mut out = Vec::new();
     // Edges in the plane.
     for i in 0..n {
         let j = (i + 1) % n;
         if h[i] == 0.0 && h[j] == 0.0 {
-            out.push((poly[i], poly[j]));
+            out.push((poly[i], poly[j], raw[i].max(raw[j]).max(0.0)));
         }
     }
     // Crossings: points where an edge passes from one side to the other, paired in order along
@@ -148,7 +169,7 @@ fn plane_section(poly: &[DVec3], h: &[f64]) -> Vec<(DVec3, DVec3)> {
         let dir = crossings[1] - crossings[0];
         crossings.sort_by(|a, b| dir.dot(*a).total_cmp(&dir.dot(*b)));
         for pair in crossings.chunks_exact(2) {
-            out.push((pair[0], pair[1]));
+            out.push((pair[0], pair[1], 0.0));
         }
     }
     out

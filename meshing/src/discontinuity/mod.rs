@@ -301,7 +301,9 @@ pub struct Discontinuities {
     pub segments: Vec<Vec<DiscontinuitySegment>>,
     /// Per surface, the contact lines cast by faces hovering over it (3D ends and the gap under
     /// the face): values at these lines are taken a few gaps off them. A face hovers when it
-    /// is parallel to the receiver and closer than a thousandth of its own size.
+    /// is parallel to the receiver and closer than a thousandth of its own size, or when its
+    /// foot stands above the receiver by no more than a file's rounding
+    /// (`Visibility::meeting_distance`).
     pub hovering: Vec<Vec<(DVec3, DVec3, f64)>>,
     /// What the search did.
     pub stats: DiscontinuityStats,
