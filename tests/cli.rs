@@ -322,7 +322,8 @@ fn adaptive_refinement_is_reported() {
     }
 }
 
-/// `penumbra sweep` runs the three default methods per budget and writes a row for each, in CSV and JSON;
+/// `penumbra sweep` runs the three default methods per budget and writes a row for each, in CSV and JSON,
+/// and each sample's values in `samples.csv`;
 /// without `--direct-only` it says what is missing and exits 2.
 #[test]
 fn sweep_writes_a_row_per_method_and_budget() {
@@ -346,6 +347,29 @@ fn sweep_writes_a_row_per_method_and_budget() {
     let sweep = json(&out.join("sweep.json"));
     let rows = sweep["rows"].as_array().expect("rows");
     assert_eq!(rows.len(), 6);
+    // Each sample with its reference and every run's value there, whose errors give the rows'.
+    let samples = std::fs::read_to_string(out.join("samples.csv")).expect("samples.csv");
+    let lines: Vec<Vec<f64>> = samples
+        .lines()
+        .skip(1)
+        .map(|l| {
+            l.split(',')
+                .skip(4)
+                .map(|v| v.parse().expect("a number"))
+                .collect()
+        })
+        .collect();
+    assert_eq!(lines.len(), 400);
+    let mean = lines.iter().map(|l| l[0]).sum::<f64>() / 400.0;
+    for (k, r) in rows.iter().enumerate() {
+        let sum2: f64 = lines.iter().map(|l| (l[k + 1] - l[0]).powi(2)).sum();
+        let rms = (sum2 / 400.0).sqrt() / mean;
+        let want = r["rms"].as_f64().expect("rms");
+        assert!(
+            (rms - want).abs() <= 1e-5 * want,
+            "row {k}: {rms} from samples.csv, {want}"
+        );
+    }
     for r in rows {
         let rms = r["rms"].as_f64().expect("rms");
         assert!(rms.is_finite() && rms >= 0.0 && rms <= r["max"].as_f64().expect("max"));

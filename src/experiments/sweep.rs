@@ -265,6 +265,10 @@ pub struct SweepRow {
     pub penumbra_rms: f64,
     /// The sample with the largest error, to see where a method fails.
     pub worst: Option<WorstSample>,
+    /// The run's radiosity (channel mean) at each sample, interpolated on its mesh
+    /// (`samples.csv`).
+    #[serde(skip)]
+    pub values: Vec<f64>,
 }
 
 /// Where a run's error is largest.
@@ -303,6 +307,9 @@ pub struct Sweep {
     pub reference_mean: f64,
     /// Every run, budget by budget, method by method within a budget.
     pub rows: Vec<SweepRow>,
+    /// Each sample's surface (by name), point and reference value (`samples.csv`).
+    #[serde(skip)]
+    pub points: Vec<(String, DVec3, f64)>,
 }
 
 /// A sample point on a surface, with the exact direct radiosity there (channel mean) and whether
@@ -461,6 +468,7 @@ pub fn sweep(
             max: score.max / scale,
             penumbra_rms: (score.penumbra_sum2 / score.penumbra_count.max(1) as f64).sqrt() / scale,
             worst: score.worst,
+            values: score.values,
         });
         progress.set(rows.len() as u64);
     }
@@ -478,11 +486,15 @@ pub fn sweep(
         penumbra_samples: samples.iter().filter(|s| s.penumbra).count(),
         reference_mean: mean,
         rows,
+        points: (samples.iter().zip(&values))
+            .map(|(s, &v)| (scene.surfaces[s.surface].name.clone(), s.point, v))
+            .collect(),
     })
 }
 
 /// A run's errors at the samples, in W/m² (channel mean).
 struct Score {
+    values: Vec<f64>,
     sum2: f64,
     max: f64,
     penumbra_sum2: f64,
@@ -499,6 +511,7 @@ impl Score {
         values: &[f64],
     ) -> Score {
         let mut score = Score {
+            values: Vec::with_capacity(samples.len()),
             sum2: 0.0,
             max: 0.0,
             penumbra_sum2: 0.0,
@@ -520,6 +533,7 @@ impl Score {
                 )
                 .mean();
             let e = value - reference;
+            score.values.push(value);
             score.sum2 += e * e;
             if e.abs() > score.max {
                 score.max = e.abs();
@@ -651,6 +665,42 @@ pub fn sweep_charts(sweep: &Sweep) -> Vec<(&'static str, LogLogChart)> {
             },
         ),
     ]
+}
+
+/// Each sample as CSV, a line each: its surface, point and reference value, then each run's
+/// interpolated value (a column per row of `sweep.csv`, named method/solver/budget), to see
+/// where a run's error lies.
+pub fn samples_csv(sweep: &Sweep) -> String {
+    let mut out = String::from("surface,x,y,z,reference");
+    for r in &sweep.rows {
+        let budget = r.photons.map_or(r.max_elements, |p| p);
+        out += &format!(",{}/{}/{budget}", r.method, r.solver);
+    }
+    out.push('\n');
+    for (k, (surface, p, reference)) in sweep.points.iter().enumerate() {
+        out += &format!(
+            "{},{},{},{},{:e}",
+            csv_field(surface),
+            p.x,
+            p.y,
+            p.z,
+            reference
+        );
+        for r in &sweep.rows {
+            out += &format!(",{:e}", r.values.get(k).copied().unwrap_or(f64::NAN));
+        }
+        out.push('\n');
+    }
+    out
+}
+
+/// A CSV field: quoted when it holds a comma or a quote.
+fn csv_field(text: &str) -> String {
+    if text.contains([',', '"']) {
+        format!("\"{}\"", text.replace('"', "\"\""))
+    } else {
+        text.to_string()
+    }
 }
 
 /// The sweep as CSV, a row per run.

@@ -209,11 +209,13 @@ fn scored_surfaces(scene: &Scene, names: &[String]) -> Result<Vec<SurfaceId>, Fa
     Ok(surfaces)
 }
 
-/// Writes `sweep.csv`, `sweep.json` and the charts (SVG and PNG) to `out`.
+/// Writes `sweep.csv`, `samples.csv`, `sweep.json` and the charts (SVG and PNG) to `out`.
 fn write_sweep(out: &Path, result: &Sweep) -> Result<(), Failure> {
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     let csv = penumbra::experiments::sweep::sweep_csv(result);
     penumbra::outputs::write_atomic(&out.join("sweep.csv"), csv.as_bytes())?;
+    let samples = penumbra::experiments::sweep::samples_csv(result);
+    penumbra::outputs::write_atomic(&out.join("samples.csv"), samples.as_bytes())?;
     let json = serde_json::to_string_pretty(result)?;
     penumbra::outputs::write_atomic(&out.join("sweep.json"), json.as_bytes())?;
     for (stem, chart) in penumbra::experiments::sweep::sweep_charts(result) {
@@ -256,7 +258,7 @@ fn print_sweep(result: &Sweep, out: &Path) {
         );
     }
     println!(
-        "wrote sweep.csv, sweep.json and the charts error-vs-elements and error-vs-time (SVG, PNG) to {}",
+        "wrote sweep.csv, samples.csv, sweep.json and the charts error-vs-elements and error-vs-time (SVG, PNG) to {}",
         out.display()
     );
 }
