@@ -67,8 +67,8 @@ enum Command {
     /// SVGs of the surfaces worth looking at (--svg).
     Run(Box<RunArgs>),
     /// Run uniform, uniform + adaptive, discontinuity and discontinuity + adaptive meshes over a
-    /// ladder of element budgets and score each against a reference; write sweep.csv and
-    /// sweep.json.
+    /// ladder of element budgets and score each against a reference; write sweep.csv,
+    /// sweep.json and samples.csv.
     Sweep(Box<SweepArgs>),
     /// Measure every form-factor method (analytic, Monte Carlo, hemicube) against closed forms:
     /// error against cost, point by point, the hemicube's aliasing, the 1 x 2 x 3 box's face
