@@ -263,7 +263,7 @@ pub fn refine_by_error(
         let m = s.mesh.mesh();
         // The solvers lift a vertex on a hovering face's contact line by less where its edges
         // are short; they measure those vertices themselves.
-        let lifts = hover_lifts(scene, m, &s.hovering);
+        let lifts = hover_lifts(m, &s.hovering, refiner.on_line);
         mesh.measured_direct[s.id] = (s.vertex.iter().zip(&s.irradiance).enumerate())
             .map(|(v, (x, &h))| {
                 let lifted = lifts[v] == hover_lift(&s.hovering, m.points3[v], refiner.on_line);

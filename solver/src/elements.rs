@@ -85,11 +85,12 @@ impl Discretization {
         let mut receiver_surface = Vec::new();
         let mut elements = Vec::new();
         let mut patches = Vec::new();
+        let on_line = on_line_distance(scene);
         for m in &mesh.surfaces {
             let offset = receivers.len();
             offsets.push(offset);
             let normal = m.frame.normal;
-            let lifts = hover_lifts(scene, m, &mesh.hovering[m.surface]);
+            let lifts = hover_lifts(m, &mesh.hovering[m.surface], on_line);
             for ((p, inward), lift) in m.points3.iter().zip(m.interior_directions()).zip(lifts) {
                 receivers.push(ReceivingPoint {
                     point: *p + inward * lift,
@@ -308,7 +309,7 @@ impl Discretization {
 /// How many gaps off a hovering face's contact line its vertices are evaluated: the face's blur
 /// fades over a few gaps (to under 0.3 % of the light at 10 for light from all directions), so the
 /// value there stands for the element, where the value right at the line would not.
-pub const HOVER_LIFT: f64 = 10.0;
+pub(crate) const HOVER_LIFT: f64 = 10.0;
 
 /// Points closer than this fraction of the scene's diagonal to a hovering face's contact line lie
 /// on it.
@@ -334,9 +335,9 @@ pub fn hover_lift(lines: &[(DVec3, DVec3, f64)], p: DVec3, on_line: f64) -> f64 
 /// Per vertex of `m`, how far to move it into its own triangles before evaluating it: its
 /// [`hover_lift`], at most a quarter of its shortest edge.
 pub fn hover_lifts(
-    scene: &Scene,
     m: &penumbra_meshing::SurfaceMesh,
     lines: &[(DVec3, DVec3, f64)],
+    on_line: f64,
 ) -> Vec<f64> {
     let mut lifts = vec![0.0; m.vertex_count()];
     if lines.is_empty() {
@@ -351,7 +352,6 @@ pub fn hover_lifts(
             shortest[b] = shortest[b].min(length);
         }
     }
-    let on_line = on_line_distance(scene);
     for (v, p) in m.points3.iter().enumerate() {
         let lift = hover_lift(lines, *p, on_line);
         if lift > 0.0 && shortest[v].is_finite() {

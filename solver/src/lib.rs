@@ -116,9 +116,7 @@ mod solution;
 
 pub use direct::{DirectLight, SEQUENTIAL_SHADOWS};
 pub use direct_pass::{OVERLAY_CAP, SHARED_POINT};
-pub use elements::{
-    Discretization, Element, HOVER_LIFT, Patch, hover_lift, hover_lifts, on_line_distance,
-};
+pub use elements::{Discretization, Element, Patch, hover_lift, hover_lifts, on_line_distance};
 pub use error::SolveError;
 pub use gathering::{PatchSystem, SolverMethod, SystemSolution, solve_gathering};
 pub use hierarchical::solve_hierarchical;

@@ -271,6 +271,17 @@ pub struct SweepRow {
     pub values: Vec<f64>,
 }
 
+impl SweepRow {
+    /// The run's budget as a table names it: triangles, or for photon-map runs photons and
+    /// final-gather rays (`500000ph/64r`).
+    pub fn budget(&self) -> String {
+        match (self.photons, self.final_gather) {
+            (Some(p), Some(rays)) => format!("{p}ph/{rays}r"),
+            _ => self.max_elements.to_string(),
+        }
+    }
+}
+
 /// Where a run's error is largest.
 #[derive(Clone, Debug, Serialize)]
 pub struct WorstSample {
@@ -673,8 +684,7 @@ pub fn sweep_charts(sweep: &Sweep) -> Vec<(&'static str, LogLogChart)> {
 pub fn samples_csv(sweep: &Sweep) -> String {
     let mut out = String::from("surface,x,y,z,reference");
     for r in &sweep.rows {
-        let budget = r.photons.map_or(r.max_elements, |p| p);
-        out += &format!(",{}/{}/{budget}", r.method, r.solver);
+        out += &format!(",{}/{}/{}", r.method, r.solver, r.budget());
     }
     out.push('\n');
     for (k, (surface, p, reference)) in sweep.points.iter().enumerate() {

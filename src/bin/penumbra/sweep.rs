@@ -241,10 +241,7 @@ fn print_sweep(result: &Sweep, out: &Path) {
         "method", "solver", "budget", "triangles", "seconds", "rms", "max", "penumbra rms"
     );
     for r in &result.rows {
-        let budget = match (r.photons, r.final_gather) {
-            (Some(p), Some(rays)) => format!("{p}ph/{rays}r"),
-            _ => r.max_elements.to_string(),
-        };
+        let budget = r.budget();
         println!(
             "{:<24} {:<13} {:>16} {:>9} {:>9.3} {:>9.4}% {:>9.3}% {:>11.4}%",
             r.method,
