@@ -25,7 +25,9 @@ use std::time::Instant;
 
 use glam::DVec3;
 use penumbra_meshing::{BisectionMesh, SceneMesh, Split, SurfaceMesh};
-use penumbra_scenes::{AreaSampler, Rgb, Scene, SplitMix64, Surface, SurfaceId, Visibility};
+use penumbra_scenes::{
+    AreaSampler, Rgb, Scene, SceneTriangle, SplitMix64, Surface, SurfaceId, Visibility,
+};
 use penumbra_solver::{
     DirectLight, Interrupt, OVERLAY_CAP, Progress, ReceivingPoint, Solution, form_factor,
     hover_lift, hover_lifts, on_line_distance,
@@ -84,8 +86,9 @@ const MEAN_SEED: u64 = 0x6d65_616e;
 /// two of the split itself.
 const SPLIT_MARGIN: usize = 32;
 
-/// Why error-driven refinement stopped (`mesh_error.stop` in `report.json`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, serde::Deserialize)]
+/// Why error-driven refinement stopped (`mesh_error.stop` in `report.json`), from the most
+/// ordinary to the least (shards joined report the least ordinary).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ErrorStop {
     /// Every refined surface's estimated RMS error is within the tolerance.
@@ -151,6 +154,9 @@ pub struct MeshErrorReport {
     pub rms: f64,
     /// The share of the reflecting surfaces' area in triangles never measured.
     pub unmeasured_area: f64,
+    /// The area of the measured triangles, m² (what `rms` is weighted over).
+    #[serde(default)]
+    pub measured_area: f64,
     /// The largest check point error, relative to `mean_reflected`.
     pub max: f64,
     /// Each refined surface, in the scene's order.
@@ -187,6 +193,35 @@ impl MeshErrorReport {
             (squared, reflected, area) = (squared + s2, reflected + sum, area + e.area);
         }
         self.reflected_rms = (reflected > 0.0).then(|| (squared * area).sqrt() / reflected);
+    }
+
+    /// The reports of shards that each refined their own surfaces alone (with the scene's
+    /// reflecting `area`, m²), joined: counts summed, errors weighted by measured area,
+    /// surfaces in shard order (the scene's).
+    pub fn join(shards: &[&MeshErrorReport], area: f64) -> Option<MeshErrorReport> {
+        let first = shards.first()?;
+        let measured: f64 = shards.iter().map(|r| r.measured_area).sum();
+        let squared: f64 = shards.iter().map(|r| r.rms.powi(2) * r.measured_area).sum();
+        Some(MeshErrorReport {
+            stop: shards.iter().map(|r| r.stop).max().unwrap_or(first.stop),
+            triangles_before: shards.iter().map(|r| r.triangles_before).sum(),
+            triangles: shards.iter().map(|r| r.triangles).sum(),
+            evaluations: shards.iter().map(|r| r.evaluations).sum(),
+            rms: if measured > 0.0 {
+                (squared / measured).sqrt()
+            } else {
+                0.0
+            },
+            unmeasured_area: if area > 0.0 {
+                1.0 - measured / area
+            } else {
+                0.0
+            },
+            measured_area: measured,
+            max: shards.iter().map(|r| r.max).fold(0.0, f64::max),
+            surfaces: shards.iter().flat_map(|r| r.surfaces.clone()).collect(),
+            ..(*first).clone()
+        })
     }
 
     /// The surfaces left above the tolerance: where the budget or the time ran out first.
@@ -239,7 +274,7 @@ pub fn refine_by_error(
     if let Some(reason) = stop.now() {
         return refiner.report(scene, tolerance, 0.0, reason, triangles_before);
     }
-    let mean = refiner.sampled_mean();
+    let mean = refiner.sampled_mean(scene, visibility);
     refiner.start(scene, budget, tolerance, mean);
     progress.start("refining by error", budget as u64);
     let reason = loop {
@@ -408,39 +443,47 @@ impl<'a> Refiner<'a> {
         }
     }
 
-    /// The mean reflected direct light over the reflecting surfaces, sampled at seeded points
-    /// spread by area.
-    fn sampled_mean(&mut self) -> f64 {
-        let triangles: Vec<(usize, usize)> = (self.surfaces.iter().enumerate())
-            .flat_map(|(i, s)| (0..s.mesh().triangle_count()).map(move |t| (i, t)))
+    /// The mean reflected direct light over the scene's reflecting surfaces, sampled at seeded
+    /// points spread by area over their polygons (not the mesh: a shard that meshes its own
+    /// surfaces alone samples the same points as the run not split).
+    fn sampled_mean(&mut self, scene: &Scene, visibility: &Visibility) -> f64 {
+        let reflects = |s: SurfaceId| scene.surfaces[s].reflectance.mean() > 0.0;
+        let triangles: Vec<&SceneTriangle> = (visibility.triangles().iter())
+            .filter(|t| reflects(t.surface))
             .collect();
-        let sampler = AreaSampler::new(
-            triangles
-                .iter()
-                .map(|&(i, t)| self.surfaces[i].mesh().triangle_area(t)),
-        );
+        let sampler = AreaSampler::new(triangles.iter().map(|t| {
+            let [a, b, c] = t.vertices;
+            (b - a).cross(c - a).length() / 2.0
+        }));
         let mut rng = SplitMix64::keyed(MEAN_SEED, &[]);
-        let points: Vec<(usize, ReceivingPoint)> = (0..MEAN_SAMPLES)
+        let points: Vec<(SurfaceId, ReceivingPoint)> = (0..MEAN_SAMPLES)
             .map_while(|_| {
                 let (k, w) = sampler.pick(&mut rng)?;
-                let (i, t) = triangles[k];
-                let m = self.surfaces[i].mesh();
-                let corners = m.triangle_points3(t);
-                let p: DVec3 = (0..3).map(|j| corners[j] * w[j]).sum();
-                Some((i, ReceivingPoint::interior(p, m.frame.normal)))
+                let t = triangles[k];
+                let p: DVec3 = (0..3).map(|j| t.vertices[j] * w[j]).sum();
+                let normal = scene.surfaces[t.surface].normal();
+                Some((t.surface, ReceivingPoint::interior(p, normal)))
             })
             .collect();
         let values: Vec<f64> = points
             .par_iter()
-            .map(|(i, x)| self.surfaces[*i].value(self.direct.irradiance(x, self.surfaces[*i].id)))
+            .map(|(s, x)| {
+                let h = self.direct.irradiance(x, *s);
+                scene.surfaces[*s].reflectance.mul_rgb(h).mean()
+            })
             .collect();
         self.evaluations += values.len();
+        let refined: HashMap<SurfaceId, usize> = (self.surfaces.iter().enumerate())
+            .map(|(i, s)| (s.id, i))
+            .collect();
         let (mut sum, mut count) = (0.0, 0usize);
-        for (&(i, _), v) in points.iter().zip(values) {
+        for (&(surface, _), v) in points.iter().zip(values) {
             if v.is_finite() {
-                let s = &mut self.surfaces[i];
-                s.samples.0 += v;
-                s.samples.1 += 1;
+                if let Some(&i) = refined.get(&surface) {
+                    let s = &mut self.surfaces[i];
+                    s.samples.0 += v;
+                    s.samples.1 += 1;
+                }
                 sum += v;
                 count += 1;
             }
@@ -633,6 +676,7 @@ impl<'a> Refiner<'a> {
             } else {
                 0.0
             },
+            measured_area: measured,
             max: relative(max),
             surfaces,
             reflected_rms: None,

@@ -255,7 +255,12 @@ impl<'a> Stages<'a> {
         let t = Instant::now();
         self.progress.start("meshing", 1);
         let mut mesh = self.first_mesh(visibility, found, plan)?;
-        let budget = plan.final_budget(self.options, &mesh, self.scene.surfaces.len())?;
+        let (scene, options) = (self.scene, self.options);
+        // A shard meshing its own surfaces alone gets their part of the budget.
+        let share = (options.shard)
+            .filter(|_| crate::options::meshed_alone(scene, options))
+            .map(|shard| shard.cost_share(scene, options));
+        let budget = plan.final_budget(options, &mesh, scene.surfaces.len(), share)?;
         self.progress.finish();
         let mesh_error = self
             .options

@@ -2,27 +2,34 @@
 //! scheduler (a Slurm job array, GNU parallel), then joined.
 //!
 //! Shard `I` of `N` (`0 <= I < N`) lights the `I`-th of `N` runs of consecutive surfaces of
-//! about equal estimated cost ([`Shard::surfaces`]), so that each surface's mesh and values are
-//! those of the run not split, to the bit:
+//! about equal estimated cost ([`Shard::surfaces`]):
 //!
 //! - a large scene (its polygons alone need more triangles than the fitted budget's floor;
-//!   [`meshed_alone`]) meshed by discontinuities (`--mesh discontinuity`): the shard finds the discontinuities of its own surfaces and meshes them
-//!   alone, since each surface's share of the budget depends on nothing but the surface and the
-//!   scene's polygons; the other surfaces get empty meshes;
-//! - otherwise (an error-driven mesh, the default, a budget chosen with `--max-elements`, or a
-//!   scene within the floor) the budget is spread over all surfaces, and each one's share depends
-//!   on every surface (an error-driven mesh splits the worst triangles of the whole scene first),
-//!   so every shard finds the discontinuities of the whole scene and meshes every surface, and
-//!   splits only the direct light at the vertices it did not measure while meshing;
+//!   [`meshed_alone`]): the shard finds the discontinuities of its own surfaces and meshes them
+//!   alone, the other surfaces get empty meshes. Meshed by discontinuities
+//!   (`--mesh discontinuity`), each surface's share of the budget depends on nothing but the
+//!   surface and the scene's polygons, so its mesh and values are those of the run not split,
+//!   to the bit. Error-driven (the default), the shard refines its own surfaces from their
+//!   least mesh with its part (by estimated cost) of the fit's extra triangles, spent where
+//!   its own surfaces' measured error is largest (the run not split spends the same budget
+//!   where the whole scene's is), against the same scene mean; one shard is the run not split,
+//!   more give a mesh of their own;
+//! - otherwise (a budget chosen with `--max-elements`, or a scene within the floor) the budget
+//!   is spread over all surfaces, and each one's share depends on every surface (an
+//!   error-driven mesh splits the worst triangles of the whole scene first), so every shard
+//!   finds the discontinuities of the whole scene and meshes every surface, and splits only the
+//!   direct light at the vertices it did not measure while meshing: the joined result is the
+//!   run not split, to the bit;
 //! - the direct light at a vertex is the same whichever other surfaces have a vertex at its
 //!   point: the faces meeting there share one view of the light, taken from the point they round
 //!   to ([`penumbra_solver::DirectLight::irradiance_group`]).
 //!
 //! Each shard writes [`SHARD_FILE`] (its surfaces' part of `solution.json`, its report and a
 //! fingerprint of the scene and the options) and the SVGs of its surfaces; [`merge`] checks
-//! that the shards belong to one run, that none is missing or twice, and joins them into the
-//! `solution.json` the run would have written, byte for byte, with the report's figures of the
-//! discontinuities and the mesh summed over the shards that meshed alone.
+//! that the shards belong to one run, that none is missing or twice, and joins them into one
+//! `solution.json` (the run not split would have written the same bytes, but for error-driven
+//! shards that meshed alone), with the report's figures of the discontinuities and the mesh
+//! joined over the shards that meshed alone.
 //!
 //! A full solution cannot be split this way: light bounces between all surfaces, so every
 //! surface's radiosity depends on every other's. Adaptive refinement spends one budget over the
@@ -36,6 +43,7 @@ use penumbra_scenes::{LoadedScene, PlaneFrame, Rgb, Scene, SceneError, SurfaceId
 use serde::{Deserialize, Serialize};
 
 use crate::energy::EnergyBalance;
+use crate::error_mesh::MeshErrorReport;
 use crate::export::{ExportFormat, ExportSource, export};
 use crate::fingerprint::hex;
 pub use crate::fingerprint::scene_fingerprint;
@@ -44,7 +52,7 @@ use crate::outputs::{
     DEFAULT_SVG_SURFACES, SVG_DIR, Staging, SurfaceSolution, SvgSelection, solution_json_of,
     surface_solution, svg_name, worth_looking_at,
 };
-use crate::report::{Report, ShardPart, ShardsSummary};
+use crate::report::{Report, ShardPart, ShardsSummary, mesh_error_warning};
 use crate::run_result::{RunResult, StageTimes};
 
 /// The file a shard writes into its output directory.
@@ -510,12 +518,13 @@ pub fn merge(
     }
     let mut report = first.report.clone();
     let meshed_alone = first.meshed_alone;
+    let mut warnings = first.warnings.clone();
     if meshed_alone {
         let reports: Vec<&Report> = shards.iter().map(|(_, f)| &f.report).collect();
         sum_mesh_figures(&mut report, &reports);
+        join_mesh_errors(&mut report, &mut warnings, &reports, &loaded.scene);
     }
     let (width, height) = (first.render_width, first.render_height);
-    let warnings = first.warnings.clone();
     let count = first.shard.count;
     let scene = &loaded.scene;
     let emitted = report.solver.emitted;
@@ -663,6 +672,31 @@ fn sum_mesh_figures(report: &mut Report, shards: &[&Report]) {
     }
 }
 
+/// The error-driven refinement of shards that each refined their own surfaces, joined into
+/// `report`, and the warning of surfaces left above the tolerance made again from all of them.
+fn join_mesh_errors(
+    report: &mut Report,
+    warnings: &mut Vec<String>,
+    shards: &[&Report],
+    scene: &Scene,
+) {
+    let parts: Vec<&MeshErrorReport> = shards
+        .iter()
+        .filter_map(|r| r.mesh_error.as_ref())
+        .collect();
+    let area = (scene.surfaces.iter())
+        .filter(|s| s.reflectance.mean() > 0.0)
+        .map(|s| s.area())
+        .sum();
+    let Some(joined) = MeshErrorReport::join(&parts, area) else {
+        return;
+    };
+    let first = report.mesh_error.as_ref().and_then(mesh_error_warning);
+    warnings.retain(|w| Some(w) != first.as_ref());
+    warnings.extend(mesh_error_warning(&joined));
+    report.mesh_error = Some(joined);
+}
+
 /// Each number field of the object `sum` made the sum of that field over `all` (the largest
 /// for fields named `..._max`): counts stay integers.
 fn sum_numbers(sum: &mut serde_json::Value, all: &[serde_json::Value]) {
@@ -772,6 +806,20 @@ pub fn write_merged(merged: &Merged, dir: &Path) -> anyhow::Result<Vec<PathBuf>>
 mod tests {
     use super::*;
     use crate::options::RunOptions;
+
+    /// A mesh with a triangle of no area has an infinite largest aspect ratio, which JSON
+    /// writes `null`: a shard's report holding one reads back (Sponza's and Crytek's do).
+    #[test]
+    fn an_infinite_aspect_ratio_reads_back() {
+        let quality = penumbra_meshing::MeshQuality {
+            aspect_ratio_max: f64::INFINITY,
+            ..Default::default()
+        };
+        let text = serde_json::to_string(&quality).expect("writes");
+        assert!(text.contains("\"aspect_ratio_max\":null"), "{text}");
+        let back: penumbra_meshing::MeshQuality = serde_json::from_str(&text).expect("reads");
+        assert_eq!(back.aspect_ratio_max, f64::INFINITY);
+    }
 
     #[test]
     fn shards_are_parsed_and_checked() {

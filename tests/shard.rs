@@ -1,5 +1,6 @@
 //! Sharded runs (`run --shard I/N`) joined by `penumbra merge` give the run not split, byte for
-//! byte; mixed, missing and duplicate shards are refused.
+//! byte, unless an error-driven mesh of a large scene is refined by each shard alone; mixed,
+//! missing and duplicate shards are refused.
 
 use std::path::{Path, PathBuf};
 
@@ -163,6 +164,117 @@ fn shards_merge_into_the_run_not_split_byte_for_byte() {
             assert!((fraction(&report) - fraction(&whole_report)).abs() < 1e-12);
         }
     }
+}
+
+/// An error-driven mesh of a large scene with the fitted budget: each shard refines its own
+/// surfaces alone, from their least mesh, with its part (by estimated cost) of the fit's extra
+/// triangles.
+/// One shard is the run not split, byte for byte. More spend the same budget in all, each on
+/// its own surfaces (where the run not split spends it where the whole scene's error is
+/// largest), against the same scene mean.
+#[test]
+fn error_driven_shards_of_a_large_scene_refine_alone() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scene = "boxworld-1000";
+    let whole = dir.path().join("whole");
+    run(scene, &whole, &["--fit"]);
+    let whole_report = json(&whole.join("report.json"));
+    let one = shards(scene, &dir.path().join("one"), 1, &["--fit"]);
+    let out = dir.path().join("one-merged");
+    assert!(merge(&one, &out).status.success());
+    assert!(
+        std::fs::read(out.join("solution.json")).expect("merged")
+            == std::fs::read(whole.join("solution.json")).expect("whole")
+    );
+    let dirs = shards(scene, &dir.path().join("three"), 3, &["--fit"]);
+    let mut triangles = 0;
+    for d in &dirs {
+        let shard = json(&d.join("shard.json"));
+        assert_eq!(shard["meshed_alone"], true, "{}", d.display());
+        triangles += shard["report"]["mesh_error"]["triangles"]
+            .as_u64()
+            .expect("a count");
+    }
+    let out = dir.path().join("merged");
+    let o = merge(&dirs, &out);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let report = json(&out.join("report.json"));
+    let at = |r: &serde_json::Value, p: &str| r.pointer(p).cloned().expect(p);
+    assert_eq!(
+        at(&report, "/mesh_error/mean_reflected"),
+        at(&whole_report, "/mesh_error/mean_reflected")
+    );
+    // The budget, shared out (each part rounded).
+    let budget = |r: &serde_json::Value| at(r, "/method/max_elements").as_i64().expect("a count");
+    assert!((budget(&report) - budget(&whole_report)).abs() <= 3);
+    let refined = |r: &serde_json::Value| at(r, "/mesh_error/surfaces").as_array().map(Vec::len);
+    assert!(refined(&report) > Some(0));
+    assert_eq!(at(&report, "/mesh_error/triangles"), triangles);
+    assert_eq!(at(&report, "/counts/triangles"), triangles);
+    assert!(triangles as i64 <= budget(&report));
+    // Where both meshes have a point, its direct light agrees to 1e-9 of the brightest (on a
+    // contact line, both sides' values): the mesh may measure a vertex that the direct light
+    // pass lights in the other run, which rounds differently.
+    let whole_solution = json(&whole.join("solution.json"));
+    let merged_solution = json(&out.join("solution.json"));
+    let (shared, same) = same_light_at_shared_points(&whole_solution, &merged_solution, 1e-9);
+    assert!(shared > 1000, "{shared} points shared");
+    assert_eq!(same, shared);
+    // The light's energy accounted for as in the run not split.
+    let fraction = |r: &serde_json::Value| at(r, "/energy/escaped_fraction").as_f64();
+    let (split, not_split) = (fraction(&report), fraction(&whole_report));
+    assert!((split.expect("a number") - not_split.expect("a number")).abs() < 0.01);
+}
+
+/// Of the points (by their coordinates' bits) where both solutions have vertices on the same
+/// surface: how many, and at how many both give the same direct light values, each channel
+/// within `tolerance` of the brightest value of either.
+fn same_light_at_shared_points(
+    a: &serde_json::Value,
+    b: &serde_json::Value,
+    tolerance: f64,
+) -> (usize, usize) {
+    type Values = std::collections::BTreeMap<Vec<u64>, Vec<Vec<f64>>>;
+    let list = |v: &serde_json::Value| v.as_array().cloned().unwrap_or_default();
+    let numbers = |v: &serde_json::Value| -> Vec<f64> {
+        list(v)
+            .iter()
+            .filter_map(serde_json::Value::as_f64)
+            .collect()
+    };
+    let by_point = |s: &serde_json::Value| {
+        let mut at = Values::new();
+        for (p, d) in list(&s["vertices"]).iter().zip(list(&s["direct"])) {
+            let point = numbers(p).into_iter().map(f64::to_bits).collect();
+            at.entry(point).or_default().push(numbers(&d));
+        }
+        at.values_mut()
+            .for_each(|v| v.sort_by(|x, y| x.partial_cmp(y).expect("finite")));
+        at
+    };
+    let surfaces = |s: &serde_json::Value| list(&s["surfaces"]);
+    let brightest = [a, b]
+        .iter()
+        .flat_map(|s| surfaces(s))
+        .flat_map(|s| list(&s["direct"]))
+        .flat_map(|d| numbers(&d))
+        .fold(0.0, f64::max);
+    let close = |x: &Vec<Vec<f64>>, y: &Vec<Vec<f64>>| {
+        x.len() == y.len()
+            && (x.iter().flatten().zip(y.iter().flatten()))
+                .all(|(u, v)| (u - v).abs() <= tolerance * brightest)
+    };
+    let (mut shared, mut same) = (0, 0);
+    for (x, y) in surfaces(a).iter().zip(&surfaces(b)) {
+        let (x, y) = (by_point(x), by_point(y));
+        for (point, values) in &x {
+            if let Some(other) = y.get(point) {
+                shared += 1;
+                same += usize::from(close(values, other));
+            }
+        }
+    }
+    (shared, same)
 }
 
 /// More shards than surfaces: some shards light nothing, and the merge is still the whole run.

@@ -114,6 +114,20 @@ impl ElementBudget {
         }
     }
 
+    /// The triangles of some of a large scene's surfaces meshed alone (a shard): their least
+    /// mesh (`minimum`) and `share` of the fit's triangles per surface over all the scene's
+    /// `surfaces`, so that parts whose shares add up to one add up to the scene's fit; `None`
+    /// for a cap.
+    pub fn part(self, minimum: usize, surfaces: usize, share: f64) -> Option<usize> {
+        match self {
+            ElementBudget::Fit { per_surface, .. } => {
+                let extra = per_surface.saturating_mul(surfaces) as f64 * share.clamp(0.0, 1.0);
+                Some(minimum.saturating_add(extra.round() as usize))
+            }
+            ElementBudget::AtMost(_) => None,
+        }
+    }
+
     /// The cap, if the caller chose one.
     pub fn at_most(self) -> Option<usize> {
         match self {
@@ -176,6 +190,19 @@ mod tests {
             Some(3 * FIT_TRIANGLES_PER_SURFACE)
         );
         assert_eq!(ElementBudget::AtMost(10).shared_extra(999, 3), None);
+        // Parts of a large scene meshed alone: each its least mesh and its share of the extra,
+        // without the floor; shares adding up to one add up to the scene's fit.
+        let fit = ElementBudget::Fit {
+            at_least: 1000,
+            per_surface: 2,
+        };
+        let parts: usize = [(700, 0.25), (500, 0.5), (300, 0.25)]
+            .iter()
+            .filter_map(|&(minimum, share)| fit.part(minimum, 1000, share))
+            .sum();
+        assert_eq!(Some(parts), fit.resolve(1500, 1000).ok());
+        assert_eq!(fit.part(10, 1000, 0.0), Some(10));
+        assert_eq!(ElementBudget::AtMost(5000).part(10, 1000, 0.5), None);
         let square = penumbra_scenes::builtin::textbook();
         // Three quadrilaterals: two triangles each.
         assert_eq!(polygon_minimum(&square), 6);

@@ -27,8 +27,16 @@ pub struct MeshQuality {
     pub aspect_ratio_median: f64,
     /// The 95th percentile of the aspect ratios.
     pub aspect_ratio_p95: f64,
-    /// The largest aspect ratio.
+    /// The largest aspect ratio: infinite where a triangle has no area (written `null`, as JSON
+    /// has no infinity, and read back so).
+    #[serde(deserialize_with = "infinite_if_null")]
     pub aspect_ratio_max: f64,
+}
+
+/// A number, or `null` for the infinity it was written from.
+fn infinite_if_null<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    let value: Option<f64> = serde::Deserialize::deserialize(d)?;
+    Ok(value.unwrap_or(f64::INFINITY))
 }
 
 impl SurfaceMesh {

@@ -1,7 +1,7 @@
 //! Shards: a scene's surfaces split into runs of consecutive surfaces of about equal cost, each
 //! lit by a process of its own ([`crate::shard`] writes and joins them).
 
-use penumbra_meshing::polygon_minimum;
+use penumbra_meshing::{ElementBudget, polygon_minimum};
 use penumbra_scenes::Scene;
 use serde::{Deserialize, Serialize};
 
@@ -99,6 +99,18 @@ impl Shard {
         self.surfaces(&surface_costs(scene, options))
     }
 
+    /// This shard's part of the estimated cost of a run of `options` on `scene`: about one
+    /// shard's worth, as the runs of surfaces are balanced by it.
+    pub fn cost_share(self, scene: &Scene, options: &RunOptions) -> f64 {
+        let costs = surface_costs(scene, options);
+        let total: f64 = costs.iter().sum();
+        let own: f64 = (costs.iter().zip(self.surfaces(&costs)))
+            .filter(|(_, own)| *own)
+            .map(|(c, _)| c)
+            .sum();
+        if total > 0.0 { own / total } else { 0.0 }
+    }
+
     /// Refuses options whose results cannot be split by surface.
     pub fn check(self, options: &RunOptions) -> Result<(), ShardError> {
         Shard::new(self.index, self.count)?;
@@ -117,13 +129,11 @@ impl Shard {
 
 /// Whether a shard of a run with these options finds the discontinuities of its own surfaces and
 /// meshes them alone: a fitted budget of a scene whose polygons need more than the budget's
-/// floor ([`penumbra_meshing::ElementBudget::shared_extra`]) gives each surface a share that
-/// depends on nothing else, unless the mesh is error-driven. Otherwise each shard meshes the
-/// whole scene, as the run not split does.
+/// floor ([`penumbra_meshing::ElementBudget::shared_extra`]) gives each surface its least mesh
+/// and a share that depends on nothing else (an error-driven mesh spends the shard's surfaces'
+/// share on them alone). Otherwise each shard meshes the whole scene, as the run not split does.
 pub fn meshed_alone(scene: &Scene, options: &RunOptions) -> bool {
-    // An error-driven mesh spends one budget over all surfaces through one queue.
     options.refine.is_none()
-        && !options.error_driven()
         && options
             .max_elements
             .shared_extra(polygon_minimum(scene), scene.surfaces.len())
@@ -136,31 +146,37 @@ impl std::fmt::Display for Shard {
     }
 }
 
-/// Each surface's estimated share of a shard's work, the vertices whose direct light it
-/// evaluates: about the triangles meshing will give the surface (its share of the planned
-/// budget by area, or its polygon's own triangles when that is more). An error-driven mesh
-/// (which every shard makes whole) measures the light at the vertices of the surfaces it
-/// refines while it is made, so what is left to split is mostly the small faces that keep
-/// their polygon's own triangles: there a surface costs those. The same for every shard of a
-/// run, from the scene and the options alone.
+/// Each surface's estimated share of a shard's work, the points where it evaluates the direct
+/// light: about the triangles meshing will give the surface. Spread by area, that is its share
+/// of the planned budget, or its polygon's own triangles when that is more. An error-driven mesh
+/// gives each surface its own triangles and a fitted budget's triangles per surface, spent where
+/// the measured error is largest, which nothing tells before; a surface's search for
+/// discontinuities and its lines' triangles grow with its size, here as the square root of its
+/// area in typical elements (on the Crytek Sponza the search's time per surface grew about so,
+/// summed over a shard). The same for every shard of a run, from the scene and the options
+/// alone.
 pub fn surface_costs(scene: &Scene, options: &RunOptions) -> Vec<f64> {
     // A cap below the polygons' needs is refused before any shard runs.
     let planned = options
         .planned_elements(scene)
         .unwrap_or_else(|_| polygon_minimum(scene)) as f64;
     let area = scene.total_area();
-    let spread = !options.error_driven() && area > 0.0;
+    let per_surface = match options.max_elements {
+        ElementBudget::Fit { per_surface, .. } => per_surface as f64,
+        ElementBudget::AtMost(_) => 0.0,
+    };
     scene
         .surfaces
         .iter()
         .map(|s| {
             let own = s.polygon.len().saturating_sub(2).max(1) as f64;
-            let share = if spread {
-                planned * s.area() / area
+            if options.error_driven() {
+                own + per_surface + (planned * s.area() / area.max(f64::MIN_POSITIVE)).sqrt()
+            } else if area > 0.0 {
+                own.max(planned * s.area() / area)
             } else {
-                0.0
-            };
-            own.max(share)
+                own
+            }
         })
         .collect()
 }
@@ -221,7 +237,8 @@ mod tests {
     }
 
     /// The costs follow the triangles meshing spreads: about the planned budget in all, each
-    /// surface at least its polygon's own triangles (only those, for an error-driven mesh).
+    /// surface at least its polygon's own triangles; an error-driven mesh's, its own, the fit's
+    /// triangles per surface and its size in typical elements.
     #[test]
     fn costs_follow_the_planned_triangles() {
         let scene = penumbra_scenes::load_scene("cornell")
@@ -241,10 +258,12 @@ mod tests {
         for (s, cost) in scene.surfaces.iter().zip(&costs) {
             assert!(*cost >= (s.polygon.len() - 2) as f64);
         }
-        // An error-driven mesh leaves each surface its own triangles to split.
         let error_driven = surface_costs(&scene, &RunOptions::default());
+        let area = scene.total_area();
         for (s, cost) in scene.surfaces.iter().zip(&error_driven) {
-            assert_eq!(*cost, (s.polygon.len() - 2) as f64);
+            let per_surface = penumbra_meshing::FIT_TRIANGLES_PER_SURFACE as f64;
+            let size = (planned * s.area() / area).sqrt();
+            assert_eq!(*cost, (s.polygon.len() - 2) as f64 + per_surface + size);
         }
     }
 }

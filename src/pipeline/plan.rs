@@ -105,21 +105,29 @@ impl Plan {
     }
 
     /// The whole run's budget, resolved now that the first mesh and the scene's least mesh
-    /// are known: the mesh's own, or what refinement may grow it to.
+    /// are known: the mesh's own, or what refinement may grow it to. A shard meshing some of a
+    /// large scene's surfaces alone, `share` of the run's estimated cost, fits the budget to
+    /// them ([`ElementBudget::part`]).
     pub(crate) fn final_budget(
         &self,
         options: &RunOptions,
         mesh: &SceneMesh,
         surfaces: usize,
+        share: Option<f64>,
     ) -> Result<usize, RunError> {
         if options.refine.is_none() && !options.error_driven() {
             return Ok(mesh.budget);
         }
-        let resolved = options.max_elements.resolve_for(
-            mesh.minimum_triangles,
-            surfaces,
-            mesh.discontinuity_stats.is_some(),
-        )?;
+        let part = share
+            .and_then(|share| (options.max_elements).part(mesh.minimum_triangles, surfaces, share));
+        let resolved = match part {
+            Some(part) => part,
+            None => options.max_elements.resolve_for(
+                mesh.minimum_triangles,
+                surfaces,
+                mesh.discontinuity_stats.is_some(),
+            )?,
+        };
         Ok(resolved.max(mesh.triangle_count()))
     }
 }

@@ -77,9 +77,9 @@ enum Command {
     /// Write a finished run's solution for other tools: solution.vtp (ParaView), .ply
     /// (MeshLab), .glb (glTF), .obj + .mtl, and index.html (a page to explore it in a browser).
     Export(ExportArgs),
-    /// Join the outputs of the shards of a run (`run --shard I/N`) into one: solution.json as
-    /// the run not split would have written it, report.json with the shards' figures joined,
-    /// render.png and the shards' SVGs.
+    /// Join the outputs of the shards of a run (`run --shard I/N`) into one: solution.json (the
+    /// run not split's, unless the shards refined their own meshes), report.json with the
+    /// shards' figures joined, render.png and the shards' SVGs.
     Merge(MergeArgs),
     /// List the built-in scenes, or print one as JSON to start a scene of your own from.
     #[command(

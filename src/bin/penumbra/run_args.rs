@@ -332,8 +332,9 @@ pub(crate) struct RunArgs {
     /// consecutive surfaces of about equal estimated cost (the triangles each surface is
     /// expected to have to light), and write OUT/shard.json and their SVGs for `penumbra merge`. In a
     /// scene whose polygons need more than the budget's floor, with the fitted budget, the shard
-    /// also finds the discontinuities of its own surfaces and meshes them alone; otherwise it
-    /// meshes the whole scene (each surface's share of the budget depends on all of them).
+    /// also finds the discontinuities of its own surfaces and meshes them alone (an error-driven
+    /// mesh spends their share of the budget on them); otherwise it meshes the whole scene
+    /// (each surface's share of the budget depends on all of them).
     #[arg(help_heading = LIMITS, long, value_name = "I/N")]
     pub(crate) shard: Option<String>,
 }
