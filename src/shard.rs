@@ -52,7 +52,9 @@ use crate::outputs::{
     DEFAULT_SVG_SURFACES, SVG_DIR, Staging, SurfaceSolution, SvgSelection, solution_json_of,
     surface_solution, svg_name, worth_looking_at,
 };
-use crate::report::{Report, ShardPart, ShardsSummary, mesh_error_warning};
+use crate::report::{
+    Report, ShardPart, ShardsSummary, estimated_direct_warning, mesh_error_warning,
+};
 use crate::run_result::{RunResult, StageTimes};
 
 /// The file a shard writes into its output directory.
@@ -437,6 +439,10 @@ struct LightSums {
     ambient: Rgb,
     residual: f64,
     times: StageTimes,
+    /// Vertices lit, and of those estimated by rays (and for being beyond the overlay's cap).
+    receivers: usize,
+    estimated: usize,
+    beyond_cap: usize,
 }
 
 impl LightSums {
@@ -449,6 +455,9 @@ impl LightSums {
         self.ambient += report.render.ambient;
         self.residual += solver.residual;
         self.times += &report.times_seconds;
+        self.receivers += solver.receivers;
+        self.estimated += solver.direct_estimated;
+        self.beyond_cap += solver.direct_beyond_cap;
     }
 }
 
@@ -549,7 +558,19 @@ pub fn merge(
     if meshed_alone {
         report.mesh_quality = quality_of(&mesh.surfaces);
     }
+    let first_estimate = estimated_direct_warning(&report.solver);
+    warnings.retain(|w| Some(w) != first_estimate.as_ref());
     join_light(&mut report, &parts, warnings, render.exposure);
+    let solver = &mut report.solver;
+    (solver.direct_estimated, solver.direct_beyond_cap) =
+        (parts.light.estimated, parts.light.beyond_cap);
+    if meshed_alone {
+        // Each shard lit only its own surfaces' vertices.
+        solver.receivers = parts.light.receivers;
+    }
+    report
+        .warnings
+        .extend(estimated_direct_warning(&report.solver));
     report.svgs.written = parts.svgs.iter().map(|(_, name)| name.clone()).collect();
     report.times_seconds = parts.light.times.clone();
     report.times_seconds.merge = Some(started.elapsed().as_secs_f64());
