@@ -21,7 +21,7 @@ use penumbra_viz::Render;
 
 use crate::error_mesh::{MeshErrorReport, StopWhen, refine_by_error};
 use crate::memory::{self, MemoryEstimate};
-use crate::options::{MeshMethod, RunOptions};
+use crate::options::{MeshMethod, RunOptions, Shard};
 pub use crate::run_error::RunError;
 pub use crate::run_result::{
     Kept, MemoryReport, RunResult, Stage, StagePeaks, StageTimes, Stopped,
@@ -235,12 +235,14 @@ impl<'a> Stages<'a> {
         Some(found)
     }
 
+    /// The shard of a large scene this run is, if it meshes its own surfaces alone.
+    fn shard_alone(&self) -> Option<Shard> {
+        (self.options.shard).filter(|_| crate::options::meshed_alone(self.scene, self.options))
+    }
+
     /// The surfaces a shard of a large scene meshes alone, if it does.
     fn shard_surfaces(&self) -> Option<Vec<bool>> {
-        self.options
-            .shard
-            .filter(|_| crate::options::meshed_alone(self.scene, self.options))
-            .map(|shard| shard.surfaces_of(self.scene, self.options))
+        (self.shard_alone()).map(|shard| shard.surfaces_of(self.scene, self.options))
     }
 
     /// The mesh stage: the first mesh, then, for error-driven meshes, refinement where the
@@ -257,9 +259,7 @@ impl<'a> Stages<'a> {
         let mut mesh = self.first_mesh(visibility, found, plan)?;
         let (scene, options) = (self.scene, self.options);
         // A shard meshing its own surfaces alone gets their part of the budget.
-        let share = (options.shard)
-            .filter(|_| crate::options::meshed_alone(scene, options))
-            .map(|shard| shard.cost_share(scene, options));
+        let share = (self.shard_alone()).map(|shard| shard.cost_share(scene, options));
         let budget = plan.final_budget(options, &mesh, scene.surfaces.len(), share)?;
         self.progress.finish();
         let mesh_error = self

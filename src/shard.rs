@@ -559,8 +559,6 @@ pub fn merge(
         report.mesh_quality = quality_of(&mesh.surfaces);
     }
     let first_estimate = estimated_direct_warning(&report.solver);
-    warnings.retain(|w| Some(w) != first_estimate.as_ref());
-    join_light(&mut report, &parts, warnings, render.exposure);
     let solver = &mut report.solver;
     (solver.direct_estimated, solver.direct_beyond_cap) =
         (parts.light.estimated, parts.light.beyond_cap);
@@ -568,9 +566,9 @@ pub fn merge(
         // Each shard lit only its own surfaces' vertices.
         solver.receivers = parts.light.receivers;
     }
-    report
-        .warnings
-        .extend(estimated_direct_warning(&report.solver));
+    let joined_estimate = estimated_direct_warning(&report.solver);
+    replace_warning(&mut warnings, first_estimate.as_deref(), joined_estimate);
+    join_light(&mut report, &parts, warnings, render.exposure);
     report.svgs.written = parts.svgs.iter().map(|(_, name)| name.clone()).collect();
     report.times_seconds = parts.light.times.clone();
     report.times_seconds.merge = Some(started.elapsed().as_secs_f64());
@@ -713,9 +711,14 @@ fn join_mesh_errors(
         return;
     };
     let first = report.mesh_error.as_ref().and_then(mesh_error_warning);
-    warnings.retain(|w| Some(w) != first.as_ref());
-    warnings.extend(mesh_error_warning(&joined));
+    replace_warning(warnings, first.as_deref(), mesh_error_warning(&joined));
     report.mesh_error = Some(joined);
+}
+
+/// The first shard's warning `first` (if it gave one) replaced by the joined shards' `joined`.
+fn replace_warning(warnings: &mut Vec<String>, first: Option<&str>, joined: Option<String>) {
+    warnings.retain(|w| Some(w.as_str()) != first);
+    warnings.extend(joined);
 }
 
 /// Each number field of the object `sum` made the sum of that field over `all` (the largest

@@ -168,9 +168,8 @@ fn shards_merge_into_the_run_not_split_byte_for_byte() {
 
 /// An error-driven mesh of a large scene with the fitted budget: each shard refines its own
 /// surfaces alone, from their least mesh, with its part (by estimated cost) of the fit's extra
-/// triangles.
-/// One shard is the run not split, byte for byte. More spend the same budget in all, each on
-/// its own surfaces (where the run not split spends it where the whole scene's error is
+/// triangles. One shard is the run not split, byte for byte. More spend the same budget in all,
+/// each on its own surfaces (where the run not split spends it where the whole scene's error is
 /// largest), against the same scene mean.
 #[test]
 fn error_driven_shards_of_a_large_scene_refine_alone() {
