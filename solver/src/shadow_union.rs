@@ -24,12 +24,12 @@
 
 use std::time::Instant;
 
-use clipper2_rust::{ClipType, Clipper64, FillRule, Path64, Paths64, Point64, PolyTree64};
 use glam::DVec2;
 
 use crate::clip::{bounds_2d, clip_to_box, convex_hull_2d};
 pub(crate) use crate::sheet_outline::CornerKey;
 use crate::sheet_outline::{Loops, SheetEdge, outlines};
+use penumbra_overlay::{Engine, Path64, Point64, PolyTree64};
 use penumbra_scenes::polygon::signed_area_2d;
 
 /// Shadows go into one overlay until they have this many edges; the next batch is subtracted
@@ -289,7 +289,7 @@ fn doubled_area(path: &Path64) -> (f64, f64) {
 }
 
 thread_local! {
-    static CLIPPER: std::cell::RefCell<Clipper64> = std::cell::RefCell::new(Clipper64::new());
+    static CLIPPER: std::cell::RefCell<Engine> = std::cell::RefCell::new(Engine::new());
 }
 
 /// The overlay's coordinates span up to this many integer steps (the largest power of two of a
@@ -318,21 +318,10 @@ impl Grid {
         subject: &[&Vec<DVec2>],
         contours: &[Vec<DVec2>],
     ) -> Option<Vec<VisibleShape>> {
-        let subject: Paths64 = subject.iter().map(|c| self.path(c)).collect();
-        let clip: Paths64 = contours.iter().map(|c| self.path(c)).collect();
-        let mut tree = PolyTree64::new();
-        // One engine per thread, cleared between uses: it keeps its arenas' memory.
-        CLIPPER.with_borrow_mut(|clipper| {
-            clipper.clear();
-            clipper.add_subject(&subject);
-            clipper.add_clip(&clip);
-            clipper.execute_tree(
-                ClipType::Difference,
-                FillRule::NonZero,
-                &mut tree,
-                &mut Paths64::new(),
-            );
-        });
+        let subject: Vec<Path64> = subject.iter().map(|c| self.path(c)).collect();
+        let clip: Vec<Path64> = contours.iter().map(|c| self.path(c)).collect();
+        // One engine per thread: it keeps its working memory.
+        let tree = CLIPPER.with_borrow_mut(|clipper| clipper.difference(&subject, &clip));
         self.consistent_shapes(&tree, &subject)
     }
 
@@ -341,7 +330,10 @@ impl Grid {
             .iter()
             .map(|&p| {
                 let q = ((p - self.origin) * self.scale).round();
-                Point64::new(q.x as i64, q.y as i64)
+                Point64 {
+                    x: q.x as i64,
+                    y: q.y as i64,
+                }
             })
             .collect()
     }
@@ -355,7 +347,11 @@ impl Grid {
     /// The tree's outlines (even depth below the root), each with its holes; `None` when the
     /// tree contradicts itself: an outline turned clockwise or a hole counter-clockwise by more
     /// than the rounding of its corners can turn it, or more area left than `subject` had.
-    fn consistent_shapes(&self, tree: &PolyTree64, subject: &Paths64) -> Option<Vec<VisibleShape>> {
+    fn consistent_shapes(
+        &self,
+        tree: &PolyTree64,
+        subject: &[Path64],
+    ) -> Option<Vec<VisibleShape>> {
         let (mut left, mut slack) = (0.0, 0.0);
         let mut turned = |path: &Path64, outline: bool| {
             let (area, rounding) = doubled_area(path);
@@ -364,19 +360,19 @@ impl Grid {
             (area > 0.0) == outline || area.abs() <= rounding
         };
         let mut shapes = Vec::new();
-        let mut outlines: Vec<usize> = tree.root().children().to_vec();
+        let mut outlines: Vec<usize> = tree.root().children.clone();
         while let Some(outline) = outlines.pop() {
             let node = &tree.nodes[outline];
-            if !turned(node.polygon(), true) {
+            if !turned(&node.polygon, true) {
                 return None;
             }
-            let mut shape = vec![self.contour(node.polygon())];
-            for &hole in node.children() {
-                if !turned(tree.nodes[hole].polygon(), false) {
+            let mut shape = vec![self.contour(&node.polygon)];
+            for &hole in &node.children {
+                if !turned(&tree.nodes[hole].polygon, false) {
                     return None;
                 }
-                shape.push(self.contour(tree.nodes[hole].polygon()));
-                outlines.extend_from_slice(tree.nodes[hole].children());
+                shape.push(self.contour(&tree.nodes[hole].polygon));
+                outlines.extend_from_slice(&tree.nodes[hole].children);
             }
             shapes.push(shape);
         }
