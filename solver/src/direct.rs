@@ -918,7 +918,7 @@ impl<'a> DirectLight<'a> {
         }
     }
 
-    /// The faces (sorted) and outline sheets of the occluder tree in the shaft with these sides,
+    /// The faces (in the tree's order) and outline sheets of the occluder tree in the shaft with these sides,
     /// less the receiver's own faces, the emitter's, and faces of closed solids turned away.
     fn reached(
         &self,
@@ -946,7 +946,6 @@ impl<'a> DirectLight<'a> {
                 Reached::Outline { sheet, reversed } => outlines.push((sheet, reversed)),
             },
         );
-        candidates.sort_unstable();
         candidates.retain(|&index| {
             let occ = &self.occluders[index];
             // A face of a closed solid turned away from x is behind another face of it.

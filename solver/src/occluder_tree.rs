@@ -14,8 +14,6 @@
 //! its facing normals and a sphere holding its corners, and for a small node the cone cannot
 //! decide, face by face; faces of a node that turns both ways are visited one by one.
 
-use std::f64::consts::PI;
-
 use glam::DVec3;
 use penumbra_scenes::polygon::newell_normal;
 
@@ -64,13 +62,14 @@ pub(crate) struct OutlineEdge {
 }
 
 /// What a node's faces look like from afar: the cone of their facing normals (every one within
-/// `deviation` of `axis`, at most `spread` radians from it), a sphere around their corners, and
+/// `deviation` of `axis`, at most an angle `spread` from it), a sphere around their corners, and
 /// their outline.
 #[derive(Debug)]
 struct Sheet {
     axis: DVec3,
     deviation: f64,
-    spread: f64,
+    /// The cosine and sine of the spread.
+    spread: (f64, f64),
     center: DVec3,
     radius: f64,
     /// The least and greatest of `axis . v` over the corners.
@@ -455,13 +454,28 @@ impl Sheet {
         if distance <= self.radius {
             return None;
         }
-        let angle = self.axis.angle_between(to_point);
-        let blur = self.spread + (self.radius / distance).asin();
-        // The least of n . (point - v) is at least (distance - radius) cos(angle + blur).
-        let least = |angle: f64| (distance - self.radius) * (angle + blur).min(PI).cos();
-        if least(angle) > margin {
+        // The least of n . (point - v) is at least (distance - radius) cos(angle + blur), the
+        // angle from the axis to the point, the blur the spread and asin(radius / distance);
+        // with sums of angles by their cosines and sines, as this runs at every node.
+        let cos_angle = (self.axis.dot(to_point) / distance).clamp(-1.0, 1.0);
+        let sin_angle = (1.0 - cos_angle * cos_angle).max(0.0).sqrt();
+        let r = self.radius / distance;
+        let (cos_spread, sin_spread) = self.spread;
+        let cos_r = (1.0 - r * r).max(0.0).sqrt();
+        let cos_blur = cos_spread * cos_r - sin_spread * r;
+        let sin_blur = sin_spread * cos_r + cos_spread * r;
+        let least = |cos_angle: f64| {
+            // Both angles lie in [0, π]: their sum reaches π where cos(blur) <= -cos(angle).
+            let cos_sum = if cos_blur <= -cos_angle {
+                -1.0
+            } else {
+                cos_angle * cos_blur - sin_angle * sin_blur
+            };
+            (distance - self.radius) * cos_sum
+        };
+        if least(cos_angle) > margin {
             Some(false)
-        } else if least(PI - angle) > margin {
+        } else if least(-cos_angle) > margin {
             Some(true)
         } else {
             None
@@ -489,6 +503,7 @@ fn sheet_of<'a>(
         return None;
     }
     let spread = 2.0 * (deviation / 2.0).min(1.0).asin();
+    let spread = (spread.cos(), spread.sin());
     let (mut min, mut max) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
     for f in faces.clone() {
         for &p in f.polygon {
@@ -625,6 +640,7 @@ fn straight_runs(outline: &[OutlineEdge]) -> Vec<OutlineEdge> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::PI;
 
     /// A welded n x n grid of unit squares at height z, each split into two triangles listed
     /// counter-clockwise from above.
