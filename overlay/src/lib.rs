@@ -12,7 +12,9 @@
 //!     [(lo, lo), (hi, lo), (hi, hi), (lo, hi)].map(|(x, y)| Point64 { x, y }).to_vec()
 //! };
 //! // A square with a square hole: one outline with one hole nested in it.
-//! let tree = Engine::new().difference(&[square(0, 10)], &[square(3, 6)]);
+//! let tree = Engine::new()
+//!     .difference(&[square(0, 10)], &[square(3, 6)])
+//!     .expect("the engine joins its contours");
 //! let outline = &tree.nodes[tree.root().children[0]];
 //! assert_eq!(outline.children.len(), 1);
 //! ```
@@ -62,15 +64,17 @@ impl Engine {
         }
     }
 
-    /// What of `subject` no path of `clip` covers (non-zero winding, each set on its own).
-    pub fn difference(&mut self, subject: &[Path64], clip: &[Path64]) -> PolyTree64 {
+    /// What of `subject` no path of `clip` covers (non-zero winding, each set on its own), or
+    /// `None` where the engine reports that it failed (it cannot join an output contour). Its
+    /// arithmetic holds for coordinates within ±2⁶¹; it does not check them.
+    pub fn difference(&mut self, subject: &[Path64], clip: &[Path64]) -> Option<PolyTree64> {
         let subject = OwnedPaths::new(subject);
         let clip = OwnedPaths::new(clip);
         let tree = OwnedTree::new();
         let open = OwnedPaths::new(&[]);
         // SAFETY: every pointer is to a live object of the library, owned here; the engine
         // copies the paths it is given.
-        unsafe {
+        let succeeded = unsafe {
             c::clipper_clipper64_clear(self.raw.as_ptr());
             c::clipper_clipper64_add_subject(self.raw.as_ptr(), subject.0.as_ptr());
             c::clipper_clipper64_add_clip(self.raw.as_ptr(), clip.0.as_ptr());
@@ -80,13 +84,17 @@ impl Engine {
                 c::ClipperFillRule_NON_ZERO,
                 tree.0.as_ptr(),
                 open.0.as_ptr(),
-            );
+            ) != 0
+        };
+        if !succeeded {
+            return None;
         }
         let mut out = PolyTree64 {
             nodes: vec![TreeNode::default()],
         };
-        copy_children(tree.0.as_ptr(), 0, &mut out);
-        out
+        // SAFETY: the tree is live and owned here until the end of this call.
+        unsafe { copy_children(tree.0.as_ptr(), 0, &mut out) };
+        Some(out)
     }
 }
 
@@ -104,24 +112,32 @@ impl Drop for Engine {
 }
 
 /// Copies the children of the library's `node` under `parent` of `out`, depth first.
-fn copy_children(node: *mut c::ClipperPolyTree64, parent: usize, out: &mut PolyTree64) {
-    // SAFETY: `node` is a live node of a tree owned by the caller.
+///
+/// # Safety
+/// `node` is a live node of a tree of the library, not freed during the call.
+unsafe fn copy_children(node: *mut c::ClipperPolyTree64, parent: usize, out: &mut PolyTree64) {
+    // SAFETY: `node` is live (the caller's promise).
     let count = unsafe { c::clipper_polytree64_count(node) };
     for i in 0..count {
         // SAFETY: `i` is below the count; the child is owned by `node` and lives as long.
         let child = unsafe { c::clipper_polytree64_get_child(node, i) }.cast_mut();
         let index = out.nodes.len();
         out.nodes.push(TreeNode {
-            polygon: polygon_of(child),
+            // SAFETY: the child lives as long as `node`.
+            polygon: unsafe { polygon_of(child) },
             children: Vec::new(),
         });
         out.nodes[parent].children.push(index);
-        copy_children(child, index, out);
+        // SAFETY: as above.
+        unsafe { copy_children(child, index, out) };
     }
 }
 
 /// The contour of a node of the library's tree.
-fn polygon_of(node: *mut c::ClipperPolyTree64) -> Path64 {
+///
+/// # Safety
+/// `node` is a live node of a tree of the library.
+unsafe fn polygon_of(node: *mut c::ClipperPolyTree64) -> Path64 {
     // SAFETY: `node` is live; the path is a copy made for this call, read within its length and
     // deleted at the end.
     unsafe {
@@ -212,14 +228,18 @@ mod tests {
     #[test]
     fn a_hole_cut_from_a_square_nests_under_it() {
         let mut engine = Engine::new();
-        let tree = engine.difference(&[square(0, 10)], &[square(3, 6)]);
+        let tree = engine
+            .difference(&[square(0, 10)], &[square(3, 6)])
+            .expect("in range");
         assert_eq!(tree.root().children.len(), 1);
         let outline = &tree.nodes[tree.root().children[0]];
         assert_eq!(doubled_area(&outline.polygon), 200);
         assert_eq!(outline.children.len(), 1);
         assert_eq!(doubled_area(&tree.nodes[outline.children[0]].polygon), -18);
         // The engine is reused: the next difference starts afresh.
-        let tree = engine.difference(&[square(0, 10)], &[square(-1, 11)]);
+        let tree = engine
+            .difference(&[square(0, 10)], &[square(-1, 11)])
+            .expect("in range");
         assert!(tree.root().children.is_empty());
     }
 }

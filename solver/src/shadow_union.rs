@@ -311,8 +311,8 @@ struct Grid {
 }
 
 impl Grid {
-    /// What of `subject` no contour covers, on this grid, if the overlay is consistent
-    /// ([`Self::consistent_shapes`]).
+    /// What of `subject` no contour covers, on this grid, if the overlay succeeds and is
+    /// consistent ([`Self::consistent_shapes`]).
     fn difference(
         &self,
         subject: &[&Vec<DVec2>],
@@ -321,7 +321,7 @@ impl Grid {
         let subject: Vec<Path64> = subject.iter().map(|c| self.path(c)).collect();
         let clip: Vec<Path64> = contours.iter().map(|c| self.path(c)).collect();
         // One engine per thread: it keeps its working memory.
-        let tree = CLIPPER.with_borrow_mut(|clipper| clipper.difference(&subject, &clip));
+        let tree = CLIPPER.with_borrow_mut(|clipper| clipper.difference(&subject, &clip))?;
         self.consistent_shapes(&tree, &subject)
     }
 
