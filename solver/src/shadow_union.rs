@@ -2,18 +2,18 @@
 //! difference instead of subtracting the shadows one by one (which splits the visible region
 //! into as many convex pieces as the shadows have edges, and costs their product).
 //!
-//! The difference is computed by Clipper2 (`clipper2-rust`) on an integer grid of up to 2⁴⁰
-//! steps across the overlay's extent: a point moves by at most 2⁻⁴⁰ of that extent, and the
-//! result's area is exact to that scale. Clipper2 stays fast where edges of different shadows
+//! The difference is computed by Clipper2's C++ engine (`penumbra-overlay`) on an integer grid of
+//! up to 2⁴⁰ steps across the overlay's extent: a point moves by at most 2⁻⁴⁰ of that extent, and
+//! the result's area is exact to that scale. Clipper2 stays fast where edges of different shadows
 //! run a few rounding steps apart (shadows of faces sharing an edge, clipped in different ways),
-//! which made an earlier engine split segments without end; but it decides the order of such
-//! edges in f64 and now and then turns part of its result inside out. Each result is checked
-//! ([`Grid::consistent_shapes`]) and, where it contradicts itself, computed again on another
-//! grid. Shadows are cut only to an axis-aligned box around the region they are subtracted
-//! from, never to the region itself: that laid their edges along its slanted sides, collinear
-//! with its own edges but for rounding, and made such failures ten times as common (one
-//! Sponza vertex in 2,000 was off, by up to 4 % of its light). Degenerate parts may come back as
-//! an outline with a reversed copy of it beside it (not inside it): consumers count each contour
+//! which made an earlier engine split segments without end; but it decides the order of such edges
+//! in f64 and now and then turns part of its result inside out, or reports that it failed. Each
+//! result is checked ([`Grid::consistent_shapes`]) and, where it contradicts itself or failed,
+//! computed again on another grid. Shadows are cut only to an axis-aligned box around the region
+//! they are subtracted from, never to the region itself: that laid their edges along its slanted
+//! sides, collinear with its own edges but for rounding, and made such failures ten times as common
+//! (one Sponza vertex in 2,000 was off, by up to 4 % of its light). Degenerate parts may come back
+//! as an outline with a reversed copy of it beside it (not inside it): consumers count each contour
 //! with the sign of its turn.
 //!
 //! Shadows of occluder faces lying wholly inside the shaft are fused before the overlay: each is
