@@ -918,8 +918,9 @@ impl<'a> DirectLight<'a> {
         }
     }
 
-    /// The faces (in the tree's order) and outline sheets of the occluder tree in the shaft with these sides,
-    /// less the receiver's own faces, the emitter's, and faces of closed solids turned away.
+    /// The faces (in the tree's order) and outline sheets of the occluder tree in the shaft with
+    /// these sides, less the receiver's own faces, the emitter's, and faces of closed solids
+    /// turned away.
     fn reached(
         &self,
         point: DVec3,
