@@ -153,6 +153,30 @@ fn the_cornell_box() {
     beats_uniform(&builtin::cornell(), 10_000);
 }
 
+/// A long thin face smaller than a few typical elements by area (a roof tile) is refined along
+/// its length: its light varies as much as a large face's. Under the light's middle and dim at
+/// both ends, a 0.02 × 3.5 triangle with its least mesh interpolates its two ends' light over
+/// its length.
+#[test]
+fn a_long_thin_face_is_refined() {
+    let tile = vec![
+        DVec3::new(-1.75, 0.49, 1.0),
+        DVec3::new(1.75, 0.5, 1.0),
+        DVec3::new(-1.75, 0.51, 1.0),
+    ];
+    let mut scene = floor_scene("tile", Vec::new());
+    scene
+        .surfaces
+        .push(Surface::new("tile", tile, Rgb::splat(0.6)));
+    // The floor's 16 m² over 2,000 triangles: the tile is 4.4 typical elements by area, and its
+    // length 26 typical edges.
+    let (_, errors) = capped_errors(&scene, MeshMethod::Auto, 2_000, &["tile"]);
+    let (rms, triangles) = errors[0];
+    eprintln!("tile: {:.3} % RMS, {triangles} triangles", 100.0 * rms);
+    assert!(triangles >= 8, "{triangles} triangles");
+    assert!(rms < 0.02, "{:.3} % RMS", 100.0 * rms);
+}
+
 /// Full solutions report the estimated interpolation error of the light reflected more than
 /// once (from its gradient's jumps), per surface and for the scene; direct-light runs report
 /// none. In the closed furnace that light is the same everywhere, and the estimate is zero; in
