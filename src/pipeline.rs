@@ -19,7 +19,7 @@ use penumbra_scenes::{LoadedScene, Rgb, Scene, Visibility};
 use penumbra_solver::{Progress, SolveError, SolverOptions, StopReason};
 use penumbra_viz::Render;
 
-use crate::error_mesh::{MeshErrorReport, StopWhen, refine_by_error};
+use crate::error_mesh::{ErrorBudget, MeshErrorReport, StopWhen, refine_by_error};
 use crate::memory::{self, MemoryEstimate};
 use crate::options::{MeshMethod, RunOptions, Shard};
 pub use crate::run_error::RunError;
@@ -262,10 +262,19 @@ impl<'a> Stages<'a> {
         let share = (self.shard_alone()).map(|shard| shard.cost_share(scene, options));
         let budget = plan.final_budget(options, &mesh, scene.surfaces.len(), share)?;
         self.progress.finish();
+        // Judged by no larger an element than the whole scene's, whatever its part of the budget.
+        let error_budget = match share {
+            Some(_) => ErrorBudget::for_shard(
+                budget,
+                scene.total_area(),
+                options.planned_elements(scene).unwrap_or(budget),
+            ),
+            None => ErrorBudget::triangles(budget),
+        };
         let mesh_error = self
             .options
             .error_driven()
-            .then(|| self.refine_by_error(visibility, &mut mesh, budget));
+            .then(|| self.refine_by_error(visibility, &mut mesh, error_budget));
         self.times.mesh = t.elapsed().as_secs_f64();
         self.peaks.mesh = memory::peak_resident_bytes();
         Ok(Meshed {
@@ -319,7 +328,7 @@ impl<'a> Stages<'a> {
         &self,
         visibility: &Visibility,
         mesh: &mut SceneMesh,
-        budget: usize,
+        budget: ErrorBudget,
     ) -> MeshErrorReport {
         let stop = StopWhen {
             deadline: self.solver.deadline,

@@ -6,7 +6,8 @@ mod common;
 
 use common::in_process::run_scene;
 use glam::DVec3;
-use penumbra::error_mesh::{DEFAULT_TOLERANCE, StopWhen, refine_by_error};
+use penumbra::error_mesh::{DEFAULT_TOLERANCE, ErrorBudget, StopWhen, refine_by_error};
+use penumbra::options::Shard;
 use penumbra::reflected_mesh::refine_reflected;
 use penumbra::{MeshMethod, RunOptions};
 use penumbra_meshing::{SceneMesh, TriangleLocator, mesh_scene_uniform};
@@ -177,6 +178,58 @@ fn a_long_thin_face_is_refined() {
     assert!(rms < 0.02, "{:.3} % RMS", 100.0 * rms);
 }
 
+/// A shard whose part of the budget (balanced by time) is small for its area judges its faces
+/// by the whole scene's typical element, as the run not split does: the tile of
+/// [`a_long_thin_face_is_refined`] is refined in the first of 32 shards, which holds the floor
+/// and the tile, though the shard's own 63 triangles over 16 m² would make the tile short of 8
+/// typical edges (judged so, it kept 1 triangle, 104 % RMS off). The other shards hold 2,000
+/// small faces under the floor, out of the light.
+#[test]
+fn a_shard_judges_its_faces_by_the_scenes_element() {
+    let tile = vec![
+        DVec3::new(-1.75, 0.49, 1.0),
+        DVec3::new(1.75, 0.5, 1.0),
+        DVec3::new(-1.75, 0.51, 1.0),
+    ];
+    let mut scene = floor_scene("tile-and-chips", Vec::new());
+    scene
+        .surfaces
+        .push(Surface::new("tile", tile, Rgb::splat(0.6)));
+    // Facing down, under the floor.
+    scene.surfaces.extend((0..2_000).map(|i| {
+        let c = DVec3::new(-1.9 + 0.0019 * f64::from(i), 0.0, -1.0);
+        let corners = [c, c + DVec3::new(0.0, 0.001, 0.0), c + DVec3::X * 0.001];
+        Surface::new(format!("chip/{i}"), corners.to_vec(), Rgb::splat(0.5))
+    }));
+    let options = RunOptions {
+        max_elements: penumbra_meshing::ElementBudget::fit(100),
+        shard: Some(Shard::new(0, 32).expect("a shard")),
+        ..capped_direct_only(MeshMethod::Auto, 0)
+    };
+    let result = run_scene(scene.clone(), options);
+    let tile = scene.surface_id("tile").expect("the tile");
+    let triangles = result.mesh.surfaces[tile].triangle_count();
+    let budget = result.mesh.triangle_count();
+    let visibility = Visibility::build(&scene);
+    let direct = DirectLight::new(&scene, &visibility);
+    let mesh = &result.mesh.surfaces[tile];
+    let e = direct_interpolation_error(
+        &scene,
+        &direct,
+        mesh,
+        &result.solution.radiosity[tile],
+        4_000,
+        11,
+    );
+    let rms = e.rms / e.mean_exact;
+    eprintln!(
+        "tile: {triangles} triangles of the shard's {budget}, {:.1} % RMS",
+        100.0 * rms
+    );
+    assert!(budget < 200, "the shard's part: {budget} triangles");
+    assert!(triangles > 1 && rms < 0.5, "{triangles} triangles, {rms}");
+}
+
 /// Full solutions report the estimated interpolation error of the light reflected more than
 /// once (from its gradient's jumps), per surface and for the scene; direct-light runs report
 /// none. In the closed furnace that light is the same everywhere, and the estimate is zero; in
@@ -271,7 +324,7 @@ fn the_reflected_light_is_refined_where_it_bends() {
         &scene,
         &visibility,
         &mut start,
-        1_200,
+        ErrorBudget::triangles(1_200),
         DEFAULT_TOLERANCE,
         &stop,
         &NoProgress,
