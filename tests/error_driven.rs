@@ -80,7 +80,17 @@ fn capped_errors(
     max_elements: usize,
     surfaces: &[&str],
 ) -> (usize, Vec<(f64, usize)>) {
-    let result = run_scene(scene.clone(), capped_direct_only(mesh, max_elements));
+    surface_errors(scene, capped_direct_only(mesh, max_elements), surfaces)
+}
+
+/// A run of `scene` with `options`: its triangles, and for each of the named surfaces its RMS
+/// error of the direct light relative to its mean, at 4,000 random points, and its triangles.
+fn surface_errors(
+    scene: &Scene,
+    options: RunOptions,
+    surfaces: &[&str],
+) -> (usize, Vec<(f64, usize)>) {
+    let result = run_scene(scene.clone(), options);
     let visibility = Visibility::build(scene);
     let direct = DirectLight::new(scene, &visibility);
     let errors = surfaces
@@ -154,21 +164,28 @@ fn the_cornell_box() {
     beats_uniform(&builtin::cornell(), 10_000);
 }
 
+/// [`floor_scene`] with a 0.02 × 3.5 triangle, `tile`, at half the light's height: under the
+/// light's middle and dim at both ends.
+fn tile_scene(name: &str) -> Scene {
+    let tile = vec![
+        DVec3::new(-1.75, 0.49, 1.0),
+        DVec3::new(1.75, 0.5, 1.0),
+        DVec3::new(-1.75, 0.51, 1.0),
+    ];
+    let mut scene = floor_scene(name, Vec::new());
+    scene
+        .surfaces
+        .push(Surface::new("tile", tile, Rgb::splat(0.6)));
+    scene
+}
+
 /// A long thin face smaller than a few typical elements by area (a roof tile) is refined along
 /// its length: its light varies as much as a large face's. Under the light's middle and dim at
 /// both ends, a 0.02 × 3.5 triangle with its least mesh interpolates its two ends' light over
 /// its length.
 #[test]
 fn a_long_thin_face_is_refined() {
-    let tile = vec![
-        DVec3::new(-1.75, 0.49, 1.0),
-        DVec3::new(1.75, 0.5, 1.0),
-        DVec3::new(-1.75, 0.51, 1.0),
-    ];
-    let mut scene = floor_scene("tile", Vec::new());
-    scene
-        .surfaces
-        .push(Surface::new("tile", tile, Rgb::splat(0.6)));
+    let scene = tile_scene("tile");
     // The floor's 16 m² over 2,000 triangles: the tile is 4.4 typical elements by area, and its
     // length 26 typical edges.
     let (_, errors) = capped_errors(&scene, MeshMethod::Auto, 2_000, &["tile"]);
@@ -186,15 +203,7 @@ fn a_long_thin_face_is_refined() {
 /// small faces under the floor, out of the light.
 #[test]
 fn a_shard_judges_its_faces_by_the_scenes_element() {
-    let tile = vec![
-        DVec3::new(-1.75, 0.49, 1.0),
-        DVec3::new(1.75, 0.5, 1.0),
-        DVec3::new(-1.75, 0.51, 1.0),
-    ];
-    let mut scene = floor_scene("tile-and-chips", Vec::new());
-    scene
-        .surfaces
-        .push(Surface::new("tile", tile, Rgb::splat(0.6)));
+    let mut scene = tile_scene("tile-and-chips");
     // Facing down, under the floor.
     scene.surfaces.extend((0..2_000).map(|i| {
         let c = DVec3::new(-1.9 + 0.0019 * f64::from(i), 0.0, -1.0);
@@ -206,22 +215,8 @@ fn a_shard_judges_its_faces_by_the_scenes_element() {
         shard: Some(Shard::new(0, 32).expect("a shard")),
         ..capped_direct_only(MeshMethod::Auto, 0)
     };
-    let result = run_scene(scene.clone(), options);
-    let tile = scene.surface_id("tile").expect("the tile");
-    let triangles = result.mesh.surfaces[tile].triangle_count();
-    let budget = result.mesh.triangle_count();
-    let visibility = Visibility::build(&scene);
-    let direct = DirectLight::new(&scene, &visibility);
-    let mesh = &result.mesh.surfaces[tile];
-    let e = direct_interpolation_error(
-        &scene,
-        &direct,
-        mesh,
-        &result.solution.radiosity[tile],
-        4_000,
-        11,
-    );
-    let rms = e.rms / e.mean_exact;
+    let (budget, errors) = surface_errors(&scene, options, &["tile"]);
+    let (rms, triangles) = errors[0];
     eprintln!(
         "tile: {triangles} triangles of the shard's {budget}, {:.1} % RMS",
         100.0 * rms
