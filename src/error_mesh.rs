@@ -259,6 +259,14 @@ impl StopWhen {
     }
 }
 
+/// Whether a face of `area` whose triangles' longest edge is `longest_edge` is refined in a mesh
+/// of typical elements of `element` area: it spans at least [`REFINED_ELEMENTS`] of them, by area
+/// or laid end to end along that edge (the side of an equilateral triangle of their area).
+pub fn refinable(area: f64, longest_edge: f64, element: f64) -> bool {
+    let typical_edge = (element * 4.0 / 3f64.sqrt()).sqrt();
+    area >= REFINED_ELEMENTS * element || longest_edge >= REFINED_ELEMENTS * typical_edge
+}
+
 /// The triangles error-driven refinement may reach, and the typical element it judges faces
 /// and triangles by: the area meshed over those triangles, or less.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -545,16 +553,13 @@ impl<'a> Refiner<'a> {
         let area: f64 = self.surfaces.iter().map(|s| s.mesh().area()).sum();
         let element = budget.element(area);
         self.smallest = SMALLEST_SHARE * element;
-        // The side of an equilateral triangle of the typical element's area.
-        let typical_edge = (element * 4.0 / 3f64.sqrt()).sqrt();
         // Once, not per triangle: a scanned statue's scene has tens of thousands of surfaces.
         let on_emitter = UNOCCLUDED_TOLERANCE * scene.diagonal();
         let emitters: Vec<&Surface> = scene.emitters().map(|(_, e)| e).collect();
         for s in self.surfaces.iter_mut() {
             // A face the budget would give only a few triangles keeps its least mesh: the
             // faces of a tessellated statue.
-            s.refined = s.mesh().area() >= REFINED_ELEMENTS * element
-                || s.longest_edge() >= REFINED_ELEMENTS * typical_edge;
+            s.refined = refinable(s.mesh().area(), s.longest_edge(), element);
             if !s.refined {
                 continue;
             }

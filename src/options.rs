@@ -15,7 +15,7 @@ use serde::Serialize;
 use crate::adaptive::RefineOptions;
 
 mod shard;
-pub use shard::{Shard, ShardError, meshed_alone, surface_costs};
+pub use shard::{Shard, ShardError, ShardPart, extra_shares, meshed_alone, surface_costs};
 
 /// How surfaces are meshed (`--mesh`; `method.mesh_requested` in `report.json`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, serde::Deserialize)]

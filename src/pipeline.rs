@@ -21,7 +21,7 @@ use penumbra_viz::Render;
 
 use crate::error_mesh::{ErrorBudget, MeshErrorReport, StopWhen, refine_by_error};
 use crate::memory::{self, MemoryEstimate};
-use crate::options::{MeshMethod, RunOptions, Shard};
+use crate::options::{MeshMethod, RunOptions, ShardPart};
 pub use crate::run_error::RunError;
 pub use crate::run_result::{
     Kept, MemoryReport, RunResult, Stage, StagePeaks, StageTimes, Stopped,
@@ -64,6 +64,7 @@ pub fn run(
         lit => lit?,
     };
     let render = stages.render(&lit)?;
+    let shard_surfaces = stages.shard_part.take().map(|part| part.surfaces);
     let figures = stages.figures();
     // Abandoned meshing may hold the scene a moment longer.
     let scene = Arc::try_unwrap(scene).unwrap_or_else(|shared| Scene::clone(&shared));
@@ -72,7 +73,9 @@ pub fn run(
         source,
         warnings,
     };
-    Ok(assemble(loaded, options, lit, render, &plan, figures))
+    let mut result = assemble(loaded, options, lit, render, &plan, figures);
+    result.shard_surfaces = shard_surfaces;
+    Ok(result)
 }
 
 /// Whether `error` is the interrupt, before a solution existed.
@@ -107,6 +110,8 @@ struct Stages<'a> {
     stage_started: Instant,
     times: StageTimes,
     peaks: StagePeaks,
+    /// The shard this run is, if it is one: its surfaces and part of the budget, settled once.
+    shard_part: Option<ShardPart>,
 }
 
 impl<'a> Stages<'a> {
@@ -139,6 +144,7 @@ impl<'a> Stages<'a> {
             stage_started: started,
             times: StageTimes::default(),
             peaks: StagePeaks::default(),
+            shard_part: options.shard.map(|shard| shard.part(scene, options)),
         })
     }
 
@@ -235,14 +241,15 @@ impl<'a> Stages<'a> {
         Some(found)
     }
 
-    /// The shard of a large scene this run is, if it meshes its own surfaces alone.
-    fn shard_alone(&self) -> Option<Shard> {
-        (self.options.shard).filter(|_| crate::options::meshed_alone(self.scene, self.options))
+    /// The part of a large scene this run is, if it is a shard meshing its own surfaces alone.
+    fn shard_alone(&self) -> Option<&ShardPart> {
+        (self.shard_part.as_ref())
+            .filter(|_| crate::options::meshed_alone(self.scene, self.options))
     }
 
     /// The surfaces a shard of a large scene meshes alone, if it does.
     fn shard_surfaces(&self) -> Option<Vec<bool>> {
-        (self.shard_alone()).map(|shard| shard.surfaces_of(self.scene, self.options))
+        (self.shard_alone()).map(|part| part.surfaces.clone())
     }
 
     /// The mesh stage: the first mesh, then, for error-driven meshes, refinement where the
@@ -259,7 +266,7 @@ impl<'a> Stages<'a> {
         let mut mesh = self.first_mesh(visibility, found, plan)?;
         let (scene, options) = (self.scene, self.options);
         // A shard meshing its own surfaces alone gets their part of the budget.
-        let share = (self.shard_alone()).map(|shard| shard.cost_share(scene, options));
+        let share = (self.shard_alone()).map(|part| part.budget_share);
         let budget = plan.final_budget(options, &mesh, scene.surfaces.len(), share)?;
         self.progress.finish();
         // Judged by no larger an element than the whole scene's, whatever its part of the budget.
@@ -480,5 +487,6 @@ fn assemble(
         },
         stopped: lit.stopped,
         invocation: None,
+        shard_surfaces: None,
     }
 }

@@ -174,9 +174,19 @@ pub struct RunResult {
     /// The command line that asked for the run, if one did (set by the front end; recorded in
     /// `report.json`).
     pub invocation: Option<crate::options::Invocation>,
+    /// For a shard (`RunOptions::shard`), which of the scene's surfaces are its own.
+    pub shard_surfaces: Option<Vec<bool>>,
 }
 
 impl RunResult {
+    /// Which of the scene's surfaces are `shard`'s: this run's own, when it was that shard.
+    pub fn surfaces_of(&self, shard: crate::options::Shard) -> Vec<bool> {
+        match &self.shard_surfaces {
+            Some(on) if self.options.shard == Some(shard) => on.clone(),
+            _ => shard.surfaces_of(&self.loaded.scene, &self.options),
+        }
+    }
+
     /// The light surface `s` reflects at its vertices, in two parts: straight from the lights,
     /// ρ·H_direct, and after more bounces, ρ·(H − H_direct).
     pub fn reflected_parts(&self, s: SurfaceId) -> (Vec<Rgb>, Vec<Rgb>) {

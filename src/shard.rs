@@ -145,7 +145,7 @@ pub fn write_shard(
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let scene = &result.loaded.scene;
     let report = Report::of_run(result, svgs);
-    let on = shard.surfaces_of(scene, &result.options);
+    let on = result.surfaces_of(shard);
     let ours: Vec<SurfaceId> = svgs
         .surfaces(result)
         .into_iter()

@@ -232,7 +232,7 @@ fn write_shard(
     if args.quiet {
         return Ok(());
     }
-    let on = shard.surfaces_of(&result.loaded.scene, &result.options);
+    let on = result.surfaces_of(shard);
     let lit = |count: fn(&penumbra_meshing::SurfaceMesh) -> usize| -> usize {
         result
             .mesh
