@@ -307,7 +307,7 @@ impl<'a> DirectLight<'a> {
                 ));
             }
         }
-        let tree = OccluderTree::build(
+        let mut tree = OccluderTree::build(
             &occluders
                 .iter()
                 .map(|o| TreeFace {
@@ -318,6 +318,11 @@ impl<'a> DirectLight<'a> {
                 })
                 .collect::<Vec<_>>(),
         );
+        // Stored in the tree's order, each copied afresh: a shaft's thousands of candidates are
+        // then read nearly in memory order (scattered, they cost a cache miss each).
+        let occluders: Vec<ConvexPiece> = (tree.renumber_in_order().into_iter())
+            .map(|old| occluders[old].clone())
+            .collect();
         DirectLight {
             visibility,
             emitters,

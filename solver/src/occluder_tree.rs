@@ -189,6 +189,24 @@ impl OccluderTree {
         tree
     }
 
+    /// Renumbers the faces in the tree's order, so that a walk reaches them in increasing order
+    /// (a shaft's candidates then lie close together in memory, where the caller stores its
+    /// faces in that order); returns each new face's old index.
+    pub(crate) fn renumber_in_order(&mut self) -> Vec<usize> {
+        let order = std::mem::replace(&mut self.items, (0..self.turns.len()).collect());
+        let mut new_index = vec![0; order.len()];
+        for (k, &old) in order.iter().enumerate() {
+            new_index[old] = k;
+        }
+        self.turns = order.iter().map(|&old| self.turns[old]).collect();
+        for sheet in &mut self.sheets {
+            if let Members::Listed(faces) = &mut sheet.faces {
+                faces.iter_mut().for_each(|i| *i = new_index[*i]);
+            }
+        }
+        order
+    }
+
     /// Builds the node over `items[start..end]` and its subtree; returns its index.
     fn split(
         &mut self,
