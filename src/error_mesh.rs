@@ -291,10 +291,10 @@ impl ErrorBudget {
 
     /// A shard's budget of `triangles` in a scene of `area` whose polygons' fitted budget is
     /// `planned` triangles: its typical element is at most `area / planned`. (A shard's part of
-    /// the budget is balanced by time, not area: the Crytek Sponza's first shard of 16 held 61 %
-    /// of the area and 8 % of the triangles, and judged by its own element, 7.6 times the whole
-    /// run's, its roof tiles were too short to refine.) A whole run's element is never larger:
-    /// its budget fits its least mesh, which holds at least the polygons'.
+    /// the budget follows the lit area of its faces large enough to refine; much of its area may
+    /// be in other faces, and judged by its own element a long face beside them would be too
+    /// short to refine.) A whole run's element is never larger: its budget fits its least mesh,
+    /// which holds at least the polygons'.
     pub fn for_shard(triangles: usize, area: f64, planned: usize) -> ErrorBudget {
         ErrorBudget {
             triangles,

@@ -73,9 +73,11 @@ pub fn run(
         source,
         warnings,
     };
-    let mut result = assemble(loaded, options, lit, render, &plan, figures);
-    result.shard_surfaces = shard_surfaces;
-    Ok(result)
+    let result = assemble(loaded, options, lit, render, &plan, figures);
+    Ok(RunResult {
+        shard_surfaces,
+        ..result
+    })
 }
 
 /// Whether `error` is the interrupt, before a solution existed.
@@ -368,7 +370,16 @@ impl<'a> Stages<'a> {
             ..self.solver.clone()
         };
         let (scene, options) = (self.scene, self.options);
-        let solved = solve_with(scene, visibility, meshed, options, &solver, self.progress)?;
+        let on = (self.shard_part.as_ref()).map(|part| part.surfaces.as_slice());
+        let solved = solve_with(
+            scene,
+            visibility,
+            meshed,
+            options,
+            on,
+            &solver,
+            self.progress,
+        )?;
         self.peaks.solve = memory::peak_resident_bytes();
         if let Some(report) = meshed.mesh_error.as_mut().filter(|_| !solver.direct_only) {
             report.estimate_reflected(scene, &meshed.mesh, &solved.solution);

@@ -7,7 +7,7 @@ mod common;
 use common::in_process::run_scene;
 use glam::DVec3;
 use penumbra::error_mesh::{DEFAULT_TOLERANCE, ErrorBudget, StopWhen, refine_by_error};
-use penumbra::options::Shard;
+use penumbra::options::{Shard, surface_costs};
 use penumbra::reflected_mesh::refine_reflected;
 use penumbra::{MeshMethod, RunOptions};
 use penumbra_meshing::{SceneMesh, TriangleLocator, mesh_scene_uniform};
@@ -208,9 +208,10 @@ fn chips(count: u32, legs: f64) -> impl Iterator<Item = Surface> {
 /// The shard of `count` holding surface `name`, for a run of `options`.
 fn shard_holding(scene: &Scene, options: &RunOptions, name: &str, count: usize) -> Shard {
     let id = scene.surface_id(name).expect("a named surface");
+    let costs = surface_costs(scene, options);
     (0..count)
         .map(|i| Shard::new(i, count).expect("a shard"))
-        .find(|shard| shard.surfaces_of(scene, options)[id])
+        .find(|shard| shard.surfaces(&costs)[id])
         .expect("every surface is in a shard")
 }
 

@@ -108,7 +108,8 @@ impl Shard {
     /// the run not split, as far as the polygons tell.
     pub fn part(self, scene: &Scene, options: &RunOptions) -> ShardPart {
         let extra = error_driven_shares(scene, options);
-        let surfaces = self.surfaces(&costs_with(scene, options, &extra));
+        let surfaces = self.surfaces(&costs_with(scene, options, extra.as_deref()));
+        let extra = extra.unwrap_or_default();
         let total: f64 = extra.iter().sum();
         let own: f64 = (extra.iter().zip(&surfaces))
             .filter(|(_, own)| **own)
@@ -173,23 +174,23 @@ impl std::fmt::Display for Shard {
 /// search's time per surface grew about so, summed over a shard). The same for every shard of a
 /// run, from the scene and the options alone.
 pub fn surface_costs(scene: &Scene, options: &RunOptions) -> Vec<f64> {
-    costs_with(scene, options, &error_driven_shares(scene, options))
+    costs_with(
+        scene,
+        options,
+        error_driven_shares(scene, options).as_deref(),
+    )
 }
 
 /// The [`extra_shares`] of an error-driven run (none for other meshes, which spread their
 /// budget by area).
-fn error_driven_shares(scene: &Scene, options: &RunOptions) -> Vec<f64> {
-    match options.error_driven() {
-        true => extra_shares(scene, options),
-        false => Vec::new(),
-    }
+fn error_driven_shares(scene: &Scene, options: &RunOptions) -> Option<Vec<f64>> {
+    options.error_driven().then(|| extra_shares(scene, options))
 }
 
-/// [`surface_costs`], given the surfaces' [`extra_shares`].
-fn costs_with(scene: &Scene, options: &RunOptions, extra: &[f64]) -> Vec<f64> {
+/// [`surface_costs`], given an error-driven run's [`extra_shares`].
+fn costs_with(scene: &Scene, options: &RunOptions, extra: Option<&[f64]>) -> Vec<f64> {
     let planned = planned_triangles(scene, options);
     let area = scene.total_area();
-    let extra = options.error_driven().then_some(extra);
     scene
         .surfaces
         .iter()

@@ -37,11 +37,13 @@ pub(crate) struct Solved {
 
 /// Solves on `meshed` with the solver `options` choose, refining the mesh where they ask for
 /// it (adaptive refinement; error-driven meshes again for the light reflected more than once).
+/// A shard lights only its own surfaces, `shard_surfaces`.
 pub(crate) fn solve_with(
     scene: &Scene,
     visibility: &Visibility,
     meshed: &mut Meshed,
     options: &RunOptions,
+    shard_surfaces: Option<&[bool]>,
     solver: &SolverOptions,
     progress: &dyn Progress,
 ) -> Result<Solved, RunError> {
@@ -70,12 +72,11 @@ pub(crate) fn solve_with(
             refinement: Some(report),
         });
     }
-    if let Some(shard) = options.shard {
+    if let Some(on) = shard_surfaces {
         // Every surface is meshed as in a whole run (each one's share of the budget depends on
         // all of them, and the direct light at a point shared by several surfaces is evaluated
         // once for all); only the shard's vertices are lit.
-        let on = shard.surfaces_of(scene, options);
-        let solution = solve_direct_on(scene, mesh, visibility, solver, &on, progress)?;
+        let solution = solve_direct_on(scene, mesh, visibility, solver, on, progress)?;
         return Ok(plain(solution));
     }
     let solution = match options.method {
