@@ -14,7 +14,7 @@ use std::time::Instant;
 use penumbra_meshing::discontinuity::{
     Boundary, Discontinuities, DiscontinuityOptions, find_discontinuities_reporting,
 };
-use penumbra_meshing::{MeshError, SceneMesh};
+use penumbra_meshing::{ElementBudget, MeshError, SceneMesh};
 use penumbra_scenes::{LoadedScene, Rgb, Scene, Visibility};
 use penumbra_solver::{Progress, SolveError, SolverOptions, StopReason};
 use penumbra_viz::Render;
@@ -279,6 +279,14 @@ impl<'a> Stages<'a> {
                 options.planned_elements(scene).unwrap_or(budget),
             ),
             None => ErrorBudget::triangles(budget),
+        };
+        // Where only the direct light is wanted, a vertex made at a point measured costs
+        // nothing: a fitted budget (not one asked for) grows by those.
+        let error_budget = match options.max_elements {
+            ElementBudget::Fit { .. } if options.solver.direct_only => {
+                error_budget.splitting_measured()
+            }
+            _ => error_budget,
         };
         let mesh_error = self
             .options

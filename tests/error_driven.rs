@@ -9,8 +9,8 @@ use glam::DVec3;
 use penumbra::error_mesh::{DEFAULT_TOLERANCE, ErrorBudget, StopWhen, refine_by_error};
 use penumbra::options::{Shard, surface_costs};
 use penumbra::reflected_mesh::refine_reflected;
-use penumbra::{MeshMethod, RunOptions};
-use penumbra_meshing::{SceneMesh, TriangleLocator, mesh_scene_uniform};
+use penumbra::{MeshMethod, RunOptions, RunResult};
+use penumbra_meshing::{ElementBudget, SceneMesh, TriangleLocator, mesh_scene_uniform};
 use penumbra_scenes::tessellated::{bumpy_blob, icosphere, torus};
 use penumbra_scenes::{Rgb, Scene, SplitMix64, Surface, Visibility, builtin};
 use penumbra_solver::{
@@ -91,9 +91,18 @@ fn surface_errors(
     surfaces: &[&str],
 ) -> (usize, Vec<(f64, usize)>) {
     let result = run_scene(scene.clone(), options);
+    (
+        result.mesh.triangle_count(),
+        result_errors(scene, &result, surfaces),
+    )
+}
+
+/// For each of the named surfaces of `result`, a run of `scene`: its RMS error of the direct
+/// light relative to its mean, at 4,000 random points, and its triangles.
+fn result_errors(scene: &Scene, result: &RunResult, surfaces: &[&str]) -> Vec<(f64, usize)> {
     let visibility = Visibility::build(scene);
     let direct = DirectLight::new(scene, &visibility);
-    let errors = surfaces
+    surfaces
         .iter()
         .map(|name| {
             let id = scene.surface_id(name).expect("a named surface");
@@ -110,8 +119,7 @@ fn surface_errors(
                 result.mesh.surfaces[id].triangle_count(),
             )
         })
-        .collect();
-    (result.mesh.triangle_count(), errors)
+        .collect()
 }
 
 /// At equal triangles the default (error-driven) mesh's RMS error of the direct light on the
@@ -162,6 +170,44 @@ fn a_torus() {
 #[test]
 fn the_cornell_box() {
     beats_uniform(&builtin::cornell(), 10_000);
+}
+
+/// Where refinement measures up to a fitted budget and only the direct light is wanted, it goes
+/// on splitting at the check points it measured: the sphere's floor with no more evaluations,
+/// more triangles and a smaller error at random points than the same budget as a cap.
+#[test]
+fn splits_at_measured_points_cost_no_evaluations() {
+    let scene = floor_scene("sphere", icosphere(DVec3::new(0.1, -0.2, 0.8), 0.4, 3));
+    let budget = 4_000;
+    let capped = capped_direct_only(MeshMethod::Auto, budget);
+    let fitted = RunOptions {
+        max_elements: ElementBudget::fit(budget),
+        ..capped.clone()
+    };
+    let run = |options: RunOptions| {
+        let result = run_scene(scene.clone(), options);
+        let errors = result_errors(&scene, &result, &["floor"]);
+        (result.mesh_error.expect("an error-driven run"), errors[0])
+    };
+    let (at_cap, (capped_error, capped_floor)) = run(capped);
+    let (split, (fitted_error, fitted_floor)) = run(fitted);
+    eprintln!(
+        "capped: {capped_floor} floor triangles, {:.3} %, {} evaluations; fitted: \
+         {fitted_floor}, {:.3} %, {} evaluations, {} splits at measured points",
+        100.0 * capped_error,
+        at_cap.evaluations,
+        100.0 * fitted_error,
+        split.evaluations,
+        split.splits_at_measured_points
+    );
+    assert_eq!(split.evaluations, at_cap.evaluations);
+    assert!(at_cap.triangles <= budget, "{}", at_cap.triangles);
+    assert!(split.triangles > at_cap.triangles && split.triangles <= 2 * budget);
+    assert!(fitted_floor > capped_floor);
+    assert!(
+        fitted_error < 0.75 * capped_error,
+        "{fitted_error:e} against {capped_error:e}"
+    );
 }
 
 /// [`floor_scene`] with a 0.02 × 3.5 triangle, `tile`, at half the light's height: under the
@@ -225,7 +271,7 @@ fn a_shards_part_of_the_budget_follows_its_refinable_area() {
     let mut scene = floor_scene("floor-and-chips", Vec::new());
     scene.surfaces.extend(chips(2_000, 0.001));
     let whole = RunOptions {
-        max_elements: penumbra_meshing::ElementBudget::fit(100),
+        max_elements: ElementBudget::fit(100),
         ..capped_direct_only(MeshMethod::Auto, 0)
     };
     let shard = shard_holding(&scene, &whole, "floor", 32);
@@ -257,7 +303,7 @@ fn a_shard_judges_its_faces_by_the_scenes_element() {
     scene.surfaces.extend(chips(6_000, 0.45));
     // 4 triangles a surface: the tile's part of the extra is about 50.
     let options = RunOptions {
-        max_elements: penumbra_meshing::ElementBudget::Fit {
+        max_elements: ElementBudget::Fit {
             at_least: 100,
             per_surface: 4,
         },

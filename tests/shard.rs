@@ -210,7 +210,8 @@ fn error_driven_shards_of_a_large_scene_refine_alone() {
     assert!(refined(&report) > Some(0));
     assert_eq!(at(&report, "/mesh_error/triangles"), triangles);
     assert_eq!(at(&report, "/counts/triangles"), triangles);
-    assert!(triangles as i64 <= budget(&report));
+    // Direct-light runs with a fitted budget split at points measured up to twice it.
+    assert!(triangles as i64 <= 2 * budget(&report));
     // Where both meshes have a point, its direct light agrees to 1e-9 of the brightest (on a
     // contact line, both sides' values): the mesh may measure a vertex that the direct light
     // pass lights in the other run, which rounds differently.

@@ -28,6 +28,27 @@ pub struct Split {
     pub vertices: Vec<(u32, [u32; 3])>,
 }
 
+/// The end of a longest-edge propagation path ([`BisectionMesh::terminal`]): the triangles
+/// that share the edge to bisect, each with the corner that starts it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Terminal {
+    sides: [(u32, usize); 2],
+}
+
+impl Terminal {
+    /// Each triangle with its corner starting the edge: one, or two.
+    pub fn sides(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
+        (self.sides.iter())
+            .filter(|(t, _)| *t != NONE)
+            .map(|&(t, k)| (t as usize, k))
+    }
+
+    /// Whether bisecting it splits triangle `t`.
+    pub fn splits(&self, t: usize) -> bool {
+        self.sides().any(|(s, _)| s == t)
+    }
+}
+
 /// A surface mesh that can be refined by conforming longest-edge bisection.
 #[derive(Clone, Debug)]
 pub struct BisectionMesh {
@@ -91,26 +112,43 @@ impl BisectionMesh {
     /// Splits triangle `t` at its longest edge, splitting first what conformity needs; appends
     /// what changed to `out`.
     pub fn split(&mut self, t: usize, out: &mut Split) {
-        let mut path = vec![t as u32];
-        while let Some(&t) = path.last() {
-            let k = self.longest(t as usize);
-            let e = self.edge(t as usize, k);
-            match self.across(t, e) {
-                None => {
-                    self.bisect(t, k, None, out);
-                    path.pop();
-                }
-                Some(n) => {
-                    let kn = self.longest(n as usize);
-                    if self.key(self.edge(n as usize, kn)) == self.key(e) {
-                        self.bisect(t, k, Some((n, kn)), out);
-                        path.pop();
-                    } else {
-                        path.push(n);
-                    }
-                }
+        loop {
+            let end = self.terminal(t);
+            self.bisect_terminal(end, out);
+            if end.splits(t) {
+                return;
             }
         }
+    }
+
+    /// Where `t`'s longest-edge propagation path ends: the first triangle on it whose longest
+    /// edge is its neighbour's longest too (or has no neighbour). Bisecting that pair, again
+    /// and again, splits `t`.
+    pub fn terminal(&self, t: usize) -> Terminal {
+        let mut t = t as u32;
+        loop {
+            let k = self.longest(t as usize);
+            let e = self.edge(t as usize, k);
+            let Some(n) = self.across(t, e) else {
+                return Terminal {
+                    sides: [(t, k), (NONE, 0)],
+                };
+            };
+            let kn = self.longest(n as usize);
+            if self.key(self.edge(n as usize, kn)) == self.key(e) {
+                return Terminal {
+                    sides: [(t, k), (n, kn)],
+                };
+            }
+            t = n;
+        }
+    }
+
+    /// Bisects the pair [`Self::terminal`] found (nothing else changed since); appends what
+    /// changed to `out`.
+    pub fn bisect_terminal(&mut self, end: Terminal, out: &mut Split) {
+        let [(t, k), (n, kn)] = end.sides;
+        self.bisect(t, k, (n != NONE).then_some((n, kn)), out);
     }
 
     fn key(&self, [a, b]: [u32; 2]) -> (u32, u32) {

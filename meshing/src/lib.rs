@@ -89,7 +89,7 @@ mod tolerances;
 mod uniform;
 mod wedges;
 
-pub use bisection::{BisectionMesh, SHORTEST_SPLIT_EDGE, Split};
+pub use bisection::{BisectionMesh, SHORTEST_SPLIT_EDGE, Split, Terminal};
 pub use budget::{ElementBudget, FIT_TRIANGLES_PER_SURFACE, polygon_minimum};
 pub use constrained::{ConstrainedSurface, Constraint, RefinableSurface};
 pub use error::MeshError;

@@ -9,7 +9,7 @@
 
 use glam::DVec3;
 use penumbra_meshing::discontinuity::{DiscontinuityOptions, EmitterProbe, EventSet};
-use penumbra_meshing::{DEFAULT_PENUMBRA_DENSITY, TriangleLocator};
+use penumbra_meshing::{DEFAULT_PENUMBRA_DENSITY, ElementBudget, TriangleLocator};
 use penumbra_scenes::{AreaSampler, SplitMix64};
 use penumbra_scenes::{LoadedScene, Scene, SurfaceId, Visibility};
 use penumbra_solver::path_trace::ReferenceValue;
@@ -105,6 +105,10 @@ impl SweepMethod {
 pub struct SweepOptions {
     /// Element budgets (`--max-elements` of each run).
     pub budgets: Vec<usize>,
+    /// Whether each budget is fitted as a run's default is ([`ElementBudget::fit`]: at least
+    /// the budget, or the scene's least mesh and a triangle more per surface when that is
+    /// more), rather than a cap.
+    pub fitted: bool,
     /// The meshing methods compared; each runs at every budget.
     pub methods: Vec<SweepMethod>,
     /// Names of the surfaces scored, for the record (empty: all; the samples are chosen by
@@ -436,7 +440,10 @@ pub fn sweep(
         let run_options = RunOptions {
             method: job.solver,
             mesh: method.mesh(),
-            max_elements: job.budget.into(),
+            max_elements: match options.fitted {
+                true => ElementBudget::fit(job.budget),
+                false => job.budget.into(),
+            },
             penumbra_density: if method.adaptive() {
                 1.0
             } else {

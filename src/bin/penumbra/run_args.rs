@@ -173,7 +173,9 @@ pub(crate) struct RunArgs {
     /// Cap on triangles for the whole scene, spread over the surfaces by area. Default: what the
     /// scene needs: 25,000 with the hierarchical solver (its cost grows about linearly with the
     /// vertices), 10,000 with the others or --direct-only, or, when that is too few, the least
-    /// mesh of its polygons with their discontinuities as edges and 1 triangle more per surface.
+    /// mesh of its polygons with their discontinuities as edges and 1 triangle more per surface;
+    /// with --direct-only, error-driven refinement that spends it goes on splitting at the
+    /// points it measured, with no new evaluations, up to twice as many.
     #[arg(help_heading = MESH, long)]
     pub(crate) max_elements: Option<usize>,
     /// Discontinuity meshes: how many times smaller in area triangles are in partial shadow than

@@ -30,6 +30,10 @@ pub(crate) struct SweepArgs {
         default_value = "2500,5000,10000,20000,30000"
     )]
     budgets: Vec<usize>,
+    /// Fit each budget to the scene as a run's default budget is: at least that many triangles,
+    /// or the scene's least mesh and a triangle more per surface when that is more.
+    #[arg(long)]
+    fitted: bool,
     /// Tolerance of the adaptive runs at the first budget, relative to the mean reflected
     /// radiosity (as `run --refine-tol`); it shrinks in proportion as the budget grows, so that larger budgets are spent.
     #[arg(long, default_value_t = 1e-3)]
@@ -168,6 +172,7 @@ fn sweep_options(args: &SweepArgs) -> SweepOptions {
     };
     SweepOptions {
         budgets: args.budgets.clone(),
+        fitted: args.fitted,
         methods,
         surfaces: args.surfaces.clone(),
         refine_tol: args.refine_tol,
