@@ -449,6 +449,11 @@ struct Refined {
     hovering: Vec<(DVec3, DVec3, f64)>,
 }
 
+/// Where an edge's midpoint is kept: by its two vertices, smaller first.
+fn edge_key(a: u32, b: u32) -> (u32, u32) {
+    (a.min(b), a.max(b))
+}
+
 /// The deviations at the midpoints of the edges that bisecting a triangle at its edge `k` makes
 /// (the edge's halves, and the median), predicted from the deviations `d` at its edges'
 /// midpoints by the quadratic through its corners and midpoints. A quadratic's deviation on a
@@ -665,19 +670,17 @@ impl<'a> Refiner<'a> {
         let mut changed: Vec<Split> = vec![Split::default(); self.surfaces.len()];
         let (mut splits, mut measures) = (0, 0);
         while splits < batch && measures < batch && self.triangles < most {
-            let Some(e) = self.queue.pop() else { break };
-            let (i, t) = (e.surface as usize, e.triangle as usize);
+            let Some((i, t)) = self.pop_current() else {
+                break;
+            };
             let s = &mut self.surfaces[i];
-            if s.version[t] != e.version || s.done {
-                continue;
-            }
             if !s.measured[t] {
                 s.measured[t] = true;
                 changed[i].triangles.push(t as u32);
                 measures += 1;
                 continue;
             }
-            if s.mesh.too_small(t) || s.mesh().triangle_area(t) < self.smallest {
+            if !s.splittable(t, self.smallest) {
                 continue;
             }
             let mut split = Split::default();
@@ -716,13 +719,11 @@ impl<'a> Refiner<'a> {
     fn split_at_measured(&mut self, most: usize) -> usize {
         let mut splits = 0;
         while self.triangles + SPLIT_MARGIN <= most {
-            let Some(e) = self.queue.pop() else { break };
-            let (i, t) = (e.surface as usize, e.triangle as usize);
+            let Some((i, t)) = self.pop_current() else {
+                break;
+            };
             let s = &mut self.surfaces[i];
-            if s.version[t] != e.version || s.done || !s.measured[t] {
-                continue;
-            }
-            if s.mesh.too_small(t) || s.mesh().triangle_area(t) < self.smallest {
+            if !s.measured[t] || !s.splittable(t, self.smallest) {
                 continue;
             }
             let Some(split) = s.split_at_measured(t) else {
@@ -733,6 +734,19 @@ impl<'a> Refiner<'a> {
             self.requeue(i, split.triangles);
         }
         splits
+    }
+
+    /// The next triangle off the queue, as (surface, triangle), that has not changed since it
+    /// was queued and whose surface is not done yet; `None` when the queue is empty.
+    fn pop_current(&mut self) -> Option<(usize, usize)> {
+        while let Some(e) = self.queue.pop() {
+            let (i, t) = (e.surface as usize, e.triangle as usize);
+            let s = &self.surfaces[i];
+            if s.version[t] == e.version && !s.done {
+                return Some((i, t));
+            }
+        }
+        None
     }
 
     /// Estimates the errors of surface `i`'s `triangles` (new or changed, possibly repeated)
@@ -905,7 +919,7 @@ impl Refined {
                 if self.vertex[a as usize].is_nan() && vertices.insert(a) {
                     checks.push(Check::Vertex(a, centroid));
                 }
-                let key = (a.min(b), a.max(b));
+                let key = edge_key(a, b);
                 if !self.midpoint.contains_key(&key) && edges.insert(key) {
                     checks.push(Check::Edge([a, b, self.mesh.opposite(t, k)], None));
                 }
@@ -927,7 +941,7 @@ impl Refined {
             self.version[t as usize] += 1;
         }
         for &(v, [a, b, _]) in &split.vertices {
-            if let Some(&(h, value)) = self.midpoint.get(&(a.min(b), a.max(b))) {
+            if let Some(&(h, value)) = self.midpoint.get(&edge_key(a, b)) {
                 self.irradiance[v as usize] = h;
                 self.vertex[v as usize] = value;
             }
@@ -964,7 +978,7 @@ impl Refined {
                 self.vertex[v as usize] = value;
             }
             Check::Edge([a, b, _], None) => {
-                self.midpoint.insert((a.min(b), a.max(b)), (h, value));
+                self.midpoint.insert(edge_key(a, b), (h, value));
             }
         }
     }
@@ -977,7 +991,7 @@ impl Refined {
         let mut d = [0.0; 3];
         for (k, dk) in d.iter_mut().enumerate() {
             let [a, b] = self.mesh.edge(t, k);
-            let key = (a.min(b), a.max(b));
+            let key = edge_key(a, b);
             if let Some(&(_, m)) = self.midpoint.get(&key) {
                 let e = m - (self.vertex[a as usize] + self.vertex[b as usize]) * 0.5;
                 *dk = if e.is_finite() { e } else { 0.0 };
@@ -988,10 +1002,16 @@ impl Refined {
         d
     }
 
+    /// Whether triangle `t` may be split: not too small for its midpoints to be exact
+    /// ([`BisectionMesh::too_small`]), nor below `smallest` in area.
+    fn splittable(&self, t: usize, smallest: f64) -> bool {
+        !self.mesh.too_small(t) && self.mesh().triangle_area(t) >= smallest
+    }
+
     /// Whether edge `k` of triangle `t` has a measured midpoint.
     fn midpoint_measured(&self, t: usize, k: usize) -> bool {
         let [a, b] = self.mesh.edge(t, k);
-        self.midpoint.contains_key(&(a.min(b), a.max(b)))
+        self.midpoint.contains_key(&edge_key(a, b))
     }
 
     /// Splits triangle `t` as [`BisectionMesh::split`] would, while every edge that takes
@@ -1011,16 +1031,15 @@ impl Refined {
             let mut step = Split::default();
             self.mesh.bisect_terminal(end, &mut step);
             self.grow(&step);
-            let key = |p: u32, q: u32| (p.min(q), p.max(q));
             for ([a, b], c, [half, median]) in quadratics {
                 let made = step
                     .vertices
                     .iter()
-                    .find(|(_, e)| key(e[0], e[1]) == key(a, b));
+                    .find(|(_, e)| edge_key(e[0], e[1]) == edge_key(a, b));
                 let Some(&(m, _)) = made else { continue };
-                self.predicted.insert(key(a, m), half);
-                self.predicted.insert(key(m, b), half);
-                self.predicted.insert(key(m, c), median);
+                self.predicted.insert(edge_key(a, m), half);
+                self.predicted.insert(edge_key(m, b), half);
+                self.predicted.insert(edge_key(m, c), median);
             }
             split.triangles.extend(step.triangles);
             split.vertices.extend(step.vertices);

@@ -73,11 +73,15 @@ pub fn run(
         source,
         warnings,
     };
-    let result = assemble(loaded, options, lit, render, &plan, figures);
-    Ok(RunResult {
+    Ok(assemble(
+        loaded,
+        options,
+        lit,
+        render,
+        &plan,
+        figures,
         shard_surfaces,
-        ..result
-    })
+    ))
 }
 
 /// Whether `error` is the interrupt, before a solution existed.
@@ -486,6 +490,7 @@ fn assemble(
     render: Render,
     plan: &Plan,
     (times, peaks): (StageTimes, StagePeaks),
+    shard_surfaces: Option<Vec<bool>>,
 ) -> RunResult {
     RunResult {
         loaded,
@@ -506,6 +511,6 @@ fn assemble(
         },
         stopped: lit.stopped,
         invocation: None,
-        shard_surfaces: None,
+        shard_surfaces,
     }
 }
