@@ -37,7 +37,7 @@ use penumbra_scenes::{
 };
 use penumbra_solver::{
     DirectLight, Interrupt, OVERLAY_CAP, Progress, ReceivingPoint, Solution, form_factor,
-    hover_lift, hover_lifts, on_line_distance,
+    hover_lift, hover_lifts, irradiance_shared, on_line_distance,
 };
 use rayon::prelude::*;
 use serde::Serialize;
@@ -164,7 +164,8 @@ pub struct MeshErrorReport {
     pub triangles_before: usize,
     /// Triangles of the refined mesh.
     pub triangles: usize,
-    /// Points where the exact direct light was evaluated (vertices and check points).
+    /// Points where the exact direct light was evaluated (vertices and check points; surfaces
+    /// meeting at a point share one).
     pub evaluations: usize,
     /// Splits made, once measuring stopped, at check points already measured (no new
     /// evaluations).
@@ -774,14 +775,15 @@ impl<'a> Refiner<'a> {
 
     /// Evaluates the exact light at `checks` (in parallel) and stores the values.
     fn evaluate(&mut self, checks: &[(usize, Check)]) {
-        let values: Vec<Rgb> = checks
-            .par_iter()
+        let points: Vec<(ReceivingPoint, SurfaceId)> = checks
+            .iter()
             .map(|&(i, c)| {
                 let s = &self.surfaces[i];
-                self.direct.irradiance(&s.point(c, self.on_line), s.id)
+                (s.point(c, self.on_line), s.id)
             })
             .collect();
-        self.evaluations += checks.len();
+        let (values, evaluated) = irradiance_shared(self.direct, &points);
+        self.evaluations += evaluated;
         for (&(i, c), value) in checks.iter().zip(values) {
             self.surfaces[i].store(c, value);
         }

@@ -99,32 +99,16 @@ pub(crate) fn direct_at(
     limits: &Limits,
     progress: &dyn Progress,
 ) -> Result<(Vec<Rgb>, Estimated), SolveError> {
-    // Groups in order of first appearance, so the work and its result do not depend on hashing.
-    // Each group: the grid point its receivers round to, and the receivers.
-    let mut groups: Vec<(DVec3, Vec<usize>)> = Vec::new();
-    let mut at_point: HashMap<[i64; 3], usize> = HashMap::new();
-    let quantum = SHARED_POINT * direct.scene_diagonal();
-    let gridded = quantum > 0.0 && quantum.is_finite();
-    for (i, &v) in receivers.iter().enumerate() {
-        if !wanted(v) {
-            continue;
-        }
-        let p = disc.receivers[v].point;
-        let (key, at) = if gridded {
-            let q = (p / quantum).round();
-            ([q.x as i64, q.y as i64, q.z as i64], q * quantum)
-        } else {
-            (
-                [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()].map(|b| b as i64),
-                p,
-            )
-        };
-        let g = *at_point.entry(key).or_insert_with(|| {
-            groups.push((at, Vec::new()));
-            groups.len() - 1
-        });
-        groups[g].1.push(i);
-    }
+    let wanted: Vec<usize> = (0..receivers.len())
+        .filter(|&i| wanted(receivers[i]))
+        .collect();
+    let groups: Vec<(DVec3, Vec<usize>)> = shared_points(
+        wanted.iter().map(|&i| disc.receivers[receivers[i]].point),
+        direct.scene_diagonal(),
+    )
+    .into_iter()
+    .map(|(at, members)| (at, members.into_iter().map(|k| wanted[k]).collect()))
+    .collect();
     let members = |g: &[usize]| -> Vec<(ReceivingPoint, SurfaceId)> {
         g.iter()
             .map(|&i| {
@@ -184,6 +168,62 @@ pub(crate) fn direct_at(
             beyond_cap,
         },
     ))
+}
+
+/// The points of `points` that share one evaluation ([`SHARED_POINT`] of the scene's
+/// `diagonal` apart at most): each the grid point they round to and their indices, in order of
+/// first appearance, so that the work and its result do not depend on hashing.
+pub fn shared_points(
+    points: impl Iterator<Item = DVec3>,
+    diagonal: f64,
+) -> Vec<(DVec3, Vec<usize>)> {
+    let mut groups: Vec<(DVec3, Vec<usize>)> = Vec::new();
+    let mut at_point: HashMap<[i64; 3], usize> = HashMap::new();
+    let quantum = SHARED_POINT * diagonal;
+    let gridded = quantum > 0.0 && quantum.is_finite();
+    for (i, p) in points.enumerate() {
+        let (key, at) = if gridded {
+            let q = (p / quantum).round();
+            ([q.x as i64, q.y as i64, q.z as i64], q * quantum)
+        } else {
+            (
+                [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()].map(|b| b as i64),
+                p,
+            )
+        };
+        let g = *at_point.entry(key).or_insert_with(|| {
+            groups.push((at, Vec::new()));
+            groups.len() - 1
+        });
+        groups[g].1.push(i);
+    }
+    groups
+}
+
+/// The exact direct irradiance at each receiving point of a surface, in parallel, one
+/// evaluation for the points that share one ([`shared_points`], [`DirectLight::irradiance_group`]):
+/// each value is the one the direct-light pass gives a vertex there, to the bit. Also returns
+/// how many points were evaluated.
+pub fn irradiance_shared(
+    direct: &DirectLight,
+    points: &[(ReceivingPoint, SurfaceId)],
+) -> (Vec<Rgb>, usize) {
+    let groups = shared_points(points.iter().map(|(x, _)| x.point), direct.scene_diagonal());
+    let values: Vec<Vec<Rgb>> = groups
+        .par_iter()
+        .map(|(at, members)| {
+            let group: Vec<(ReceivingPoint, SurfaceId)> =
+                members.iter().map(|&i| points[i]).collect();
+            direct.irradiance_group(*at, &group)
+        })
+        .collect();
+    let mut out = vec![Rgb::ZERO; points.len()];
+    for ((_, members), values) in groups.iter().zip(values) {
+        for (&i, h) in members.iter().zip(values) {
+            out[i] = h;
+        }
+    }
+    (out, groups.len())
 }
 
 /// The exact direct light at the new vertices `fresh` of a refined mesh, run to its end: the

@@ -115,7 +115,7 @@ mod solids;
 mod solution;
 
 pub use direct::{DirectLight, SEQUENTIAL_SHADOWS};
-pub use direct_pass::{OVERLAY_CAP, SHARED_POINT};
+pub use direct_pass::{OVERLAY_CAP, SHARED_POINT, irradiance_shared, shared_points};
 pub use elements::{Discretization, Element, Patch, hover_lift, hover_lifts, on_line_distance};
 pub use error::SolveError;
 pub use gathering::{PatchSystem, SolverMethod, SystemSolution, solve_gathering};

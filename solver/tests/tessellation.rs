@@ -140,13 +140,13 @@ fn receivers_at_one_point_share_work_without_changing_it() {
 /// A bumpy blob (a closed welded solid of 1,280 triangles with folds and overhangs) under a
 /// square light: at each of its corners, the faces meeting there get from the shared view at
 /// the grid point they round to what each gets on its own, to 10⁻⁹ of the largest value. Faces
-/// through the point that a shaft's side only grazes there are still the faces through it.
+/// through the point that a shaft's side only grazes there are still the faces through it; the
+/// whole mesh lit at once, one evaluation a point, gives each face the same.
 #[test]
 fn the_faces_at_a_blob_corner_share_their_view_exactly() {
     use penumbra_scenes::Surface;
     use penumbra_scenes::tessellated::bumpy_blob;
     use penumbra_solver::Discretization;
-    use std::collections::BTreeMap;
     let mut scene = tessellated(0);
     scene.surfaces.retain(|s| !s.name.starts_with("prism"));
     let grey = penumbra_scenes::Rgb::splat(0.6);
@@ -166,23 +166,28 @@ fn the_faces_at_a_blob_corner_share_their_view_exactly() {
     let mesh = penumbra_meshing::mesh_scene_uniform(&scene, least).expect("meshes");
     let disc = Discretization::new(&scene, &mesh, 24);
     // Grouped as the solver groups them: by the grid point they round to.
-    let quantum = penumbra_solver::SHARED_POINT * direct.scene_diagonal();
-    let mut at_point: BTreeMap<[i64; 3], Vec<usize>> = BTreeMap::new();
-    for (v, x) in disc.receivers.iter().enumerate() {
-        let q = (x.point / quantum).round();
-        at_point
-            .entry([q.x as i64, q.y as i64, q.z as i64])
-            .or_default()
-            .push(v);
-    }
+    let receivers: Vec<(ReceivingPoint, usize)> = (0..disc.receivers.len())
+        .map(|v| (disc.receivers[v], disc.receiver_surface[v]))
+        .collect();
+    let groups = penumbra_solver::shared_points(
+        receivers.iter().map(|(x, _)| x.point),
+        direct.scene_diagonal(),
+    );
+    assert!(groups.len() < receivers.len() / 2, "the corners are shared");
+    let (all, evaluated) = penumbra_solver::irradiance_shared(&shared, &receivers);
+    assert_eq!(evaluated, groups.len());
     let (mut worst, mut peak, mut lit) = (0.0f64, 0.0f64, 0);
-    for (key, group) in at_point.iter().filter(|(_, g)| g.len() > 2) {
-        let at = DVec3::new(key[0] as f64, key[1] as f64, key[2] as f64) * quantum;
-        let members: Vec<(ReceivingPoint, usize)> = group
+    for (at, group) in groups.iter().filter(|(_, g)| g.len() > 2) {
+        let members: Vec<(ReceivingPoint, usize)> = group.iter().map(|&v| receivers[v]).collect();
+        for ((&v, (x, r)), h) in group
             .iter()
-            .map(|&v| (disc.receivers[v], disc.receiver_surface[v]))
-            .collect();
-        for ((x, r), h) in members.iter().zip(shared.irradiance_group(at, &members)) {
+            .zip(&members)
+            .zip(shared.irradiance_group(*at, &members))
+        {
+            assert_eq!(
+                all[v], h,
+                "the shared evaluation of the whole mesh gives each its own"
+            );
             let alone = direct.irradiance(x, *r);
             worst = worst.max((alone.r - h.r).abs());
             peak = peak.max(alone.r);
