@@ -320,9 +320,22 @@ impl<'a> DirectLight<'a> {
         );
         // Stored in the tree's order, each copied afresh: a shaft's thousands of candidates are
         // then read nearly in memory order (scattered, they cost a cache miss each).
-        let occluders: Vec<ConvexPiece> = (tree.renumber_in_order().into_iter())
+        let mut occluders: Vec<ConvexPiece> = (tree.renumber_in_order().into_iter())
             .map(|old| occluders[old].clone())
             .collect();
+        // Their corners numbered in that order too: fusing a shaft's faces into outlines then
+        // reads per-corner tables nearly in order.
+        let mut renumbered = vec![CornerKey::MAX; corners.0.len()];
+        let mut next = 0;
+        for key in occluders.iter_mut().flat_map(|o| o.keys.iter_mut()) {
+            let new = &mut renumbered[*key as usize];
+            if *new == CornerKey::MAX {
+                *new = next;
+                next += 1;
+            }
+            *key = *new;
+        }
+        tree.renumber_keys(&renumbered);
         DirectLight {
             visibility,
             emitters,

@@ -207,6 +207,14 @@ impl OccluderTree {
         order
     }
 
+    /// Gives each corner key of the sheets' outlines its new number, `renumbered[old]`.
+    pub(crate) fn renumber_keys(&mut self, renumbered: &[CornerKey]) {
+        for edge in self.sheets.iter_mut().flat_map(|s| s.outline.iter_mut()) {
+            edge.from = renumbered[edge.from as usize];
+            edge.to = renumbered[edge.to as usize];
+        }
+    }
+
     /// Builds the node over `items[start..end]` and its subtree; returns its index.
     fn split(
         &mut self,
