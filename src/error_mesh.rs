@@ -428,7 +428,9 @@ struct Refined {
     error: Vec<f64>,
     /// Each triangle's squared error integrated over it: measured ([`Self::squared_error`]),
     /// or its prior.
-    squared: Vec<f64>,
+    squared: SquaredErrors,
+    /// The surface's area: bisection keeps it (but for rounding).
+    area: f64,
     /// Whether the surface is refined: faces smaller than [`REFINED_ELEMENTS`] typical elements
     /// (by area and along their longest edge) keep their least mesh.
     refined: bool,
@@ -448,6 +450,54 @@ struct Refined {
     /// The contact lines of faces hovering over it (ends and gap): points on them are
     /// evaluated a few gaps off them ([`hover_lift`]), as the solvers evaluate its vertices.
     hovering: Vec<(DVec3, DVec3, f64)>,
+}
+
+/// Each triangle's squared error, and their sum kept as they change with a bound on how far
+/// rounding has taken it from summing them anew: whether a surface of hundreds of thousands of
+/// triangles is done is decided at each split without a pass over them.
+#[derive(Clone, Debug, Default)]
+struct SquaredErrors {
+    each: Vec<f64>,
+    sum: f64,
+    drift: f64,
+}
+
+impl SquaredErrors {
+    fn new(n: usize) -> Self {
+        SquaredErrors {
+            each: vec![0.0; n],
+            ..SquaredErrors::default()
+        }
+    }
+
+    fn get(&self, t: usize) -> f64 {
+        self.each[t]
+    }
+
+    fn set(&mut self, t: usize, value: f64) {
+        let old = std::mem::replace(&mut self.each[t], value);
+        self.sum += value - old;
+        self.drift += 2.0 * f64::EPSILON * (value.abs() + old.abs() + self.sum.abs());
+    }
+
+    /// Room for `n` triangles, the new ones without error.
+    fn resize(&mut self, n: usize) {
+        self.each.resize(n, 0.0);
+    }
+
+    /// Whether the errors sum to at most `limit`, as summing them anew against `exact_limit`
+    /// (`limit` with its terms summed anew too) would say: the kept sum decides unless it lies
+    /// within the rounding of either of `limit`; then they are summed anew.
+    fn at_most(&mut self, limit: f64, exact_limit: impl FnOnce() -> f64) -> bool {
+        let terms = self.each.len() as f64;
+        let rounding = self.drift + 4.0 * f64::EPSILON * terms * (self.sum.abs() + limit.abs());
+        if (self.sum - limit).abs() > rounding {
+            return self.sum <= limit;
+        }
+        self.sum = self.each.iter().sum();
+        self.drift = 0.0;
+        self.sum <= exact_limit()
+    }
 }
 
 /// Where an edge's midpoint is kept: by its two vertices, smaller first.
@@ -535,7 +585,8 @@ impl<'a> Refiner<'a> {
                     predicted: HashMap::new(),
                     measured: vec![false; n],
                     error: vec![0.0; n],
-                    squared: vec![0.0; n],
+                    squared: SquaredErrors::new(n),
+                    area: m.area(),
                     refined: false,
                     target: 0.0,
                     samples: (0.0, 0),
@@ -627,7 +678,7 @@ impl<'a> Refiner<'a> {
                 let e = PRIOR_RELATIVE_ERROR
                     * s.unoccluded(&emitters, t, on_emitter)
                     * (a / element).min(1.0);
-                s.squared[t] = PRIOR_SQUARED_ERROR * a * e * e;
+                s.squared.set(t, PRIOR_SQUARED_ERROR * a * e * e);
             }
         }
         let mut checks = Vec::new();
@@ -651,9 +702,9 @@ impl<'a> Refiner<'a> {
             s.weight = if light > 0.0 { light.powi(-2) } else { 1.0 };
             s.update_done();
             for t in 0..s.mesh().triangle_count() {
-                if s.squared[t] > 0.0 {
+                if s.squared.get(t) > 0.0 {
                     self.queue.push(Entry {
-                        priority: s.weight * s.squared[t],
+                        priority: s.weight * s.squared.get(t),
                         surface: i as u32,
                         triangle: t as u32,
                         version: 0,
@@ -760,10 +811,11 @@ impl<'a> Refiner<'a> {
             let t = t as usize;
             s.measured[t] = true;
             s.error[t] = s.triangle_error(t);
-            s.squared[t] = s.squared_error(t);
-            if s.squared[t] > 0.0 {
+            let squared = s.squared_error(t);
+            s.squared.set(t, squared);
+            if squared > 0.0 {
                 self.queue.push(Entry {
-                    priority: s.weight * s.squared[t],
+                    priority: s.weight * squared,
                     surface: i as u32,
                     triangle: t as u32,
                     version: s.version[t],
@@ -811,7 +863,7 @@ impl<'a> Refiner<'a> {
                 area += a;
                 if s.measured[t] {
                     measured += a;
-                    sum2 += s.squared[t];
+                    sum2 += s.squared.each[t];
                     max = max.max(s.error[t]);
                 }
             }
@@ -888,8 +940,9 @@ impl Refined {
 
     /// Whether the estimated RMS error (measured, or prior) is within the target.
     fn update_done(&mut self) {
-        let sum: f64 = self.squared.iter().sum();
-        self.done = sum <= self.target * self.target * self.mesh().area();
+        let limit = self.target * self.target * self.area;
+        let exact_limit = || self.target * self.target * self.mesh.mesh().area();
+        self.done = self.squared.at_most(limit, exact_limit);
     }
 
     /// The reflected light (channel mean) of irradiance `h`.
@@ -937,7 +990,7 @@ impl Refined {
         self.irradiance.resize(m.vertex_count(), Rgb::ZERO);
         self.measured.resize(m.triangle_count(), false);
         self.error.resize(m.triangle_count(), 0.0);
-        self.squared.resize(m.triangle_count(), 0.0);
+        self.squared.resize(m.triangle_count());
         self.version.resize(m.triangle_count(), 0);
         for &t in &split.triangles {
             self.version[t as usize] += 1;
@@ -1079,7 +1132,7 @@ impl Refined {
         let m = self.mesh();
         let mean = self.mean();
         let relative = |e: f64| if mean > 0.0 { e / mean } else { 0.0 };
-        let squared: f64 = self.squared.iter().sum();
+        let squared: f64 = self.squared.each.iter().sum();
         SurfaceError {
             surface: scene.surfaces[self.id].name.clone(),
             id: self.id,
