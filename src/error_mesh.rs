@@ -1152,6 +1152,38 @@ mod tests {
     use super::*;
     use glam::DVec2;
 
+    /// The kept sum decides as summing anew does, at every step of a long run of changes whose
+    /// values span twelve orders of magnitude (large priors replaced by small measured errors),
+    /// against limits on either side of the sum and at it; only a limit within rounding of the
+    /// sum takes a pass over the errors.
+    #[test]
+    fn the_kept_sum_decides_as_summing_anew() {
+        let mut rng = SplitMix64::new(7);
+        let n = 2000;
+        let mut errors = SquaredErrors::new(n);
+        for step in 0..20_000 {
+            let t = (rng.next_u64() % n as u64) as usize;
+            let scale = 10f64.powf(-12.0 * rng.next_f64());
+            errors.set(t, scale * rng.next_f64());
+            let exact: f64 = errors.each.iter().sum();
+            for (limit, near) in [
+                (exact * (1.0 - 1e-6), false),
+                (exact * 2.0, false),
+                (exact * (1.0 + 1e-15), true),
+                (exact, true),
+            ] {
+                let drift = errors.drift;
+                let done = errors.at_most(limit, || limit);
+                assert_eq!(done, exact <= limit, "step {step}, limit {limit:e}");
+                let summed_anew = errors.drift == 0.0 && drift > 0.0;
+                assert!(
+                    near || !summed_anew,
+                    "step {step}: a pass for a limit far off"
+                );
+            }
+        }
+    }
+
     /// A quadratic's deviation from its chord at the midpoint of segment `[p, q]`.
     fn deviation(f: impl Fn(DVec2) -> f64, p: DVec2, q: DVec2) -> f64 {
         f((p + q) * 0.5) - (f(p) + f(q)) * 0.5
