@@ -455,7 +455,7 @@ struct Refined {
 /// Each triangle's squared error, and their sum kept as they change with a bound on how far
 /// rounding has taken it from summing them anew: whether a surface of hundreds of thousands of
 /// triangles is done is decided at each split without a pass over them.
-#[derive(Clone, Debug, Default)]
+#[derive(Debug, Default)]
 struct SquaredErrors {
     each: Vec<f64>,
     sum: f64,
@@ -472,6 +472,11 @@ impl SquaredErrors {
 
     fn get(&self, t: usize) -> f64 {
         self.each[t]
+    }
+
+    /// The errors summed anew (for a report, not the running sum).
+    fn total(&self) -> f64 {
+        self.each.iter().sum()
     }
 
     fn set(&mut self, t: usize, value: f64) {
@@ -494,7 +499,7 @@ impl SquaredErrors {
         if (self.sum - limit).abs() > rounding {
             return self.sum <= limit;
         }
-        self.sum = self.each.iter().sum();
+        self.sum = self.total();
         self.drift = 0.0;
         self.sum <= exact_limit()
     }
@@ -863,7 +868,7 @@ impl<'a> Refiner<'a> {
                 area += a;
                 if s.measured[t] {
                     measured += a;
-                    sum2 += s.squared.each[t];
+                    sum2 += s.squared.get(t);
                     max = max.max(s.error[t]);
                 }
             }
@@ -1132,7 +1137,7 @@ impl Refined {
         let m = self.mesh();
         let mean = self.mean();
         let relative = |e: f64| if mean > 0.0 { e / mean } else { 0.0 };
-        let squared: f64 = self.squared.each.iter().sum();
+        let squared = self.squared.total();
         SurfaceError {
             surface: scene.surfaces[self.id].name.clone(),
             id: self.id,
