@@ -82,6 +82,7 @@ mod frame;
 #[doc(hidden)]
 pub mod fuzzing;
 mod load;
+mod mesh_file;
 mod model;
 mod obj;
 pub mod polygon;

@@ -14,22 +14,19 @@
 //! first face, and a face cut into pieces names them `name.0`, `name.1`, ...
 
 mod faces;
-mod repair;
 mod source_lines;
-mod tally;
 
 use std::cell::RefCell;
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 
 use crate::color::Rgb;
-use crate::coplanar::merge_coplanar;
 use crate::error::SceneError;
-use crate::model::{Bounds, Scene, Surface};
+use crate::mesh_file::into_surfaces;
+use crate::mesh_file::tally::{FaceSource, Tally};
+use crate::model::Scene;
 use faces::collect_faces;
-use repair::{Face, Repairs, repair_face};
 use source_lines::SourceLines;
-use tally::{FaceSource, Tally, thousands};
 
 /// Reflectance of faces without a material.
 pub(crate) const DEFAULT_REFLECTANCE: f64 = 0.5;
@@ -137,20 +134,14 @@ fn parse(
         "ignored",
         "polylines (`l` statements; they are lines, not surfaces)",
     ));
-    let scene_diagonal = finite_diagonal(&collected.faces);
-    let (faces, repaired) = repaired_faces(collected.faces, scene_diagonal);
-    warnings.extend(repaired);
-    warnings.extend(clamped_reflectance_warnings(&faces, &materials));
-
-    let material_of = |face: &Face| surface_material(face, &materials);
-    let (surfaces, summary) = if options.merge_coplanar {
-        merged_surfaces(&faces, scene_diagonal, material_of)
-    } else {
-        unmerged_surfaces(&faces, material_of)
-    };
-    warnings.extend(summary);
-    let (surfaces, renamed) = unique_names(surfaces);
-    warnings.extend(renamed);
+    let materials_of = |m: Option<usize>| surface_material(m, &materials);
+    let (surfaces, made) = into_surfaces(
+        collected.faces,
+        options.merge_coplanar,
+        &materials_of,
+        |used| clamped_reflectance_warnings(used, &materials),
+    );
+    warnings.extend(made);
     Ok((
         Scene {
             name: scene_name(path),
@@ -239,42 +230,19 @@ fn library_warning(problem: &str) -> String {
     )
 }
 
-/// The diagonal of the box around the faces whose corners are all finite: a corner that is not
-/// is validation's to refuse, and must not make the scene's scale infinite.
-fn finite_diagonal(faces: &[Face]) -> f64 {
-    Bounds::from_points(
-        faces
-            .iter()
-            .filter(|f| f.polygon.iter().all(|p| p.is_finite()))
-            .flat_map(|f| &f.polygon),
-    )
-    .diagonal()
-}
 
-/// `faces` repaired ([`repair_face`]), and the warnings saying what was repaired.
-fn repaired_faces(faces: Vec<Face>, scene_diagonal: f64) -> (Vec<Face>, Vec<String>) {
-    let mut repairs = Repairs::default();
-    let faces = faces
-        .into_iter()
-        .flat_map(|f| repair_face(f, scene_diagonal, &mut repairs))
-        .collect();
-    (faces, repairs.warnings())
-}
 
-/// One warning per material the faces use whose `Kd` reaches 1, in material order.
-fn clamped_reflectance_warnings(faces: &[Face], materials: &[tobj::Material]) -> Vec<String> {
-    let mut used: Vec<usize> = faces.iter().filter_map(|f| f.material).collect();
-    used.sort_unstable();
-    used.dedup();
+/// One warning per material of `used` whose `Kd` reaches 1, in material order.
+fn clamped_reflectance_warnings(used: &[usize], materials: &[tobj::Material]) -> Vec<String> {
     used.iter()
         .filter_map(|&m| materials.get(m))
         .filter_map(clamped_reflectance_warning)
         .collect()
 }
 
-/// A face's reflectance and emission from its material, or the defaults without one.
-fn surface_material(face: &Face, materials: &[tobj::Material]) -> (Rgb, Rgb) {
-    match face.material.and_then(|m| materials.get(m)) {
+/// A face's reflectance and emission from its material (an index into `materials`), or the defaults without one.
+fn surface_material(material: Option<usize>, materials: &[tobj::Material]) -> (Rgb, Rgb) {
+    match material.and_then(|m| materials.get(m)) {
         Some(m) => (
             m.diffuse
                 .map(|kd| Rgb::from(kd).map(clamp_reflectance))
@@ -285,28 +253,6 @@ fn surface_material(face: &Face, materials: &[tobj::Material]) -> (Rgb, Rgb) {
     }
 }
 
-/// Every face as a surface of its own, and a line saying merging was off.
-fn unmerged_surfaces(
-    faces: &[Face],
-    material_of: impl Fn(&Face) -> (Rgb, Rgb),
-) -> (Vec<Surface>, Option<String>) {
-    let line = (!faces.is_empty()).then(|| {
-        "coplanar faces were not merged (merging is off): every face is a surface".to_string()
-    });
-    let surfaces = faces
-        .iter()
-        .map(|f| {
-            let (reflectance, emission) = material_of(f);
-            Surface {
-                name: f.source.name.clone(),
-                polygon: f.polygon.clone(),
-                emission,
-                reflectance,
-            }
-        })
-        .collect();
-    (surfaces, line)
-}
 
 /// The scene's name: the file's stem.
 fn scene_name(path: &Path) -> String {
@@ -356,77 +302,4 @@ fn undefined_materials(lines: &SourceLines, materials: &[tobj::Material]) -> Opt
     )
 }
 
-/// The surfaces of `faces` with coplanar neighbours of one material merged, and a line saying
-/// what was merged.
-fn merged_surfaces(
-    faces: &[Face],
-    scene_diagonal: f64,
-    material_of: impl Fn(&Face) -> (Rgb, Rgb),
-) -> (Vec<Surface>, Option<String>) {
-    let polygons: Vec<_> = faces.iter().map(|f| f.polygon.clone()).collect();
-    let groups: Vec<usize> = faces
-        .iter()
-        .map(|f| f.material.map_or(0, |m| m + 1))
-        .collect();
-    let (pieces, summary) = merge_coplanar(&polygons, &groups, scene_diagonal);
-    let surfaces = pieces
-        .into_iter()
-        .filter_map(|piece| {
-            let first = &faces[*piece.faces.first()?];
-            let (reflectance, emission) = material_of(first);
-            Some(Surface {
-                name: first.source.name.clone(),
-                polygon: piece.polygon,
-                emission,
-                reflectance,
-            })
-        })
-        .collect();
-    let line = (summary.merged_faces > 0).then(|| {
-        let mut line = format!(
-            "merged {} coplanar faces into {} surfaces",
-            thousands(summary.merged_faces),
-            thousands(summary.merged_surfaces)
-        );
-        if summary.split_regions > 0 {
-            line += &format!(
-                "; {} regions of coplanar faces stay in several pieces (one polygon would have holes or \
-                 touch itself)",
-                thousands(summary.split_regions)
-            );
-        }
-        line
-    });
-    (surfaces, line)
-}
 
-/// Surfaces with unique names: a name already taken (object or material names with `/` can
-/// collide) gets `#2`, `#3`, ... appended.
-fn unique_names(mut surfaces: Vec<Surface>) -> (Vec<Surface>, Option<String>) {
-    let mut taken: HashSet<String> = surfaces.iter().map(|s| s.name.clone()).collect();
-    if taken.len() == surfaces.len() {
-        return (surfaces, None);
-    }
-    let mut seen: HashSet<String> = HashSet::new();
-    let mut renamed = Tally::default();
-    for surface in &mut surfaces {
-        if seen.insert(surface.name.clone()) {
-            continue;
-        }
-        let mut k = 2;
-        while taken.contains(&format!("{}#{k}", surface.name)) {
-            k += 1;
-        }
-        surface.name = format!("{}#{k}", surface.name);
-        taken.insert(surface.name.clone());
-        seen.insert(surface.name.clone());
-        renamed.note(&FaceSource {
-            name: surface.name.clone(),
-            line: None,
-        });
-    }
-    (
-        surfaces,
-        renamed.describe("renamed", "surfaces whose names were taken"),
-    )
-}

@@ -9,9 +9,9 @@ use std::collections::HashMap;
 
 use glam::DVec3;
 
-use super::repair::Face;
 use super::source_lines::SourceLines;
-use super::tally::{FaceSource, Tally};
+use crate::mesh_file::repair::Face;
+use crate::mesh_file::tally::{FaceSource, Tally};
 
 /// The material segment of names of faces that no `usemtl` covers.
 const NO_MATERIAL: &str = "no-material";

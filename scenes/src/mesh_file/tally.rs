@@ -29,7 +29,7 @@ pub(crate) struct Tally {
 }
 
 impl Tally {
-    pub(super) fn note(&mut self, source: &FaceSource) {
+    pub(crate) fn note(&mut self, source: &FaceSource) {
         self.count += 1;
         if self.examples.len() < EXAMPLES {
             self.examples.push(source.to_string());
@@ -39,7 +39,7 @@ impl Tally {
     /// `"{action} {count} {what} (first: a at line 3, b at line 9, ...)"` (no action when it is
     /// empty), or `None` when nothing was noted. `what` should read well after a count ("faces
     /// with zero area").
-    pub(super) fn describe(&self, action: &str, what: &str) -> Option<String> {
+    pub(crate) fn describe(&self, action: &str, what: &str) -> Option<String> {
         if self.count == 0 {
             return None;
         }

@@ -41,7 +41,7 @@ pub(crate) struct Repairs {
 }
 
 impl Repairs {
-    pub(super) fn warnings(&self) -> Vec<String> {
+    pub(crate) fn warnings(&self) -> Vec<String> {
         [
             self.repeated_corners
                 .describe("removed repeated corners from", "faces"),
