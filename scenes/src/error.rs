@@ -37,8 +37,19 @@ pub enum SceneError {
         /// What is wrong, with the line where it can be told.
         message: String,
     },
-    /// The file is neither `.json` nor `.obj`.
-    #[error("{}: unsupported file type; scenes are .json or .obj files", path.display())]
+    /// A glTF file or one of its buffers could not be read as a scene.
+    #[error("{}: {message}", path.display())]
+    Gltf {
+        /// The `.gltf` or `.glb` file.
+        path: PathBuf,
+        /// What is wrong, naming the node, mesh or accessor where it can be told.
+        message: String,
+    },
+    /// The file is none of `.json`, `.obj`, `.gltf` or `.glb`.
+    #[error(
+        "{}: unsupported file type; scenes are .json, .obj, .gltf or .glb files",
+        path.display()
+    )]
     UnsupportedFormat {
         /// The file.
         path: PathBuf,

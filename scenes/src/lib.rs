@@ -79,6 +79,7 @@ mod coplanar;
 mod error;
 pub mod extremes;
 mod frame;
+mod gltf_file;
 #[doc(hidden)]
 pub mod fuzzing;
 mod load;

@@ -1,4 +1,4 @@
-//! Loading scenes: built-in names, our JSON format, and OBJ+MTL.
+//! Loading scenes: built-in names, our JSON format, OBJ+MTL, and glTF 2.0.
 
 use std::path::{Path, PathBuf};
 
@@ -6,6 +6,7 @@ use glam::DVec3;
 
 use crate::builtin;
 use crate::error::SceneError;
+use crate::gltf_file;
 use crate::model::Scene;
 use crate::obj::{self, ObjOptions};
 use crate::validate::validate;
@@ -92,6 +93,7 @@ pub(crate) fn read_scene_file_with(
             Ok((scene, Vec::new()))
         }
         Some("obj") => obj::read_obj_with(path, options),
+        Some("gltf" | "glb") => gltf_file::read_gltf_with(path, options),
         _ => Err(SceneError::UnsupportedFormat {
             path: path.to_path_buf(),
         }),

@@ -231,6 +231,7 @@ impl Builder {
         };
         material.extensions = Some(json::extensions::material::Material {
             unlit: Some(json::extensions::material::Unlit {}),
+            ..Default::default()
         });
         self.root.push(material)
     }
