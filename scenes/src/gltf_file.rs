@@ -38,10 +38,7 @@ pub(crate) fn read_gltf_with(
         source,
     })?;
     let dir = path.parent().unwrap_or(Path::new("."));
-    let name = path
-        .file_stem()
-        .and_then(|s| s.to_str())
-        .unwrap_or("scene");
+    let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("scene");
     parse_gltf(&bytes, dir, name, options).map_err(|message| SceneError::Gltf {
         path: path.to_path_buf(),
         message,
@@ -56,6 +53,7 @@ pub(crate) fn parse_gltf(
     name: &str,
     options: &ObjOptions,
 ) -> Result<(Scene, Vec<String>), String> {
+    check_glb_length(bytes)?;
     let gltf::Gltf { document, blob } =
         gltf::Gltf::from_slice(bytes).map_err(|e| format!("not a valid glTF 2.0 file: {e}"))?;
     let buffers = buffers::read_buffers(&document, dir, blob)?;
@@ -107,6 +105,21 @@ pub(crate) fn parse_gltf(
         surfaces,
     };
     Ok((scene, warnings))
+}
+
+/// A GLB shorter than its header says was cut short: said so, rather than the parser's words.
+fn check_glb_length(bytes: &[u8]) -> Result<(), String> {
+    let Some(header) = bytes.get(..12).filter(|h| h.starts_with(b"glTF")) else {
+        return Ok(());
+    };
+    let declared = u32::from_le_bytes([header[8], header[9], header[10], header[11]]) as usize;
+    if declared > bytes.len() {
+        return Err(format!(
+            "the GLB header declares {declared} bytes, but the file holds {}: it is truncated",
+            bytes.len()
+        ));
+    }
+    Ok(())
 }
 
 /// The node tree's faces and camera, gathered depth first.
@@ -165,7 +178,8 @@ impl Walk<'_> {
         let what = |part: &str, accessor: usize| {
             format!(
                 "accessor {accessor} ({part} of mesh \"{}\" primitive {}, node \"{node}\")",
-                mesh.name().map_or_else(|| mesh.index().to_string(), str::to_string),
+                mesh.name()
+                    .map_or_else(|| mesh.index().to_string(), str::to_string),
                 primitive.index()
             )
         };
@@ -263,8 +277,7 @@ impl Walk<'_> {
         let forward = world.transform_vector3(DVec3::NEG_Z).normalize_or_zero();
         let up = world.transform_vector3(DVec3::Y);
         let fov_deg = f64::from(p.yfov()).to_degrees();
-        if forward == DVec3::ZERO || up.cross(forward).length_squared() == 0.0 || !(fov_deg > 0.0)
-        {
+        if forward == DVec3::ZERO || up.cross(forward).length_squared() == 0.0 || !(fov_deg > 0.0) {
             self.camera_warnings.push(format!(
                 "the camera of node \"{node}\" is scaled to nothing or has no field of view: \
                  the default view is used"
@@ -294,10 +307,7 @@ fn triangles(mode: Mode, order: &[u32]) -> Vec<[u32; 3]> {
         Mode::TriangleFan => (1..n.saturating_sub(1))
             .map(|k| [order[k], order[k + 1], order[0]])
             .collect(),
-        _ => order
-            .chunks_exact(3)
-            .map(|t| [t[0], t[1], t[2]])
-            .collect(),
+        _ => order.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect(),
     }
 }
 

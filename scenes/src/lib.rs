@@ -79,9 +79,9 @@ mod coplanar;
 mod error;
 pub mod extremes;
 mod frame;
-mod gltf_file;
 #[doc(hidden)]
 pub mod fuzzing;
+mod gltf_file;
 mod load;
 mod mesh_file;
 mod model;

@@ -230,8 +230,6 @@ fn library_warning(problem: &str) -> String {
     )
 }
 
-
-
 /// One warning per material of `used` whose `Kd` reaches 1, in material order.
 fn clamped_reflectance_warnings(used: &[usize], materials: &[tobj::Material]) -> Vec<String> {
     used.iter()
@@ -252,7 +250,6 @@ fn surface_material(material: Option<usize>, materials: &[tobj::Material]) -> (R
         None => (Rgb::splat(DEFAULT_REFLECTANCE), Rgb::ZERO),
     }
 }
-
 
 /// The scene's name: the file's stem.
 fn scene_name(path: &Path) -> String {
@@ -301,5 +298,3 @@ fn undefined_materials(lines: &SourceLines, materials: &[tobj::Material]) -> Opt
         ),
     )
 }
-
-

@@ -47,9 +47,10 @@ fn material(m: &gltf::Material) -> Material {
     if m.emissive_texture().is_some() {
         textures.push("emissiveTexture");
     }
-    let name = m
-        .name()
-        .map_or_else(|| format!("material{}", m.index().unwrap_or(0)), str::to_string);
+    let name = m.name().map_or_else(
+        || format!("material{}", m.index().unwrap_or(0)),
+        str::to_string,
+    );
     Material {
         name,
         reflectance: Rgb::from([r, g, b]).map(|c| if c >= 1.0 { MAX_OBJ_REFLECTANCE } else { c }),

@@ -95,7 +95,7 @@ enum Command {
         after_help = "Examples:\n  penumbra check my.json\n  penumbra check model.obj --no-merge"
     )]
     Check {
-        /// A .json or .obj file, or the name of a built-in scene.
+        /// A .json, .obj, .gltf or .glb file, or the name of a built-in scene.
         scene: String,
         /// OBJ files: keep every face as its own surface (by default coplanar adjacent faces of
         /// one material are merged where the union is a simple polygon).

@@ -137,7 +137,7 @@ impl From<IndirectArg> for penumbra_solver::estimate::IndirectEstimate {
 #[derive(clap::Args, Debug, Serialize, Deserialize)]
 #[command(after_help = EXAMPLES)]
 pub(crate) struct RunArgs {
-    /// A .json or .obj file, or the name of a built-in scene (see `penumbra scenes`).
+    /// A .json, .obj, .gltf or .glb file, or the name of a built-in scene (see `penumbra scenes`).
     #[arg(required_unless_present = "replay")]
     pub(crate) scene: Option<String>,
     /// Run again the run that wrote this report.json, with the options, scene and seed it

@@ -18,7 +18,7 @@ use crate::run_args::SolverArg;
     after_help = "Examples:\n  penumbra sweep textbook --direct-only                  exact direct light, four meshes, five budgets\n  penumbra sweep cornell --budgets 5000,10000,20000 --methods discontinuity \\\n      --solvers progressive,hierarchical                 solvers against a path-traced reference\n  penumbra sweep cornell --direct-only --surfaces floor  the floor's error alone"
 )]
 pub(crate) struct SweepArgs {
-    /// A .json or .obj file, or the name of a built-in scene.
+    /// A .json, .obj, .gltf or .glb file, or the name of a built-in scene.
     scene: String,
     /// Output directory.
     #[arg(long, default_value = "sweep")]
