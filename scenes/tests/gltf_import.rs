@@ -11,7 +11,7 @@ use serde_json::{Value, json};
 
 /// A .gltf whose one buffer (a data URI) holds `points` (f32) then `order` (u16), drawn as
 /// `mode` by a mesh that `nodes` place; `material` is the file's only material.
-fn gltf(points: &[[f32; 3]], order: &[u16], mode: u32, nodes: Value, material: Value) -> Value {
+fn gltf(points: &[[f32; 3]], order: &[u16], mode: u32, nodes: &Value, material: &Value) -> Value {
     let mut bytes: Vec<u8> = points
         .iter()
         .flatten()
@@ -76,7 +76,7 @@ fn strips_and_fans_are_their_triangles_each_facing_as_drawn() {
         [0.0, 1.0, 0.0],
     ];
     for (points, mode) in [(STRIP, 5), (fan, 6)] {
-        let document = gltf(&points, &[0, 1, 2, 3], mode, json!([{"mesh": 0}]), grey());
+        let document = gltf(&points, &[0, 1, 2, 3], mode, &json!([{"mesh": 0}]), &grey());
         let apart = load(&document, false).scene;
         assert_eq!(apart.surfaces.len(), 2, "mode {mode}");
         for s in &apart.surfaces {
@@ -91,7 +91,7 @@ fn strips_and_fans_are_their_triangles_each_facing_as_drawn() {
 
 #[test]
 fn a_mirroring_node_keeps_the_front_it_draws() {
-    let plain = gltf(&STRIP, &[0, 1, 2], 4, json!([{"mesh": 0}]), grey());
+    let plain = gltf(&STRIP, &[0, 1, 2], 4, &json!([{"mesh": 0}]), &grey());
     let front = load(&plain, true).scene.surfaces[0].normal();
     assert!((front - DVec3::Z).length() < 1e-12);
     // Mirrored in z, the front a viewer sees is the mirror image of +z.
@@ -99,8 +99,8 @@ fn a_mirroring_node_keeps_the_front_it_draws() {
         &STRIP,
         &[0, 1, 2],
         4,
-        json!([{"mesh": 0, "scale": [1, 1, -1]}]),
-        grey(),
+        &json!([{"mesh": 0, "scale": [1, 1, -1]}]),
+        &grey(),
     );
     let front = load(&mirrored, true).scene.surfaces[0].normal();
     assert!((front - DVec3::NEG_Z).length() < 1e-12);
@@ -120,7 +120,7 @@ fn transforms_compose_parent_first() {
         {"name": "parent", "children": [1], "translation": [0, 0, 2], "scale": [2, 2, 2]},
         {"name": "child", "mesh": 0, "rotation": quarter},
     ]);
-    let loaded = load(&gltf(&STRIP, &[0, 1, 2], 4, nodes, grey()), true);
+    let loaded = load(&gltf(&STRIP, &[0, 1, 2], 4, &nodes, &grey()), true);
     let s = &loaded.scene.surfaces[0];
     assert!(s.name.starts_with("child/grey/"), "{}", s.name);
     let expected = [
@@ -146,7 +146,7 @@ fn materials_give_reflectance_and_emission_as_documented() {
         "emissiveFactor": [1.0, 0.5, 0.25],
         "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 4.0}},
     });
-    let mut document = gltf(&STRIP, &[0, 1, 2], 4, json!([{"mesh": 0}]), light);
+    let mut document = gltf(&STRIP, &[0, 1, 2], 4, &json!([{"mesh": 0}]), &light);
     document["extensionsUsed"] = json!(["KHR_materials_emissive_strength"]);
     let loaded = load(&document, true);
     let s = &loaded.scene.surfaces[0];
@@ -173,7 +173,7 @@ fn materials_give_reflectance_and_emission_as_documented() {
 
 #[test]
 fn points_and_lines_are_skipped_with_a_warning() {
-    let mut document = gltf(&STRIP, &[0, 1, 2], 4, json!([{"mesh": 0}]), grey());
+    let mut document = gltf(&STRIP, &[0, 1, 2], 4, &json!([{"mesh": 0}]), &grey());
     let mut lines = document["meshes"][0]["primitives"][0].clone();
     lines["mode"] = json!(1);
     document["meshes"][0]["primitives"]
