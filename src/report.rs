@@ -4,9 +4,10 @@
 //! and `replay` read it ([`Report::parse`]), and `docs/schemas/report.schema.json` describes
 //! it (tests/schemas.rs checks that the two name the same fields).
 
+use glam::DVec3;
 use penumbra_meshing::discontinuity::{DiscontinuityStats, EventSet};
 use penumbra_meshing::{ElementBudget, MeshQuality};
-use penumbra_scenes::{Camera, Rgb};
+use penumbra_scenes::{Camera, LengthUnit, Rgb};
 use penumbra_solver::coupling::FormFactorMethod;
 use penumbra_solver::{SolveStats, SolverMethod, StopReason};
 use serde::{Deserialize, Serialize};
@@ -95,6 +96,13 @@ pub struct SceneSummary {
     pub emitters: usize,
     /// The diagonal of the scene's bounding box, in scene units.
     pub bounding_box_diagonal: f64,
+    /// Which way is up ([`penumbra_viz::scene_up`]), for exports; `None` in older reports.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub up: Option<DVec3>,
+    /// The unit of the coordinates (metres unless the scene or `--unit` says); `None` in older
+    /// reports.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub unit: Option<LengthUnit>,
 }
 
 /// How a run was made (`method` in `report.json`).
@@ -278,6 +286,8 @@ impl Report {
                 surfaces: scene.surfaces.len(),
                 emitters: scene.emitters().count(),
                 bounding_box_diagonal: scene.diagonal(),
+                up: Some(penumbra_viz::scene_up(scene)),
+                unit: Some(scene.unit.unwrap_or(LengthUnit::Metre)),
             },
             warnings: run_warnings(result, &energy, &mesh_quality),
             method: Method::of_run(result),

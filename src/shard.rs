@@ -73,6 +73,9 @@ pub struct SceneOrigin {
     /// The camera `--camera` gave, which replaced the scene's.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub camera: Option<penumbra_scenes::Camera>,
+    /// The unit `--unit` gave, which replaced the scene's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub unit: Option<penumbra_scenes::LengthUnit>,
 }
 
 /// [`SHARD_FILE`]: what a shard hands to [`merge`].

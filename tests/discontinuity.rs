@@ -353,6 +353,8 @@ fn complete_events_are_classified_by_what_each_side_sees() {
         let mut floor = regular(4, 20.0, DVec3::ZERO, 0.3);
         floor.reverse();
         let scene = Scene {
+            up: None,
+            unit: None,
             name: "parallel".into(),
             camera: None,
             surfaces: vec![

@@ -43,6 +43,8 @@ fn floor_scene(name: &str, solid: Vec<[DVec3; 3]>) -> Scene {
             .map(|(i, t)| Surface::new(format!("solid/{i}"), t.to_vec(), Rgb::splat(0.6))),
     );
     Scene {
+        up: None,
+        unit: None,
         name: name.into(),
         camera: None,
         surfaces,
@@ -364,6 +366,8 @@ fn lit_from_above_by_the_ceiling() -> Scene {
     let mut ceiling = quad(1.5, 1.0);
     ceiling.reverse();
     Scene {
+        up: None,
+        unit: None,
         name: "lit from above by the ceiling".into(),
         camera: None,
         surfaces: vec![
@@ -498,6 +502,8 @@ fn a_dim_surface_is_refined_like_a_bright_one() {
         ));
     }
     let scene = Scene {
+        up: None,
+        unit: None,
         name: "two-rooms".into(),
         camera: None,
         surfaces,

@@ -432,6 +432,8 @@ fn cuboid(name: &str, half: DVec3, turn: glam::DQuat, centre: DVec3) -> Vec<Surf
 
 fn scene_of(name: &str, surfaces: Vec<Surface>) -> Scene {
     Scene {
+        up: None,
+        unit: None,
         name: name.into(),
         camera: None,
         surfaces,

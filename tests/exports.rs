@@ -302,8 +302,9 @@ fn the_ply_export_reads_back_with_its_parser() {
     }
 }
 
-/// The GLB container and its glTF document: one triangle primitive with colours, a LINES
-/// primitive per discontinuity class holding its segments, accessors inside the buffer.
+/// The GLB container and its glTF document: a node and triangle primitive with colours per
+/// object (each surface of the Cornell box, whose names have no `/`), a LINES primitive per
+/// discontinuity class holding its segments, accessors inside the buffer, all under one root.
 #[test]
 fn the_glb_export_is_a_valid_gltf_document() {
     let dir = tempfile::tempdir().expect("temp dir");
@@ -330,11 +331,6 @@ fn the_glb_export_is_a_valid_gltf_document() {
         let end = view.byte_offset.map_or(0, |o| o.0) + view.byte_length.0;
         assert!(end as usize <= bin_len);
     }
-    let surfaces = &root.meshes[0];
-    assert_eq!(surfaces.primitives.len(), 1);
-    let primitive = &surfaces.primitives[0];
-    let indices = &root.accessors[primitive.indices.expect("indexed").value()];
-    assert_eq!(indices.count.0 as usize, 3 * count(&solution, "triangles"));
     let attribute = |p: &gltf_json::mesh::Primitive, name: &str| {
         let found = p
             .attributes
@@ -342,15 +338,37 @@ fn the_glb_export_is_a_valid_gltf_document() {
             .find(|(s, _)| serde_json::to_value(s).expect("a name") == name);
         root.accessors[found.expect(name).1.value()].count.0 as usize
     };
-    for name in ["POSITION", "NORMAL", "COLOR_0", "_RADIOSITY"] {
-        assert_eq!(
-            attribute(primitive, name),
-            count(&solution, "vertices"),
-            "{name}"
-        );
+    let (objects, rest) = root.meshes.split_at(root.meshes.len() - 1);
+    let names: Vec<&str> = objects.iter().filter_map(|m| m.name.as_deref()).collect();
+    let surfaces = solution["surfaces"].as_array().expect("surfaces");
+    let surface_names: Vec<&str> = surfaces.iter().filter_map(|s| s["name"].as_str()).collect();
+    assert_eq!(names, surface_names);
+    for (object, surface) in objects.iter().zip(surfaces) {
+        assert_eq!(object.primitives.len(), 1);
+        let primitive = &object.primitives[0];
+        let indices = &root.accessors[primitive.indices.expect("indexed").value()];
+        let triangles = surface["triangles"].as_array().expect("triangles").len();
+        assert_eq!(indices.count.0 as usize, 3 * triangles);
+        let vertices = surface["vertices"].as_array().expect("vertices").len();
+        for name in [
+            "POSITION",
+            "NORMAL",
+            "COLOR_0",
+            "_RADIOSITY",
+            "_DIRECT",
+            "_INDIRECT",
+        ] {
+            assert_eq!(attribute(primitive, name), vertices, "{name}");
+        }
     }
+    // One root: the objects' nodes and the lines' under it.
+    let scene = &root.scenes[root.scene.expect("a default scene").value()];
+    assert_eq!(scene.nodes.len(), 1);
+    let top = &root.nodes[scene.nodes[0].value()];
+    assert_eq!(top.children.as_ref().map(Vec::len), Some(root.meshes.len()));
     let by_order = segments_by_order(&solution);
-    let lines = &root.meshes[1].primitives;
+    assert_eq!(rest[0].name.as_deref(), Some("discontinuities"));
+    let lines = &rest[0].primitives;
     let classes: Vec<usize> = (0..3).filter(|&o| by_order[o] > 0).collect();
     assert_eq!(lines.len(), classes.len());
     for (p, &order) in lines.iter().zip(&classes) {

@@ -1,4 +1,4 @@
-//! The scene parsers and the validator: any bytes, read as JSON or as OBJ+MTL, give a scene, its
+//! The scene parsers and the validator: any bytes, read as JSON, OBJ+MTL or glTF, give a scene, its
 //! problems or an error, never a panic.
 #![no_main]
 

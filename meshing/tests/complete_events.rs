@@ -26,6 +26,8 @@ fn polygon(n: usize, radius: f64, (x, y, z): (f64, f64, f64), turn: f64, up: boo
 fn scene(light: &[DVec3], blocker: &[DVec3]) -> Scene {
     let grey = Rgb::splat(0.5);
     Scene {
+        up: None,
+        unit: None,
         name: "parallel".into(),
         camera: None,
         surfaces: vec![

@@ -42,6 +42,8 @@ fn rotated(polygon: &[DVec3], k: usize) -> Vec<DVec3> {
 
 fn scene_of(surfaces: Vec<Surface>) -> Scene {
     Scene {
+        up: None,
+        unit: None,
         name: "rotations".into(),
         camera: None,
         surfaces,

@@ -193,6 +193,8 @@ impl Scene {
             fov_deg,
         });
         let scene = SceneData {
+            up: None,
+            unit: None,
             name,
             camera,
             surfaces,

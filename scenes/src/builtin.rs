@@ -144,6 +144,8 @@ pub fn cornell() -> Scene {
         surfaces.extend(cornell_block(block, top, white));
     }
     Scene {
+        up: None,
+        unit: None,
         name: "cornell".into(),
         camera: Some(Camera {
             eye: v(278.0, 273.0, -800.0),
@@ -266,6 +268,8 @@ pub fn textbook() -> Scene {
     let mut light = square(3.0, 0.5);
     light.reverse(); // facing down
     Scene {
+        up: None,
+        unit: None,
         name: "textbook".into(),
         camera: upright(v(0.0, -6.5, 4.5), v(0.0, 0.0, 0.4), 45.0),
         surfaces: vec![
@@ -297,6 +301,8 @@ pub fn crossed_bars() -> Scene {
     let mut light = square(4.0, 0.5);
     light.reverse(); // facing down
     Scene {
+        up: None,
+        unit: None,
         name: "bars".into(),
         camera: upright(v(0.0, -7.5, 5.5), v(0.0, 0.0, 0.6), 45.0),
         surfaces: vec![
@@ -360,6 +366,8 @@ pub fn l_room_furnace(emission: f64, reflectance: f64) -> Scene {
         faces.push((format!("wall{i}"), facing(wall, point, false)));
     }
     Scene {
+        up: None,
+        unit: None,
         name: "furnace-l".into(),
         camera: upright(v(1.9, 0.1, 0.5), v(0.3, 1.7, 0.5), 90.0),
         surfaces: faces
@@ -434,6 +442,8 @@ pub fn closed_box(size: DVec3, emission: f64, reflectance: f64) -> Scene {
         ),
     ];
     Scene {
+        up: None,
+        unit: None,
         name: "box".into(),
         camera: None,
         surfaces: faces
@@ -518,6 +528,8 @@ pub fn boxworld(count: usize, seed: u64) -> Scene {
         }
     }
     Scene {
+        up: None,
+        unit: None,
         name: format!("boxworld-{count}"),
         camera: upright(
             v(center, -0.6 * side, 0.9 * height),

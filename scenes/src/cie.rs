@@ -106,6 +106,8 @@ pub fn area_source() -> Scene {
             .with_emission(Rgb::splat(SOURCE_EXITANCE)),
     ]);
     Scene {
+        up: None,
+        unit: None,
         name: "cie-5.3".into(),
         camera: Some(camera(ROOM)),
         surfaces,
@@ -118,6 +120,8 @@ pub fn floor_reflection() -> Scene {
     let mut surfaces = room_faces(ROOM, 0.0, true);
     surfaces[0].emission = Rgb::splat(FLOOR_EXITANCE);
     Scene {
+        up: None,
+        unit: None,
         name: "cie-5.6".into(),
         camera: Some(camera(ROOM)),
         surfaces,
@@ -148,6 +152,8 @@ pub fn reflecting_cube(reflectance: f64) -> Scene {
         }
     }
     Scene {
+        up: None,
+        unit: None,
         name: "cie-5.8".into(),
         camera: Some(camera(size)),
         surfaces,

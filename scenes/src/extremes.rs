@@ -72,6 +72,8 @@ fn box_faces(lo: DVec3, hi: DVec3, bottom: bool, inward: bool) -> Vec<Vec<DVec3>
 
 fn scene(name: &str, surfaces: Vec<Surface>) -> Scene {
     Scene {
+        up: None,
+        unit: None,
         name: name.into(),
         camera: None,
         surfaces,

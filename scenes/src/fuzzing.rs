@@ -10,18 +10,30 @@ use crate::color::Rgb;
 use crate::model::{Scene, Surface};
 use crate::{Problem, SceneError};
 
-/// Parses `data` as a scene file, JSON if its first byte is even, else OBJ (with an MTL after
-/// the first NUL byte), then validates it. Any input may be rejected; the result says how.
+/// Parses `data` as a scene file by its first byte modulo 3: JSON, OBJ (with an MTL after the
+/// first NUL byte) or glTF (JSON or GLB, its buffers inline), then validates it. Any input may
+/// be rejected; the result says how.
 pub fn parse_any(data: &[u8]) -> Result<Vec<Problem>, SceneError> {
     let Some((&kind, rest)) = data.split_first() else {
         return Ok(Vec::new());
     };
     let text = String::from_utf8_lossy(rest);
-    let scene = if kind % 2 == 0 {
-        crate::load::parse_json(&text, Path::new("fuzz.json"))?
-    } else {
-        let (obj, mtl) = text.split_once('\0').unwrap_or((&text, ""));
-        crate::obj::parse_obj_text(obj, mtl, Path::new("fuzz.obj"))?.0
+    let scene = match kind % 3 {
+        0 => crate::load::parse_json(&text, Path::new("fuzz.json"))?,
+        1 => {
+            let (obj, mtl) = text.split_once('\0').unwrap_or((&text, ""));
+            crate::obj::parse_obj_text(obj, mtl, Path::new("fuzz.obj"))?.0
+        }
+        _ => {
+            // Buffers named by a path are looked for where there are none.
+            let nowhere = Path::new("/nonexistent/penumbra-fuzz");
+            crate::gltf_file::parse_gltf(rest, nowhere, "fuzz", &Default::default())
+                .map_err(|message| SceneError::Gltf {
+                    path: "fuzz.glb".into(),
+                    message,
+                })?
+                .0
+        }
     };
     Ok(crate::validate(&scene))
 }
@@ -57,6 +69,8 @@ pub fn scene_from_bytes(data: &[u8]) -> Option<Scene> {
         surfaces.push(surface);
     }
     (!surfaces.is_empty()).then(|| Scene {
+        up: None,
+        unit: None,
         name: "fuzz".into(),
         camera: None,
         surfaces,

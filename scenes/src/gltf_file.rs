@@ -24,7 +24,7 @@ use crate::error::SceneError;
 use crate::mesh_file::into_surfaces;
 use crate::mesh_file::repair::Face;
 use crate::mesh_file::tally::{FaceSource, Tally};
-use crate::model::{Camera, Scene};
+use crate::model::{Camera, LengthUnit, Scene};
 use crate::obj::ObjOptions;
 use accessors::Buffers;
 
@@ -54,8 +54,9 @@ pub(crate) fn parse_gltf(
     options: &ObjOptions,
 ) -> Result<(Scene, Vec<String>), String> {
     check_glb_length(bytes)?;
-    let gltf::Gltf { document, blob } =
-        gltf::Gltf::from_slice(bytes).map_err(|e| format!("not a valid glTF 2.0 file: {e}"))?;
+    let gltf::Gltf { document, blob } = gltf::Gltf::from_slice_without_validation(bytes)
+        .map_err(|e| format!("not a valid glTF 2.0 file: {e}"))?;
+    validate(&document)?;
     let buffers = buffers::read_buffers(&document, dir, blob)?;
     let scene = document
         .default_scene()
@@ -100,11 +101,59 @@ pub(crate) fn parse_gltf(
     });
     warnings.extend(made);
     let scene = Scene {
+        up: Some(DVec3::Y),
+        unit: Some(LengthUnit::Metre),
         name: name.to_string(),
         camera: walk.camera,
         surfaces,
     };
     Ok((scene, warnings))
+}
+
+/// The document's references checked, as the format requires, but for positions' `min` and
+/// `max`: some exporters leave them out, and they are not read here.
+fn validate(document: &gltf::Document) -> Result<(), String> {
+    use gltf::json::validation::Validate;
+    let root = document.as_json();
+    // gltf-json's own check of positions' bounds looks their accessor up unchecked.
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            for (semantic, accessor) in &primitive.attributes {
+                if accessor.value() >= root.accessors.len() {
+                    let semantic = match semantic {
+                        gltf::json::validation::Checked::Valid(s) => format!("{s:?}"),
+                        gltf::json::validation::Checked::Invalid => "an attribute".to_string(),
+                    };
+                    return Err(format!(
+                        "not a valid glTF 2.0 file: mesh {m} primitive {p} names accessor {} for \
+                         {semantic}, but the file has {}",
+                        accessor.value(),
+                        root.accessors.len()
+                    ));
+                }
+            }
+        }
+    }
+    let mut problems = Vec::new();
+    root.validate(root, gltf::json::Path::new, &mut |path, error| {
+        problems.push((path(), error));
+    });
+    let bounds_missing = |path: &str, e: &gltf::json::validation::Error| {
+        *e == gltf::json::validation::Error::Missing
+            && (path.ends_with(".min") || path.ends_with(".max"))
+    };
+    let problems: Vec<String> = problems
+        .iter()
+        .filter(|(path, e)| !bounds_missing(path.as_str(), e))
+        .map(|(path, e)| format!("{}: {e}", path.as_str()))
+        .collect();
+    if problems.is_empty() {
+        return Ok(());
+    }
+    Err(format!(
+        "not a valid glTF 2.0 file: {}",
+        problems.join("; ")
+    ))
 }
 
 /// A GLB shorter than its header says was cut short: said so, rather than the parser's words.

@@ -99,7 +99,7 @@ pub use color::Rgb;
 pub use error::SceneError;
 pub use frame::PlaneFrame;
 pub use load::{LoadedScene, load_scene, load_scene_with, parse_json, read_scene_file, to_json};
-pub use model::{Bounds, Camera, Scene, Surface, SurfaceId};
+pub use model::{Bounds, Camera, LengthUnit, Scene, Surface, SurfaceId};
 pub use obj::{MAX_OBJ_REFLECTANCE, ObjOptions, parse_obj_text, parse_obj_text_with};
 pub use rng::SplitMix64;
 pub use union_find::UnionFind;

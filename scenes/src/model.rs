@@ -21,8 +21,86 @@ pub struct Scene {
     /// The view to render; without one, a default camera frames the scene.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub camera: Option<Camera>,
+    /// Which way is up, for views and exports: glTF files are +y up; without it, +y when the
+    /// lights face −y (as in most OBJ files), else +z.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub up: Option<DVec3>,
+    /// The unit of the coordinates, for exports to formats that fix one (glTF: metres);
+    /// without it, metres.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub unit: Option<LengthUnit>,
     /// The polygons, in the order their [`SurfaceId`]s count.
     pub surfaces: Vec<Surface>,
+}
+
+/// A unit of length, written as its symbol.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum LengthUnit {
+    /// Micrometres.
+    #[serde(rename = "um")]
+    Micrometre,
+    /// Millimetres.
+    #[serde(rename = "mm")]
+    Millimetre,
+    /// Centimetres.
+    #[serde(rename = "cm")]
+    Centimetre,
+    /// Metres.
+    #[serde(rename = "m")]
+    Metre,
+    /// Kilometres.
+    #[serde(rename = "km")]
+    Kilometre,
+    /// Inches.
+    #[serde(rename = "in")]
+    Inch,
+    /// Feet.
+    #[serde(rename = "ft")]
+    Foot,
+}
+
+impl LengthUnit {
+    /// Every unit, in the order above.
+    pub const ALL: [LengthUnit; 7] = [
+        LengthUnit::Micrometre,
+        LengthUnit::Millimetre,
+        LengthUnit::Centimetre,
+        LengthUnit::Metre,
+        LengthUnit::Kilometre,
+        LengthUnit::Inch,
+        LengthUnit::Foot,
+    ];
+
+    /// Its length in metres.
+    pub fn metres(self) -> f64 {
+        match self {
+            LengthUnit::Micrometre => 1e-6,
+            LengthUnit::Millimetre => 1e-3,
+            LengthUnit::Centimetre => 1e-2,
+            LengthUnit::Metre => 1.0,
+            LengthUnit::Kilometre => 1e3,
+            LengthUnit::Inch => 0.0254,
+            LengthUnit::Foot => 0.3048,
+        }
+    }
+
+    /// Its symbol, as scene files write it.
+    pub fn symbol(self) -> &'static str {
+        match self {
+            LengthUnit::Micrometre => "um",
+            LengthUnit::Millimetre => "mm",
+            LengthUnit::Centimetre => "cm",
+            LengthUnit::Metre => "m",
+            LengthUnit::Kilometre => "km",
+            LengthUnit::Inch => "in",
+            LengthUnit::Foot => "ft",
+        }
+    }
+
+    /// The unit whose symbol is `symbol`.
+    pub fn from_symbol(symbol: &str) -> Option<LengthUnit> {
+        LengthUnit::ALL.into_iter().find(|u| u.symbol() == symbol)
+    }
 }
 
 /// One planar, simple polygon. Vertices run counter-clockwise seen from the front; light leaves

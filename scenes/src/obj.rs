@@ -144,6 +144,8 @@ fn parse(
     warnings.extend(made);
     Ok((
         Scene {
+            up: None,
+            unit: None,
             name: scene_name(path),
             camera: None,
             surfaces,

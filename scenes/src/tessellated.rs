@@ -158,6 +158,8 @@ pub fn tessellated(n: usize) -> Scene {
             .map(|(i, f)| Surface::new(format!("prism/{i}"), f, grey)),
     );
     Scene {
+        up: None,
+        unit: None,
         name: format!("tessellated-{n}"),
         camera: None,
         surfaces,

@@ -112,6 +112,8 @@ pub enum ProblemKind {
         /// Why, and what to change.
         reason: &'static str,
     },
+    /// The scene's up direction is zero or not finite.
+    BadUp,
 }
 
 impl fmt::Display for Problem {
@@ -183,6 +185,10 @@ impl fmt::Display for Problem {
                  a material with a positive Ke)"
             ),
             BadCamera { reason } => write!(f, "camera: {reason}"),
+            BadUp => write!(
+                f,
+                "up: the direction is zero or not finite; give a direction such as [0, 0, 1]"
+            ),
         }
     }
 }
@@ -242,6 +248,14 @@ pub fn validate(scene: &Scene) -> Vec<Problem> {
         problems.push(Problem {
             surface: None,
             kind: ProblemKind::BadCamera { reason },
+        });
+    }
+    if let Some(up) = scene.up
+        && !(up.is_finite() && up.length() > 0.0)
+    {
+        problems.push(Problem {
+            surface: None,
+            kind: ProblemKind::BadUp,
         });
     }
     problems

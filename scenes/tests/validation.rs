@@ -25,6 +25,8 @@ fn base() -> Scene {
     let mut light = square("light", 2.0);
     light.polygon.reverse();
     Scene {
+        up: None,
+        unit: None,
         name: "t".into(),
         camera: None,
         surfaces: vec![light.with_emission(Rgb::splat(1.0)), square("floor", 0.0)],

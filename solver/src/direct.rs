@@ -1594,6 +1594,8 @@ mod tests {
             surfaces.push(Surface::new(format!("chip {k}"), corners, grey));
         }
         let scene = Scene {
+            up: None,
+            unit: None,
             name: "roof".into(),
             camera: None,
             surfaces,

@@ -200,6 +200,8 @@ fn open_room_with_sphere() -> Scene {
             .map(|(i, t)| Surface::new(format!("sphere/{i}"), t.to_vec(), Rgb::splat(0.64))),
     );
     Scene {
+        up: None,
+        unit: None,
         name: "open room with a sphere".into(),
         camera: None,
         surfaces,

@@ -36,6 +36,8 @@ fn exported_room(turn: usize) -> Scene {
         Surface::new(name, polygon, Rgb::splat(0.5))
     };
     Scene {
+        up: None,
+        unit: None,
         name: "exported room".into(),
         camera: None,
         surfaces: vec![

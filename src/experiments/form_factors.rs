@@ -341,6 +341,8 @@ fn rectangle(
 /// A receiver square of half-side `half` about the origin, facing +z, and one target.
 fn point_scene(target: Surface, half: f64) -> Scene {
     Scene {
+        up: None,
+        unit: None,
         name: "form factor".into(),
         camera: None,
         surfaces: vec![

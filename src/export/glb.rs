@@ -1,13 +1,22 @@
 //! `solution.glb`: glTF 2.0 binary, which browsers (three.js, Babylon.js) and Blender read.
 //!
-//! One unlit mesh of every surface (`KHR_materials_unlit`): positions, normals and `COLOR_0`,
-//! the linear display value of `render.png` ((radiosity + ρ·ambient) × exposure, clamped to
-//! [0, 1]: a glTF viewer's sRGB output then shows the render's colours), and `_RADIOSITY`, the
-//! radiosity in W/m². Then one mesh of discontinuity lines, a `LINES` primitive per class (D0,
-//! D1, D2: the derivative that jumps), coloured by boundary as the SVGs are. Everything is in
-//! `f32` (glTF allows nothing wider) and in the scene's units and axes.
+//! A node per object of the scene, named as it: the surfaces' names up to their last two `/`
+//! (OBJ and glTF surfaces are named `object/material/index`), or a surface's whole name. Each
+//! holds an unlit mesh (`KHR_materials_unlit`) of its surfaces: positions, normals and
+//! `COLOR_0`, the linear display value of `render.png` ((radiosity + ρ·ambient) × exposure,
+//! clamped to [0, 1]: a glTF viewer's sRGB output then shows the render's colours), and the
+//! light in W/m²: `_RADIOSITY`, its `_DIRECT` part (ρ·H of the light straight from the
+//! emitters) and `_INDIRECT` (the rest of the reflected light). Then one mesh of discontinuity
+//! lines, a `LINES` primitive per class (D0, D1, D2: the derivative that jumps), coloured by
+//! boundary as the SVGs are. Everything is in `f32` (glTF allows nothing wider), in the scene's
+//! coordinates, under one root node that turns them into glTF's frame: the scene's up to +y,
+//! and its unit to metres ([`Frame`]). A glTF scene's frame is glTF's, so its root node does
+//! nothing and the export overlays the file it came from.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
+
+use glam::{DQuat, DVec3};
+use penumbra_scenes::LengthUnit;
 
 use gltf_json as json;
 use json::validation::Checked::Valid;
@@ -17,12 +26,46 @@ use json::{Index, Root};
 use super::mesh::FlatMesh;
 use super::{Display, ExportError, line_colour};
 
-/// The file's bytes.
-pub fn glb(mesh: &FlatMesh, display: &Display) -> Result<Vec<u8>, ExportError> {
+/// Where the scene stands in glTF's frame (metres, +y up).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Frame {
+    /// Which way is up in the scene; `None` keeps its axes.
+    pub up: Option<DVec3>,
+    /// The unit of its coordinates; `None` is metres.
+    pub unit: Option<LengthUnit>,
+}
+
+impl Frame {
+    /// The root node's rotation (the scene's up to +y) and uniform scale (to metres), each
+    /// `None` where it would do nothing.
+    fn transform(self) -> (Option<[f32; 4]>, Option<f32>) {
+        let rotation = self
+            .up
+            .and_then(|u| u.try_normalize())
+            .map(|u| DQuat::from_rotation_arc(u, DVec3::Y))
+            .filter(|q| !q.abs_diff_eq(DQuat::IDENTITY, 0.0))
+            .map(|q| q.as_quat().to_array());
+        let scale = self.unit.map(|u| u.metres() as f32).filter(|&s| s != 1.0);
+        (rotation, scale)
+    }
+}
+
+/// The file's bytes: `names` are the surfaces', in the order of `mesh`.
+pub fn glb(
+    mesh: &FlatMesh,
+    names: &[&str],
+    display: &Display,
+    frame: Frame,
+) -> Result<Vec<u8>, ExportError> {
     let mut gltf = Builder::default();
-    let surfaces = surface_primitive(&mut gltf, mesh, display);
-    let surfaces = gltf.mesh("surfaces", vec![surfaces]);
-    let mut nodes = vec![gltf.node("surfaces", surfaces)];
+    let material = gltf.unlit("surfaces");
+    let mut nodes = Vec::new();
+    for (object, surfaces) in objects(names) {
+        let part = mesh.part(&surfaces);
+        let primitive = surface_primitive(&mut gltf, &part, display, material);
+        let object_mesh = gltf.mesh(object, vec![primitive]);
+        nodes.push(gltf.node(object, object_mesh));
+    }
     let mut classes = Vec::new();
     for (class, lines) in mesh.lines_by_class() {
         let positions: Vec<[f32; 3]> = lines
@@ -57,14 +100,42 @@ pub fn glb(mesh: &FlatMesh, display: &Display) -> Result<Vec<u8>, ExportError> {
         let lines = gltf.mesh("discontinuities", classes);
         nodes.push(gltf.node("discontinuities", lines));
     }
-    gltf.finish(nodes)
+    let (rotation, scale) = frame.transform();
+    let root = gltf.root.push(json::Node {
+        name: Some("penumbra solution".into()),
+        children: Some(nodes),
+        rotation: rotation.map(json::scene::UnitQuaternion),
+        scale: scale.map(|s| [s; 3]),
+        ..Default::default()
+    });
+    gltf.finish(vec![root])
 }
 
-/// The triangles of every surface, as one primitive.
+/// The scene's objects in the order they first appear, each with its surfaces: an object is a
+/// surface's name up to its last two `/` (`object/material/index`), or the whole name.
+fn objects<'n>(names: &[&'n str]) -> Vec<(&'n str, Vec<usize>)> {
+    let mut order: Vec<(&str, Vec<usize>)> = Vec::new();
+    let mut index: HashMap<&str, usize> = HashMap::new();
+    for (s, name) in names.iter().enumerate() {
+        let object = match name.rsplitn(3, '/').nth(2) {
+            Some(object) if !object.is_empty() => object,
+            _ => name,
+        };
+        let k = *index.entry(object).or_insert_with(|| {
+            order.push((object, Vec::new()));
+            order.len() - 1
+        });
+        order[k].1.push(s);
+    }
+    order
+}
+
+/// The triangles of every surface of `mesh`, as one primitive.
 fn surface_primitive(
     gltf: &mut Builder,
     mesh: &FlatMesh,
     display: &Display,
+    material: Index<json::Material>,
 ) -> json::mesh::Primitive {
     let f32s = |v: &[f64; 3]| v.map(|c| c as f32);
     let positions: Vec<[f32; 3]> = mesh.positions.iter().map(f32s).collect();
@@ -74,6 +145,8 @@ fn surface_primitive(
         .map(|c| c.map(|c| c as f32))
         .collect();
     let radiosity: Vec<[f32; 3]> = mesh.radiosity.iter().map(f32s).collect();
+    let direct: Vec<[f32; 3]> = mesh.direct.iter().map(f32s).collect();
+    let indirect: Vec<[f32; 3]> = mesh.indirect.iter().map(f32s).collect();
     let attributes = BTreeMap::from([
         (
             Valid(json::mesh::Semantic::Positions),
@@ -91,9 +164,16 @@ fn surface_primitive(
             Valid(json::mesh::Semantic::Extras("RADIOSITY".into())),
             gltf.vec3(&radiosity, "_RADIOSITY", false),
         ),
+        (
+            Valid(json::mesh::Semantic::Extras("DIRECT".into())),
+            gltf.vec3(&direct, "_DIRECT", false),
+        ),
+        (
+            Valid(json::mesh::Semantic::Extras("INDIRECT".into())),
+            gltf.vec3(&indirect, "_INDIRECT", false),
+        ),
     ]);
     let indices = gltf.indices(&mesh.triangles);
-    let material = gltf.unlit("surfaces");
     json::mesh::Primitive {
         attributes,
         extensions: None,
@@ -111,13 +191,13 @@ fn vertex_normals(mesh: &FlatMesh) -> Vec<[f32; 3]> {
     let mut normals = Vec::with_capacity(mesh.positions.len());
     for s in 0..mesh.vertex_offsets.len() - 1 {
         let triangles = &mesh.triangles[mesh.triangle_offsets[s]..mesh.triangle_offsets[s + 1]];
-        let p = |i: u32| glam::DVec3::from_array(mesh.positions[i as usize]);
+        let p = |i: u32| DVec3::from_array(mesh.positions[i as usize]);
         let normal = triangles
             .iter()
             .map(|t| (p(t[1]) - p(t[0])).cross(p(t[2]) - p(t[0])))
             .max_by(|a, b| a.length_squared().total_cmp(&b.length_squared()))
             .and_then(|n| n.try_normalize())
-            .unwrap_or(glam::DVec3::Z);
+            .unwrap_or(DVec3::Z);
         let count = mesh.vertex_offsets[s + 1] - mesh.vertex_offsets[s];
         normals.extend(std::iter::repeat_n(normal.as_vec3().to_array(), count));
     }

@@ -179,6 +179,44 @@ impl FlatMesh {
         })
     }
 
+    /// The surfaces `surfaces` alone (indices into this mesh's, in the order given), their
+    /// vertices and triangles numbered anew; without lines or error indicators.
+    pub fn part(&self, surfaces: &[usize]) -> FlatMesh {
+        let mut part = FlatMesh {
+            vertex_offsets: vec![0],
+            triangle_offsets: vec![0],
+            ..FlatMesh::default()
+        };
+        for (k, &s) in surfaces.iter().enumerate() {
+            let vertices = self.vertex_offsets[s]..self.vertex_offsets[s + 1];
+            let triangles = self.triangle_offsets[s]..self.triangle_offsets[s + 1];
+            // Vertex numbers fit in u32 here as they did in the whole.
+            let shift = (part.positions.len() as u32).wrapping_sub(vertices.start as u32);
+            let k = k as u32;
+            part.positions
+                .extend_from_slice(&self.positions[vertices.clone()]);
+            part.radiosity
+                .extend_from_slice(&self.radiosity[vertices.clone()]);
+            part.direct
+                .extend_from_slice(&self.direct[vertices.clone()]);
+            part.indirect
+                .extend_from_slice(&self.indirect[vertices.clone()]);
+            part.vertex_surface
+                .extend(std::iter::repeat_n(k, vertices.len()));
+            part.reflectance.push(self.reflectance[s]);
+            part.triangles.extend(
+                self.triangles[triangles.clone()]
+                    .iter()
+                    .map(|t| t.map(|i| i.wrapping_add(shift))),
+            );
+            part.triangle_surface
+                .extend(std::iter::repeat_n(k, triangles.len()));
+            part.vertex_offsets.push(part.positions.len());
+            part.triangle_offsets.push(part.triangles.len());
+        }
+        part
+    }
+
     /// The reflectance of vertex `v`'s surface.
     pub fn reflectance_at(&self, v: usize) -> [f64; 3] {
         self.reflectance[self.vertex_surface[v] as usize]

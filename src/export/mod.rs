@@ -329,7 +329,18 @@ pub fn export(
         match format {
             ExportFormat::Vtp => files.push(("solution.vtp".into(), vtp::vtp(&mesh))),
             ExportFormat::Ply => files.push(("solution.ply".into(), ply::ply(&mesh, &display)?)),
-            ExportFormat::Glb => files.push(("solution.glb".into(), glb::glb(&mesh, &display)?)),
+            ExportFormat::Glb => {
+                let names: Vec<&str> = source.surfaces.iter().map(|s| s.name.as_str()).collect();
+                let scene = &source.report.scene;
+                let frame = glb::Frame {
+                    up: scene.up,
+                    unit: scene.unit,
+                };
+                files.push((
+                    "solution.glb".into(),
+                    glb::glb(&mesh, &names, &display, frame)?,
+                ));
+            }
             ExportFormat::Obj => {
                 let (obj, mtl) = obj::obj(&mesh, &source.surfaces, &display);
                 files.push(("solution.obj".into(), obj.into_bytes()));

@@ -182,7 +182,7 @@ def test_plyfile_reads_positions_colours_and_quality(request, run):
 
 
 @pytest.mark.parametrize("run", ["exported", "direct"])
-def test_pygltflib_reads_the_mesh_and_a_lines_primitive_per_class(request, run):
+def test_pygltflib_reads_a_mesh_per_object_and_a_lines_primitive_per_class(request, run):
     out, solution = request.getfixturevalue(run)
     gltf = pygltflib.GLTF2().load(str(out / "solution.glb"))
     blob = gltf.binary_blob()
@@ -194,19 +194,29 @@ def test_pygltflib_reads_the_mesh_and_a_lines_primitive_per_class(request, run):
         values = np.frombuffer(blob, dtype=dtype, count=accessor.count * width, offset=start)
         return values.reshape(accessor.count, width) if width > 1 else values
 
-    surfaces, lines = gltf.meshes
-    (triangles,) = surfaces.primitives
-    assert triangles.mode == pygltflib.TRIANGLES
+    *objects, lines = gltf.meshes
+    assert lines.name == "discontinuities"
+    # The Cornell box's surface names have no `/`: each surface is an object of its own.
+    assert [m.name for m in objects] == [s["name"] for s in json.loads((out / "solution.json").read_text())["surfaces"]]
     assert "KHR_materials_unlit" in gltf.extensionsUsed
-    positions = read(triangles.attributes.POSITION, "<f4", 3)
-    assert np.array_equal(positions, solution.vertices.astype(np.float32))
-    radiosity = read(getattr(triangles.attributes, "_RADIOSITY"), "<f4", 3)
-    assert np.array_equal(radiosity, solution.radiosity.astype(np.float32))
-    colour = read(triangles.attributes.COLOR_0, "<f4", 3)
+    parts: dict[str, list] = {}
+    offset = 0
+    for mesh in objects:
+        (triangles,) = mesh.primitives
+        assert triangles.mode == pygltflib.TRIANGLES
+        attributes = triangles.attributes
+        for name in ("POSITION", "COLOR_0", "_RADIOSITY", "_DIRECT", "_INDIRECT"):
+            parts.setdefault(name, []).append(read(getattr(attributes, name), "<f4", 3))
+        parts.setdefault("indices", []).append(read(triangles.indices, "<u4", 1).reshape(-1, 3) + offset)
+        offset += gltf.accessors[attributes.POSITION].count
+    whole = {name: np.concatenate(values) for name, values in parts.items()}
+    assert np.array_equal(whole["POSITION"], solution.vertices.astype(np.float32))
+    assert np.array_equal(whole["_RADIOSITY"], solution.radiosity.astype(np.float32))
+    assert np.array_equal(whole["_DIRECT"], solution.direct.astype(np.float32))
+    assert np.array_equal(whole["_INDIRECT"], solution.indirect.astype(np.float32))
     linear = np.clip(solution.shown() * solution.exposure, 0, 1)
-    assert np.array_equal(colour, linear.astype(np.float32))
-    indices = read(triangles.indices, "<u4", 1).reshape(-1, 3)
-    assert np.array_equal(indices, solution.triangles)
+    assert np.array_equal(whole["COLOR_0"], linear.astype(np.float32))
+    assert np.array_equal(whole["indices"], solution.triangles)
     classes = {p.extras["class"]: p for p in lines.primitives}
     assert sorted(classes) == ["D0", "D1", "D2"]
     for order in range(3):
@@ -223,8 +233,8 @@ def test_trimesh_loads_the_glb_as_a_scene(exported):
     scene = trimesh.load(str(out / "solution.glb"))
     meshes = [g for g in scene.geometry.values() if isinstance(g, trimesh.Trimesh)]
     paths = [g for g in scene.geometry.values() if not isinstance(g, trimesh.Trimesh)]
-    assert len(meshes) == 1 and len(paths) == 3
-    (mesh,) = meshes
+    assert len(meshes) == 17 and len(paths) == 3  # a mesh per surface of the Cornell box
+    mesh = trimesh.util.concatenate(meshes)
     assert len(mesh.faces) == len(solution.triangles)
     # trimesh merges nothing it was not asked to: the vertex count is the solution's.
     assert len(mesh.vertices) == len(solution.vertices)

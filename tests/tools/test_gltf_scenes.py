@@ -136,3 +136,63 @@ def test_a_broken_file_exits_2_naming_what_is_wrong(penumbra_cli, cornell_json, 
             assert words in done.stderr, (command, done.stderr)
         assert "panicked" not in done.stderr
     assert not (tmp_path / "out").exists()
+
+
+def _validate(path: Path) -> None:
+    node = shutil.which("node")
+    assert node, "the glTF validator runs on Node.js"
+    script = Path(__file__).with_name("validate_gltf.js")
+    done = subprocess.run([node, str(script), str(path)], capture_output=True, text=True, check=True)
+    issues = json.loads(done.stdout)
+    assert issues["numErrors"] == 0 and issues["numWarnings"] == 0, issues["messages"]
+
+
+def _mesh_bounds(path: Path) -> np.ndarray:
+    """The box around the triangles of a .glb, in its world frame (node transforms applied)."""
+    import trimesh
+
+    scene = trimesh.load(str(path))
+    meshes = [
+        g.copy().apply_transform(scene.graph.get(node)[0])
+        for node in scene.graph.nodes_geometry
+        if isinstance((g := scene.geometry[scene.graph.get(node)[1]]), trimesh.Trimesh)
+    ]
+    return trimesh.util.concatenate(meshes).bounds
+
+
+def test_the_export_of_a_gltf_scene_overlays_it(penumbra_cli, cornell_json, tmp_path):
+    document, binary = blender_like.gltf_document(cornell_json, 0.001)
+    (tmp_path / "cornell.glb").write_bytes(blender_like.glb(document, binary))
+    done = run(penumbra_cli, "run", "cornell.glb", "--out", "out", "--quiet", "--export", "glb", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    exported = tmp_path / "out" / "solution.glb"
+    _validate(exported)
+    assert np.allclose(_mesh_bounds(exported), _mesh_bounds(tmp_path / "cornell.glb"), atol=1e-6)
+    import pygltflib
+
+    names = {n.name for n in pygltflib.GLTF2().load(str(exported)).nodes}
+    assert {n["name"] for n in document["nodes"] if "mesh" in n} <= names
+
+
+def test_a_z_up_scene_in_millimetres_exports_in_metres_with_y_up(penumbra_cli, cornell_json, tmp_path):
+    # The Cornell box turned +z up, (x, y, z) -> (x, -z, y), in millimetres.
+    turn = lambda p: [p[0], -p[2], p[1]]
+    scene = json.loads(json.dumps(cornell_json))
+    for s in scene["surfaces"]:
+        s["polygon"] = [turn(p) for p in s["polygon"]]
+    camera = scene["camera"]
+    for key in ("eye", "target", "up"):
+        camera[key] = turn(camera[key])
+    scene["unit"] = "mm"
+    scene["up"] = [0, 0, 1]
+    (tmp_path / "z-up.json").write_text(json.dumps(scene))
+    document, binary = blender_like.gltf_document(cornell_json, 0.001)
+    (tmp_path / "cornell.glb").write_bytes(blender_like.glb(document, binary))
+    done = run(penumbra_cli, "run", "z-up.json", "--out", "out", "--quiet", "--export", "glb", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    report = json.loads((tmp_path / "out" / "report.json").read_text())
+    assert report["scene"]["up"] == [0, 0, 1] and report["scene"]["unit"] == "mm"
+    exported = tmp_path / "out" / "solution.glb"
+    _validate(exported)
+    # It lands where the +y-up box in metres stands.
+    assert np.allclose(_mesh_bounds(exported), _mesh_bounds(tmp_path / "cornell.glb"), atol=1e-6)

@@ -1,6 +1,6 @@
 //! The camera: a default view that frames a scene, and the pinhole projection to pixels.
 
-use glam::{DVec2, DVec3};
+use glam::{DQuat, DVec2, DVec3};
 use penumbra_scenes::{Camera, Scene};
 
 use crate::error::VizError;
@@ -13,9 +13,10 @@ pub const DEFAULT_VIEW_DIRECTION: DVec3 = DVec3::new(0.3, -1.0, 0.6);
 
 /// A camera that frames the scene's bounding box: it looks at the box's centre from
 /// [`DEFAULT_VIEW_DIRECTION`], far enough that the box's bounding sphere fits the vertical field
-/// of view ([`DEFAULT_FOV_DEG`]), with +z up (never parallel to that direction). A scene whose
-/// lights face -y (the +y-up convention of OBJ files) is seen the same way with +y up and +z to
-/// the front. An empty scene gets a view of the unit sphere about the origin.
+/// of view ([`DEFAULT_FOV_DEG`]), with +z up (never parallel to that direction). A scene with
+/// another up ([`scene_up`]: its own, or +y when its lights face -y, the convention of OBJ
+/// files) is seen the same way turned to it: with +y up, from +z. An empty scene gets a view of
+/// the unit sphere about the origin.
 pub fn default_camera(scene: &Scene) -> Camera {
     let bounds = scene.bounds();
     let diagonal = bounds.diagonal();
@@ -27,15 +28,9 @@ pub fn default_camera(scene: &Scene) -> Camera {
     } else {
         (DVec3::ZERO, 1.0)
     };
-    let d = DEFAULT_VIEW_DIRECTION;
     let up = scene_up(scene);
-    let direction = if up == DVec3::Y {
-        // z up, -y front turned into y up, +z front.
-        DVec3::new(d.x, d.z, -d.y)
-    } else {
-        d
-    };
-    let direction = direction.normalize();
+    // The view as seen with +z up, turned to the scene's up: +y up sees it from +z.
+    let direction = DQuat::from_rotation_arc(DVec3::Z, up) * DEFAULT_VIEW_DIRECTION.normalize();
     let half_fov = (0.5 * DEFAULT_FOV_DEG).to_radians();
     let distance = radius / half_fov.sin();
     Camera {
@@ -56,7 +51,7 @@ pub fn camera_looking(scene: &Scene, eye: DVec3, target: DVec3, fov_deg: Option<
     let up = scene_up(scene);
     let along = (target - eye).normalize_or_zero().dot(up).abs();
     let up = if along > 1.0 - ALONG_UP {
-        if up == DVec3::Z { DVec3::Y } else { DVec3::Z }
+        if up.z.abs() > 0.5 { DVec3::Y } else { DVec3::Z }
     } else {
         up
     };
@@ -68,8 +63,12 @@ pub fn camera_looking(scene: &Scene, eye: DVec3, target: DVec3, fov_deg: Option<
     }
 }
 
-/// The up direction of a scene's views: +y when its lights face -y (OBJ files), else +z.
-fn scene_up(scene: &Scene) -> DVec3 {
+/// The up direction of a scene's views: the scene's own (glTF files: +y); without one, +y when
+/// its lights face -y (OBJ files), else +z.
+pub fn scene_up(scene: &Scene) -> DVec3 {
+    if let Some(up) = scene.up.and_then(|u| u.try_normalize()) {
+        return up;
+    }
     if lights_face_minus_y(scene) {
         DVec3::Y
     } else {

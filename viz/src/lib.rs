@@ -67,7 +67,9 @@ mod surface_svg;
 mod svg_plot;
 mod tonemap;
 
-pub use camera::{DEFAULT_FOV_DEG, DEFAULT_VIEW_DIRECTION, camera_looking, default_camera};
+pub use camera::{
+    DEFAULT_FOV_DEG, DEFAULT_VIEW_DIRECTION, camera_looking, default_camera, scene_up,
+};
 pub use chart::{LogLogChart, Series};
 pub use error::VizError;
 pub use render::{MAX_PIXELS, Render, RenderOptions, encode_png, render};

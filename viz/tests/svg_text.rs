@@ -26,6 +26,8 @@ fn floor_scene(side: f64) -> Scene {
         p
     };
     Scene {
+        up: None,
+        unit: None,
         name: "units".into(),
         camera: None,
         surfaces: vec![

@@ -55,6 +55,9 @@ pub(crate) fn merge(args: &MergeArgs) -> Result<(), Failure> {
     if origin.camera.is_some() {
         loaded.scene.camera = origin.camera;
     }
+    if origin.unit.is_some() {
+        loaded.scene.unit = origin.unit;
+    }
     let merged = merge(shards, &loaded).map_err(|e| match e {
         MergeError::SceneChanged { .. } if args.scene.is_none() => usage(anyhow::anyhow!(
             "{e}; give the scene the shards were run on with --scene"

@@ -8,6 +8,7 @@ use penumbra::RunResult;
 use penumbra::export::{ExportFormat, export_run};
 use penumbra::outputs::{Invocation, SvgSelection, write_outputs};
 use penumbra::pipeline::{Kept, Stage};
+use penumbra_scenes::LengthUnit;
 use penumbra_solver::Interrupt;
 
 use crate::failure::{Command, Failure, invalid_option, run_failure, usage};
@@ -106,6 +107,10 @@ fn run_with(args: &RunArgs, fingerprint: Option<&str>) -> Result<ExitCode, Failu
         .transpose()?;
     let spec = args.scene.as_deref().unwrap_or_default();
     let mut loaded = load(spec, obj_options(args.no_merge))?;
+    let unit = unit_of(args.unit.as_deref())?;
+    if unit.is_some() {
+        loaded.scene.unit = unit;
+    }
     // The camera the options give, if any: it replaces the scene's, and a shard records it.
     let camera =
         crate::camera::camera(args, &loaded.scene).map_err(|e| usage(anyhow::anyhow!(e)))?;
@@ -144,6 +149,7 @@ fn run_with(args: &RunArgs, fingerprint: Option<&str>) -> Result<ExitCode, Failu
                 spec: spec.to_owned(),
                 no_merge: args.no_merge,
                 camera,
+                unit,
             };
             write_shard(&result, shard, origin, args, &svgs)?;
         }
@@ -322,5 +328,19 @@ fn invocation(args: &RunArgs) -> Result<Invocation, Failure> {
             .map(|d| d.display().to_string())
             .unwrap_or_default(),
         options: serde_json::to_value(args)?,
+    })
+}
+
+/// `--unit`'s unit, if given.
+fn unit_of(text: Option<&str>) -> Result<Option<LengthUnit>, Failure> {
+    let Some(text) = text else {
+        return Ok(None);
+    };
+    LengthUnit::from_symbol(text).map(Some).ok_or_else(|| {
+        let symbols: Vec<&str> = LengthUnit::ALL.iter().map(|u| u.symbol()).collect();
+        usage(anyhow::anyhow!(
+            "--unit {text:?}: not a unit; give one of {}",
+            symbols.join(", ")
+        ))
     })
 }

@@ -149,6 +149,11 @@ pub(crate) struct RunArgs {
     /// material are merged where the union is a simple polygon).
     #[arg(help_heading = INPUT, long)]
     pub(crate) no_merge: bool,
+    /// The unit of the scene's coordinates, which solution.glb turns into metres: um, mm, cm,
+    /// m, km, in or ft (default: the scene's "unit", else metres; glTF files are in metres).
+    #[arg(help_heading = INPUT, long, value_name = "UNIT")]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(crate) unit: Option<String>,
     /// How surfaces are meshed (default: error-driven, along the umbra and penumbra boundaries
     /// and contact lines, refined where the interpolation of the exact direct light is
     /// measured worst, up to --max-elements or --tol; with --refine-tol, discontinuity where
