@@ -43,3 +43,15 @@ def test_the_wheel_installs_and_runs_in_a_fresh_venv(tmp_path):
         capture_output=True, text=True, check=True,
     ).stdout.strip()
     assert {"py.typed", "_native.pyi"} <= set(os.listdir(site))
+
+
+def test_the_wheel_installs_on_any_linux_from_2014_on():
+    """Tagged manylinux2014 (glibc 2.17), and auditwheel finds nothing in it that needs more."""
+    wheel = the_wheel()
+    assert re.search(r"manylinux_2_17_x86_64|manylinux2014_x86_64", wheel.name), wheel.name
+    show = subprocess.run(
+        [sys.executable, "-m", "auditwheel", "show", str(wheel)], capture_output=True, text=True
+    )
+    assert show.returncode == 0, show.stderr
+    text = " ".join(show.stdout.split())
+    assert 'consistent with the following platform tag: "manylinux_2_17_x86_64"' in text, show.stdout

@@ -28,6 +28,9 @@ use crate::model::{Camera, LengthUnit, Scene};
 use crate::obj::ObjOptions;
 use accessors::Buffers;
 
+/// The length of a GLB's header: magic, version, length.
+const GLB_HEADER: usize = 12;
+
 /// Reads a glTF file and the buffers it names, looked for beside it.
 pub(crate) fn read_gltf_with(
     path: &Path,
@@ -157,11 +160,17 @@ fn validate(document: &gltf::Document) -> Result<(), String> {
 }
 
 /// A GLB shorter than its header says was cut short: said so, rather than the parser's words.
+/// One that says it is shorter than its header is refused before the parser subtracts.
 fn check_glb_length(bytes: &[u8]) -> Result<(), String> {
-    let Some(header) = bytes.get(..12).filter(|h| h.starts_with(b"glTF")) else {
+    let Some(header) = bytes.get(..GLB_HEADER).filter(|h| h.starts_with(b"glTF")) else {
         return Ok(());
     };
     let declared = u32::from_le_bytes([header[8], header[9], header[10], header[11]]) as usize;
+    if declared < GLB_HEADER {
+        return Err(format!(
+            "the GLB header declares {declared} bytes, fewer than the header's own {GLB_HEADER}"
+        ));
+    }
     if declared > bytes.len() {
         return Err(format!(
             "the GLB header declares {declared} bytes, but the file holds {}: it is truncated",

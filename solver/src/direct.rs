@@ -272,7 +272,7 @@ impl<'a> DirectLight<'a> {
         // corner, as are its neighbours' vertices along their junctions with it, while its
         // triangles pass through its corners.
         let tol = visibility.contact_distance();
-        let orientation = closed_solid_orientation(scene);
+        let orientation = closed_solid_orientation(scene, visibility);
         let mut corners = CornerIds::default();
         let mut occluders = Vec::new();
         let mut whole: Vec<Option<usize>> = vec![None; scene.surfaces.len()];

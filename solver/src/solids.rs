@@ -6,10 +6,10 @@
 //! A closed solid also encloses: no ray from a point inside it leaves the scene, so every form
 //! factor from there sums to exactly one ([`Enclosures`]).
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 use glam::DVec3;
-use penumbra_scenes::{Scene, SurfaceId, UnionFind, Visibility};
+use penumbra_scenes::{Bounds, Scene, SurfaceId, UnionFind, Visibility};
 use rayon::prelude::*;
 
 use crate::elements::Discretization;
@@ -20,9 +20,70 @@ fn key(p: DVec3) -> [u64; 3] {
     [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()]
 }
 
-/// For each surface, `Some(sign)` when it is a face of a closed, consistently oriented solid:
-/// its outward normal is `sign` times its own normal. `None` for every other surface.
-pub(crate) fn closed_solid_orientation(scene: &Scene) -> Vec<Option<f64>> {
+/// For each surface, `Some(sign)` when it is a face of a closed, consistently oriented solid
+/// that rests on no other surface ([`resting_solids`]): its outward normal is `sign` times its
+/// own normal. `None` for every other surface.
+pub(crate) fn closed_solid_orientation(scene: &Scene, visibility: &Visibility) -> Vec<Option<f64>> {
+    let solids = closed_solids(scene);
+    let resting = resting_solids(scene, visibility, &solids);
+    solids
+        .into_iter()
+        .map(|solid| {
+            solid
+                .filter(|(group, _)| !resting.contains(group))
+                .map(|(_, sign)| sign)
+        })
+        .collect()
+}
+
+/// The closed solids (by group) one of whose faces lies on another surface that faces it, as a
+/// cube stands on a floor: all the faces' corners within the meeting distance of its plane,
+/// their boxes overlapping. A point of that surface under the face lies in the face's plane, so
+/// the face casts nothing from there, and the solid's faces turned away from the point are all
+/// that stand between it and the light: they must not be skipped as turned away.
+fn resting_solids(
+    scene: &Scene,
+    visibility: &Visibility,
+    solids: &[Option<(usize, f64)>],
+) -> HashSet<usize> {
+    let near = visibility.meeting_distance();
+    let triangles = visibility.triangles();
+    let mut resting = HashSet::new();
+    for (f, face) in scene.surfaces.iter().enumerate() {
+        let Some((group, sign)) = solids[f] else {
+            continue;
+        };
+        if resting.contains(&group) {
+            continue;
+        }
+        let outward = face.normal() * sign;
+        let origin = face.polygon[0];
+        let b = face.bounds();
+        let around = Bounds {
+            min: b.min - DVec3::splat(near),
+            max: b.max + DVec3::splat(near),
+        };
+        let mut touching = false;
+        visibility.triangles_overlapping(around, |t| {
+            let other = &triangles[t];
+            touching = touching
+                || (solids[other.surface].is_none_or(|(g, _)| g != group)
+                    && visibility.triangle_normal(t).dot(outward) < 0.0
+                    && other
+                        .vertices
+                        .iter()
+                        .all(|&p| outward.dot(p - origin).abs() <= near));
+        });
+        if touching {
+            resting.insert(group);
+        }
+    }
+    resting
+}
+
+/// For each surface, `Some((solid, sign))` when it is a face of a closed, consistently oriented
+/// solid (numbered by any of its faces): its outward normal is `sign` times its own normal.
+fn closed_solids(scene: &Scene) -> Vec<Option<(usize, f64)>> {
     let surfaces = &scene.surfaces;
     // Directed edges by their corners, and the faces that hold them.
     let mut edges: HashMap<([u64; 3], [u64; 3]), Vec<usize>> = HashMap::new();
@@ -59,8 +120,9 @@ pub(crate) fn closed_solid_orientation(scene: &Scene) -> Vec<Option<f64>> {
     }
     (0..surfaces.len())
         .map(|s| {
-            let (is_closed, volume, _) = closed[&groups.find(s)];
-            (is_closed && volume != 0.0).then(|| volume.signum())
+            let root = groups.find(s);
+            let (is_closed, volume, _) = closed[&root];
+            (is_closed && volume != 0.0).then(|| (root, volume.signum()))
         })
         .collect()
 }
@@ -88,7 +150,10 @@ pub(crate) struct Enclosures<'a> {
 
 impl<'a> Enclosures<'a> {
     pub(crate) fn new(scene: &Scene, visibility: &'a Visibility) -> Enclosures<'a> {
-        let orientation = closed_solid_orientation(scene);
+        let orientation: Vec<Option<f64>> = closed_solids(scene)
+            .into_iter()
+            .map(|solid| solid.map(|(_, sign)| sign))
+            .collect();
         Enclosures {
             visibility,
             room: orientation.iter().map(|o| *o == Some(-1.0)).collect(),
@@ -161,13 +226,21 @@ mod tests {
             .collect()
     }
 
+    /// Each surface's outward sign as a face of a closed solid, resting or not.
+    fn orientations(scene: &Scene) -> Vec<Option<f64>> {
+        closed_solids(scene)
+            .into_iter()
+            .map(|s| s.map(|(_, sign)| sign))
+            .collect()
+    }
+
     #[test]
     fn a_closed_cube_is_found_with_its_orientation() {
         for (flip, sign) in [(false, 1.0), (true, -1.0)] {
             let mut scene = penumbra_scenes::builtin::textbook();
             let before = scene.surfaces.len();
             scene.surfaces.extend(cube(flip));
-            let found = closed_solid_orientation(&scene);
+            let found = orientations(&scene);
             assert!(found[..before].iter().all(Option::is_none));
             assert!(
                 found[before..].iter().all(|&o| o == Some(sign)),
@@ -188,17 +261,13 @@ mod tests {
         let mut faces = cube(false);
         faces.pop();
         open.surfaces.extend(faces);
-        assert!(closed_solid_orientation(&open).iter().all(Option::is_none));
+        assert!(orientations(&open).iter().all(Option::is_none));
 
         let mut inconsistent = penumbra_scenes::builtin::textbook();
         let mut faces = cube(false);
         faces[2].polygon.reverse();
         inconsistent.surfaces.extend(faces);
-        assert!(
-            closed_solid_orientation(&inconsistent)
-                .iter()
-                .all(Option::is_none)
-        );
+        assert!(orientations(&inconsistent).iter().all(Option::is_none));
     }
 
     /// A point on a receiver, facing `normal`, inside its surface.
