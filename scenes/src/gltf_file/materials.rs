@@ -64,9 +64,14 @@ fn material(m: &gltf::Material) -> Material {
 /// textures, a line each.
 pub(crate) fn warnings(materials: &[Material], used: &[usize]) -> Vec<String> {
     let mut out = Vec::new();
-    for m in used.iter().filter_map(|&i| materials.get(i)) {
+    for (i, m) in used.iter().filter_map(|&i| Some((i, materials.get(i)?))) {
         let [r, g, b] = m.base_color;
-        if m.base_color.iter().any(|&c| c >= 1.0) {
+        if i + 1 == materials.len() {
+            out.push(format!(
+                "faces without a material get glTF's default material, white: reflectance \
+                 {MAX_OBJ_REFLECTANCE}"
+            ));
+        } else if m.base_color.iter().any(|&c| c >= 1.0) {
             out.push(format!(
                 "material \"{}\" has baseColorFactor {r} {g} {b}: a surface cannot reflect all \
                  the light it receives, so its channels at or above 1 become {MAX_OBJ_REFLECTANCE}",
