@@ -95,7 +95,7 @@ impl Scene {
 
 #[pymethods]
 impl Scene {
-    /// A `.json` or `.obj` file (with its `.mtl` libraries).
+    /// A `.json`, `.obj` (with its `.mtl` libraries), `.gltf` (with its buffers) or `.glb` file.
     #[staticmethod]
     #[pyo3(signature = (path, merge = true))]
     fn load(py: Python<'_>, path: &str, merge: bool) -> PyResult<Scene> {

@@ -75,6 +75,39 @@ def test_files_load_as_the_command_line_loads_them(cli, tmp_path):
     assert penumbra.run(merged, direct_only=True).solution_json() == (tmp_path / "out" / "solution.json").read_text()
 
 
+def test_gltf_files_load_as_the_command_line_loads_them(cli, tmp_path):
+    # The same lamp over a floor as a .gltf: two triangles of the floor, one quad of the lamp
+    # drawn as a fan, each its node's; the buffer inline.
+    import base64
+    import json
+    import struct
+
+    floor = [[-1, 0, 1], [1, 0, 1], [1, 0, -1], [-1, 0, -1]]
+    lamp = [[-0.2, 1, -0.2], [0.2, 1, -0.2], [0.2, 1, 0.2], [-0.2, 1, 0.2]]
+    data = b"".join(struct.pack("<3f", *p) for p in floor + lamp) + struct.pack("<6H", 0, 1, 2, 0, 2, 3)
+    accessor = lambda offset, count, kind, component: {
+        "bufferView": 0, "byteOffset": offset, "count": count, "type": kind, "componentType": component}
+    document = {
+        "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1]}],
+        "nodes": [{"name": "floor", "mesh": 0}, {"name": "lamp", "mesh": 1}],
+        "meshes": [
+            {"primitives": [{"attributes": {"POSITION": 0}, "indices": 2, "material": 0}]},
+            {"primitives": [{"attributes": {"POSITION": 1}, "material": 1, "mode": 6}]},
+        ],
+        "materials": [{"name": "grey", "pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1]}},
+                      {"name": "glow", "emissiveFactor": [1, 1, 1]}],
+        "accessors": [accessor(0, 4, "VEC3", 5126), accessor(48, 4, "VEC3", 5126), accessor(96, 6, "SCALAR", 5123)],
+        "bufferViews": [{"buffer": 0, "byteLength": len(data)}],
+        "buffers": [{"byteLength": len(data), "uri": "data:application/octet-stream;base64," + base64.b64encode(data).decode()}],
+    }
+    (tmp_path / "lamp.gltf").write_text(json.dumps(document))
+    scene = penumbra.Scene.load(tmp_path / "lamp.gltf")
+    assert len(scene) == 2 and scene.source.endswith("lamp.gltf")
+    assert len(penumbra.Scene.load(tmp_path / "lamp.gltf", merge=False)) == 4
+    run_cli(cli, "run", "lamp.gltf", "--direct-only", "--out", "out", "--quiet", cwd=tmp_path)
+    assert penumbra.run(scene, direct_only=True).solution_json() == (tmp_path / "out" / "solution.json").read_text()
+
+
 def test_scene_errors_carry_every_problem_as_check_reports_them(cli, tmp_path):
     # A repeated name, a degenerate triangle and a reflectance above 1.
     scene_json = (

@@ -97,8 +97,8 @@ enum Command {
     Check {
         /// A .json, .obj, .gltf or .glb file, or the name of a built-in scene.
         scene: String,
-        /// OBJ files: keep every face as its own surface (by default coplanar adjacent faces of
-        /// one material are merged where the union is a simple polygon).
+        /// OBJ and glTF files: keep every face as its own surface (by default coplanar adjacent
+        /// faces of one material are merged where the union is a simple polygon).
         #[arg(long)]
         no_merge: bool,
     },

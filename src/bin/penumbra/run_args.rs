@@ -145,8 +145,8 @@ pub(crate) struct RunArgs {
     #[arg(long, help_heading = INPUT, value_name = "REPORT")]
     #[serde(skip)]
     pub(crate) replay: Option<PathBuf>,
-    /// OBJ files: keep every face as its own surface (by default coplanar adjacent faces of one
-    /// material are merged where the union is a simple polygon).
+    /// OBJ and glTF files: keep every face as its own surface (by default coplanar adjacent faces
+    /// of one material are merged where the union is a simple polygon).
     #[arg(help_heading = INPUT, long)]
     pub(crate) no_merge: bool,
     /// The unit of the scene's coordinates, which solution.glb turns into metres: um, mm, cm,
