@@ -3,8 +3,8 @@
 //! `node/material/index` (`index` counts that node's faces of that material), repaired and merged
 //! into surfaces as OBJ faces are ([`crate::mesh_file`]). Materials give reflectance and
 //! emission ([`materials`]). Triangle strips and fans are read as their triangles; points and
-//! lines are skipped with a warning. The first perspective camera in the tree becomes the
-//! scene's camera. Coordinates stay the file's: metres, +y up.
+//! lines are skipped with a warning, as are punctual lights. The first perspective camera in the
+//! tree becomes the scene's camera. Coordinates stay the file's: metres, +y up.
 //!
 //! Accessors are read with their bounds checked ([`accessors`]): a truncated buffer, an index past
 //! the vertices or a position that is not a number is an error naming the accessor, the mesh and
@@ -95,6 +95,16 @@ pub(crate) fn parse_gltf(
     .flatten()
     .chain(walk.camera_warnings)
     .collect();
+    if document
+        .extensions_used()
+        .any(|e| e == "KHR_lights_punctual")
+    {
+        warnings.push(
+            "the file's point, spot and sun lights (KHR_lights_punctual) are not read: lights \
+             here are surfaces, so give a polygon an emissive material"
+                .to_string(),
+        );
+    }
     let material_of = |m: Option<usize>| {
         let m = &materials[m.unwrap_or(default_material).min(default_material)];
         (m.reflectance, m.emission)

@@ -54,6 +54,8 @@
 //!     Scene {
 //!         name: "square".into(),
 //!         camera: None,
+//!         up: None,
+//!         unit: None,
 //!         surfaces: vec![
 //!             Surface::new("light", light, Rgb::ZERO).with_emission(Rgb::splat(10.0)),
 //!             Surface::new("floor", floor, Rgb::splat(0.5)),
