@@ -191,3 +191,27 @@ fn points_and_lines_are_skipped_with_a_warning() {
         loaded.warnings
     );
 }
+
+#[test]
+fn punctual_lights_are_skipped_with_a_warning_even_when_required() {
+    let mut document = gltf(&STRIP, &[0, 1, 2], 4, &json!([{"mesh": 0}]), &grey());
+    document["extensionsUsed"] = json!(["KHR_lights_punctual"]);
+    document["extensionsRequired"] = json!(["KHR_lights_punctual"]);
+    document["extensions"] =
+        json!({"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 1000}]}});
+    document["nodes"]
+        .as_array_mut()
+        .expect("nodes")
+        .push(json!({"name": "Light", "extensions": {"KHR_lights_punctual": {"light": 0}}}));
+    document["scenes"][0]["nodes"] = json!([0, 1]);
+    let loaded = load(&document, true);
+    assert_eq!(loaded.scene.surfaces.len(), 1);
+    assert!(
+        loaded
+            .warnings
+            .iter()
+            .any(|w| w.contains("KHR_lights_punctual")),
+        "{:?}",
+        loaded.warnings
+    );
+}
