@@ -21,6 +21,7 @@ use glam::{DMat4, DVec3};
 use gltf::mesh::{Mode, Semantic};
 
 use crate::error::SceneError;
+use crate::load::{read_bytes, scene_name};
 use crate::mesh_file::into_surfaces;
 use crate::mesh_file::repair::Face;
 use crate::mesh_file::tally::{FaceSource, Tally};
@@ -36,13 +37,9 @@ pub(crate) fn read_gltf_with(
     path: &Path,
     options: &ObjOptions,
 ) -> Result<(Scene, Vec<String>), SceneError> {
-    let bytes = std::fs::read(path).map_err(|source| SceneError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let bytes = read_bytes(path)?;
     let dir = path.parent().unwrap_or(Path::new("."));
-    let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("scene");
-    parse_gltf(&bytes, dir, name, options).map_err(|message| SceneError::Gltf {
+    parse_gltf(&bytes, dir, &scene_name(path), options).map_err(|message| SceneError::Gltf {
         path: path.to_path_buf(),
         message,
     })
@@ -65,24 +62,17 @@ pub(crate) fn parse_gltf(
         .default_scene()
         .or_else(|| document.scenes().next())
         .ok_or("the file has no scene: nothing in it is placed to be lit")?;
+    let materials = materials::materials(&document);
+    let default_material = materials.len() - 1;
     let mut walk = Walk {
         buffers: &buffers,
+        materials: &materials,
         nodes: document.nodes().len(),
         ..Walk::default()
     };
     for node in scene.nodes() {
         walk.visit(&node, DMat4::IDENTITY, 0)?;
     }
-    let materials = materials::materials(&document);
-    let default_material = materials.len() - 1;
-    let faces = walk
-        .faces
-        .into_iter()
-        .map(|mut f| {
-            f.material = f.material.or(Some(default_material));
-            f
-        })
-        .collect();
     let mut warnings: Vec<String> = [
         walk.not_triangles
             .describe("skipped", "primitives that are not triangles (points or lines)"),
@@ -109,9 +99,10 @@ pub(crate) fn parse_gltf(
         let m = &materials[m.unwrap_or(default_material).min(default_material)];
         (m.reflectance, m.emission)
     };
-    let (surfaces, made) = into_surfaces(faces, options.merge_coplanar, &material_of, |used| {
-        materials::warnings(&materials, used)
-    });
+    let (surfaces, made) =
+        into_surfaces(walk.faces, options.merge_coplanar, &material_of, |used| {
+            materials::warnings(&materials, used)
+        });
     warnings.extend(made);
     let scene = Scene {
         up: Some(DVec3::Y),
@@ -194,11 +185,13 @@ fn check_glb_length(bytes: &[u8]) -> Result<(), String> {
 #[derive(Default)]
 struct Walk<'b> {
     buffers: &'b Buffers,
+    /// The file's materials, then the default ([`materials::materials`]).
+    materials: &'b [materials::Material],
     /// The file's node count: a deeper tree has a cycle.
     nodes: usize,
     faces: Vec<Face>,
     /// Faces so far of each node and material, for their names.
-    counters: HashMap<(String, Option<usize>), usize>,
+    counters: HashMap<(String, usize), usize>,
     camera: Option<Camera>,
     camera_warnings: Vec<String>,
     not_triangles: Tally,
@@ -302,26 +295,23 @@ impl Walk<'_> {
         };
         // A mirroring transform turns counter-clockwise corners clockwise: the front is kept.
         let mirrored = world.determinant() < 0.0;
-        let material = primitive.material().index();
+        // Without one, the default material, last of the list.
+        let last = self.materials.len().saturating_sub(1);
+        let material = primitive.material().index().map_or(last, |m| m.min(last));
+        let material_name = self.materials.get(material).map_or("", |m| m.name.as_str());
+        let counter = self
+            .counters
+            .entry((node.to_string(), material))
+            .or_insert(0);
         for triangle in triangles(mode, &order) {
             let mut polygon: Vec<DVec3> = triangle.iter().map(|&i| corners[i as usize]).collect();
             if mirrored {
                 polygon.reverse();
             }
-            let counter = self
-                .counters
-                .entry((node.to_string(), material))
-                .or_insert(0);
-            let material_name = primitive
-                .material()
-                .name()
-                .map(str::to_string)
-                .or_else(|| material.map(|m| format!("material{m}")))
-                .unwrap_or_else(|| "default-material".to_string());
             self.faces.push(Face {
                 source: source(&format!("{node}/{material_name}/{counter}")),
                 polygon,
-                material,
+                material: Some(material),
             });
             *counter += 1;
         }

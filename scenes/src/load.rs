@@ -109,16 +109,28 @@ pub fn parse_json(text: &str, path: &Path) -> Result<Scene, SceneError> {
         message: strip_position(&e.to_string()),
     })?;
     if scene.name.is_empty() {
-        scene.name = path
-            .file_stem()
-            .and_then(|s| s.to_str())
-            .unwrap_or("scene")
-            .to_string();
+        scene.name = scene_name(path);
     }
     for s in &mut scene.surfaces {
         drop_repeated_vertices(&mut s.polygon);
     }
     Ok(scene)
+}
+
+/// A scene file's name for a scene that has none of its own: the file's stem.
+pub(crate) fn scene_name(path: &Path) -> String {
+    path.file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("scene")
+        .to_string()
+}
+
+/// The bytes of a scene file (or of a file it names), or an error naming it.
+pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, SceneError> {
+    std::fs::read(path).map_err(|source| SceneError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
 }
 
 /// serde_json appends " at line L column C"; the error already says where.

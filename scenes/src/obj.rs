@@ -22,6 +22,7 @@ use std::path::{Path, PathBuf};
 
 use crate::color::Rgb;
 use crate::error::SceneError;
+use crate::load::{read_bytes, scene_name};
 use crate::mesh_file::into_surfaces;
 use crate::mesh_file::tally::{FaceSource, Tally};
 use crate::model::Scene;
@@ -59,10 +60,7 @@ pub(crate) fn read_obj_with(
     path: &Path,
     options: &ObjOptions,
 ) -> Result<(Scene, Vec<String>), SceneError> {
-    let bytes = std::fs::read(path).map_err(|source| SceneError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let bytes = read_bytes(path)?;
     let dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
     // Names in comments are often in a legacy encoding; they need not stop the import.
     let text = String::from_utf8_lossy(&bytes);
@@ -251,14 +249,6 @@ fn surface_material(material: Option<usize>, materials: &[tobj::Material]) -> (R
         ),
         None => (Rgb::splat(DEFAULT_REFLECTANCE), Rgb::ZERO),
     }
-}
-
-/// The scene's name: the file's stem.
-fn scene_name(path: &Path) -> String {
-    path.file_stem()
-        .and_then(|s| s.to_str())
-        .unwrap_or("scene")
-        .to_string()
 }
 
 /// A `Kd` channel as a reflectance: at or above 1, [`MAX_OBJ_REFLECTANCE`]; anything else as it

@@ -59,6 +59,15 @@ fn load(document: &Value, merge_coplanar: bool) -> LoadedScene {
     load_scene_with(path.to_str().expect("a UTF-8 path"), &options).expect("the scene loads")
 }
 
+/// Fails unless a warning of `loaded` says `words`.
+fn assert_warned(loaded: &LoadedScene, words: &str) {
+    assert!(
+        loaded.warnings.iter().any(|w| w.contains(words)),
+        "no warning says {words:?}: {:?}",
+        loaded.warnings
+    );
+}
+
 /// The unit square in z = 0, counter-clockwise seen from +z, as the corners of a strip.
 const STRIP: [[f32; 3]; 4] = [
     [0.0, 0.0, 0.0],
@@ -182,14 +191,7 @@ fn points_and_lines_are_skipped_with_a_warning() {
         .push(lines);
     let loaded = load(&document, true);
     assert_eq!(loaded.scene.surfaces.len(), 1);
-    assert!(
-        loaded
-            .warnings
-            .iter()
-            .any(|w| w.contains("skipped 1 primitives")),
-        "{:?}",
-        loaded.warnings
-    );
+    assert_warned(&loaded, "skipped 1 primitives");
 }
 
 #[test]
@@ -206,12 +208,5 @@ fn punctual_lights_are_skipped_with_a_warning_even_when_required() {
     document["scenes"][0]["nodes"] = json!([0, 1]);
     let loaded = load(&document, true);
     assert_eq!(loaded.scene.surfaces.len(), 1);
-    assert!(
-        loaded
-            .warnings
-            .iter()
-            .any(|w| w.contains("KHR_lights_punctual")),
-        "{:?}",
-        loaded.warnings
-    );
+    assert_warned(&loaded, "KHR_lights_punctual");
 }

@@ -81,6 +81,14 @@ fn resting_solids(
     resting
 }
 
+/// Each surface's outward sign as a face of a closed solid ([`closed_solids`]), resting or not.
+fn closed_solid_signs(scene: &Scene) -> Vec<Option<f64>> {
+    closed_solids(scene)
+        .into_iter()
+        .map(|solid| solid.map(|(_, sign)| sign))
+        .collect()
+}
+
 /// For each surface, `Some((solid, sign))` when it is a face of a closed, consistently oriented
 /// solid (numbered by any of its faces): its outward normal is `sign` times its own normal.
 fn closed_solids(scene: &Scene) -> Vec<Option<(usize, f64)>> {
@@ -150,10 +158,7 @@ pub(crate) struct Enclosures<'a> {
 
 impl<'a> Enclosures<'a> {
     pub(crate) fn new(scene: &Scene, visibility: &'a Visibility) -> Enclosures<'a> {
-        let orientation: Vec<Option<f64>> = closed_solids(scene)
-            .into_iter()
-            .map(|solid| solid.map(|(_, sign)| sign))
-            .collect();
+        let orientation = closed_solid_signs(scene);
         Enclosures {
             visibility,
             room: orientation.iter().map(|o| *o == Some(-1.0)).collect(),
@@ -226,21 +231,13 @@ mod tests {
             .collect()
     }
 
-    /// Each surface's outward sign as a face of a closed solid, resting or not.
-    fn orientations(scene: &Scene) -> Vec<Option<f64>> {
-        closed_solids(scene)
-            .into_iter()
-            .map(|s| s.map(|(_, sign)| sign))
-            .collect()
-    }
-
     #[test]
     fn a_closed_cube_is_found_with_its_orientation() {
         for (flip, sign) in [(false, 1.0), (true, -1.0)] {
             let mut scene = penumbra_scenes::builtin::textbook();
             let before = scene.surfaces.len();
             scene.surfaces.extend(cube(flip));
-            let found = orientations(&scene);
+            let found = closed_solid_signs(&scene);
             assert!(found[..before].iter().all(Option::is_none));
             assert!(
                 found[before..].iter().all(|&o| o == Some(sign)),
@@ -261,13 +258,17 @@ mod tests {
         let mut faces = cube(false);
         faces.pop();
         open.surfaces.extend(faces);
-        assert!(orientations(&open).iter().all(Option::is_none));
+        assert!(closed_solid_signs(&open).iter().all(Option::is_none));
 
         let mut inconsistent = penumbra_scenes::builtin::textbook();
         let mut faces = cube(false);
         faces[2].polygon.reverse();
         inconsistent.surfaces.extend(faces);
-        assert!(orientations(&inconsistent).iter().all(Option::is_none));
+        assert!(
+            closed_solid_signs(&inconsistent)
+                .iter()
+                .all(Option::is_none)
+        );
     }
 
     /// A point on a receiver, facing `normal`, inside its surface.
